@@ -1,0 +1,51 @@
+"""Headless command line: ``quilt-studio SUBCOMMAND ...`` over the same engine.
+
+Each sub-command lives in its own module of this package exposing
+``add_parser(subparsers)`` (which registers it and sets ``func``) so that
+commands can be added without touching each other.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+SUBCOMMANDS = ("seam", "tileset", "synth", "transfer", "export")
+
+
+def build_parser(prog: str = "quilt-studio") -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog=prog,
+        description="Quilt Studio: seamless tiles, connectable tile sets, image quilting and "
+        "texture transfer. With no sub-command, opens the editor.",
+    )
+    sub = parser.add_subparsers(dest="command", metavar="SUBCOMMAND")
+    for name in SUBCOMMANDS:
+        try:
+            module = importlib.import_module(f"engine.cli.{name}")
+        except ModuleNotFoundError as exc:  # a command still being written
+            if exc.name != f"engine.cli.{name}":
+                raise
+            continue
+        module.add_parser(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run a headless sub-command; returns the process exit code."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if args.command is None:
+        parser.print_help()
+        return 2
+    from engine.io import ImageError
+
+    try:
+        return int(args.func(args) or 0)
+    except (ImageError, ValueError, OSError) as exc:
+        print(f"quilt-studio {args.command}: error: {exc}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print(f"quilt-studio {args.command}: interrupted", file=sys.stderr)
+        return 130
