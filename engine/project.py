@@ -194,8 +194,10 @@ def export_project(project: Project, out_dir, **options) -> dict:
         "map_weights": project.map_weights,
         "source_paths": project.source_paths,
     }
-    options.setdefault("bit_depth", project.bit_depth)
-    options.setdefault("normal_convention", project.normal_convention)
+    if options.get("bit_depth") is None:
+        options["bit_depth"] = project.bit_depth
+    if options.get("normal_convention") is None:
+        options["normal_convention"] = project.normal_convention
     return export_bundle(out_dir, name=project.name, tiles=[c.maps for c in cands],
                          index_matrix=project.layout, preview=project.preview, manifest_extra=extra, **options)
 

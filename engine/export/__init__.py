@@ -55,7 +55,17 @@ _SAFE_NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]*$")
 
 
 class ExportError(OSError):
-    """The bundle could not be written; nothing was left behind. The message says where and why."""
+    """The bundle could not be written; nothing was left behind. The message says where and why.
+
+    ``errno`` holds the underlying error number (e.g. ``ENOSPC``) when there is one.
+    """
+
+    def __init__(self, code: int | None, message: str):
+        super().__init__(message)
+        self.errno = code
+
+    def __str__(self) -> str:
+        return self.args[0]
 
 
 # ---------------------------------------------------------------- bit depth
@@ -515,7 +525,7 @@ def _write_atomically(out: Path, files: Mapping[str, object], bit_depth: int, *,
         raise ExportError(errno.EEXIST, f"cannot export to {out}: it exists and is not a folder")
     replace = out.is_dir() and any(out.iterdir())
     if replace and not overwrite:
-        raise ExportError(errno.EEXIST, f"cannot export to {out}: the folder is not empty (use overwrite)")
+        raise ExportError(errno.EEXIST, f"cannot export to {out}: the folder is not empty (pass overwrite=True or --overwrite to replace it)")
     try:
         parent.mkdir(parents=True, exist_ok=True)
         tmp = Path(tempfile.mkdtemp(dir=parent, prefix=f".{out.name}.tmp-"))
