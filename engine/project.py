@@ -194,6 +194,7 @@ def export_project(project: Project, out_dir, **options) -> dict:
         "map_weights": project.map_weights,
         "source_paths": project.source_paths,
     }
+    options.setdefault("source_bit_depth", project.bit_depth)
     if options.get("bit_depth") is None:
         options["bit_depth"] = project.bit_depth
     if options.get("normal_convention") is None:

@@ -44,7 +44,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                    help="bleed by repeating the edge pixel (default) or the opposite edge")
     p.add_argument("--bit-depth", type=int, choices=(8, 16), default=None,
                    help="output bits per channel (default: the project's; 16 -> 8 is dithered)")
-    p.add_argument("--no-dither", action="store_true", help="round instead of dithering when reducing bit depth")
+    p.add_argument("--dither", action=argparse.BooleanOptionalAction, default=None,
+                   help="dither when rounding (default: only when reducing a 16-bit project to 8 bits)")
     p.add_argument("--seed", type=int, default=0, help="seed of the dither noise")
     p.add_argument("--overwrite", action="store_true", help="replace a non-empty --out folder")
     p.set_defaults(func=run)
@@ -60,7 +61,7 @@ def run(args) -> int:
     manifest = export_project(
         project, args.out, columns=args.atlas_columns, spacing=args.spacing, margin=args.margin,
         extrude=args.extrude, extrude_mode=args.extrude_mode, bit_depth=args.bit_depth,
-        dither=not args.no_dither, rng=args.seed, overwrite=args.overwrite,
+        dither=args.dither, rng=args.seed, overwrite=args.overwrite,
     )
     print(f"quilt-studio export: wrote {manifest['tile_count']} tiles x {len(manifest['maps'])} maps "
           f"({manifest['tile_w']}x{manifest['tile_h']}, {manifest['bit_depth']}-bit) to {args.out}", file=sys.stderr)

@@ -17,6 +17,9 @@ normal, ...), into ``out_dir``:
 - ``{name}.tres``: a Godot 4 ``TileSet`` text resource;
 - ``{name}_preview_{m}.png``: the synthesized preview.
 
+PNGs are written by the exact codec of :mod:`engine.export._png` (8 or 16 bits
+per channel, gray / gray+alpha / RGB / RGBA, deterministic bytes).
+
 Everything is written into a temporary sibling folder which is renamed into
 place at the end, so a failure leaves nothing half-written and raises
 :class:`ExportError` naming the folder and the reason.
@@ -42,6 +45,7 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 
 from engine._validate import as_image, as_rng, choice
+from engine.export._png import encode_png
 from engine.materials import NORMAL_CONVENTIONS
 
 __all__ = [
@@ -96,7 +100,7 @@ def quantize(pixels, bit_depth: int, *, dither: bool = True, rng=None) -> np.nda
     x = np.clip(a, 0.0, 1.0) * top
     r = np.round(x)
     if dither:
-        off = np.abs(x - r) > 1e-3
+        off = np.abs(x - r) > 1e-2  # float32 k/65535 is off the grid by up to ~0.004 LSB
         if off.any():
             n = gen.random(int(off.sum())) - gen.random(int(off.sum()))
             r[off] = np.round(x[off] + n)
@@ -328,7 +332,8 @@ def export_bundle(out_dir, *, name: str, tiles: Sequence[Mapping[str, np.ndarray
                   index_matrix=None, preview: Mapping[str, np.ndarray] | None = None, columns: int | None = None,
                   spacing: int = 0, margin: int = 0, extrude: int = 0, extrude_mode: str = "edge",
                   manifest_extra: Mapping | None = None, normal_convention: str = "opengl",
-                  weights: Sequence[float] | None = None, dither: bool = True, rng=0,
+                  weights: Sequence[float] | None = None, source_bit_depth: int | None = None,
+                  dither: bool | None = None, rng=0,
                   godot_path_prefix: str | None = None, overwrite: bool = False) -> dict:
     """Write the export bundle of ``tiles`` into the folder ``out_dir``; returns the manifest.
 
@@ -338,8 +343,14 @@ def export_bundle(out_dir, *, name: str, tiles: Sequence[Mapping[str, np.ndarray
         Every tile has the same maps (the first map is the main map, used for the
         Tiled/Godot atlas) and every map the same size. Float [0, 1], uint8 or uint16.
     bit_depth : 8, 16 or None
-        Output bits per channel. None: 16 if any input array is uint16, else 8.
-        Going from finer data to 8 bits is dithered when ``dither`` (seeded by ``rng``).
+        Output bits per channel. None: ``source_bit_depth``.
+    source_bit_depth : 8, 16 or None
+        Bit depth of the source the tiles come from. None: 16 if any input array
+        is uint16, else 8.
+    dither : bool or None
+        Dither when rounding (seeded by ``rng``). None (default): only when
+        reducing a 16-bit source to 8 bits; otherwise values are rounded (values
+        already on the output grid, i.e. copied source pixels, are always exact).
     index_matrix : (rows, cols) int array or None
         Tile ids of the previewed layout, -1 = empty.
     preview : {map: image} or None
@@ -384,8 +395,14 @@ def export_bundle(out_dir, *, name: str, tiles: Sequence[Mapping[str, np.ndarray
     for m in maps:
         if shapes[m][:2] != (th, tw):
             raise ValueError(f"map {m!r} tiles are {shapes[m][1]}x{shapes[m][0]}, main map tiles are {tw}x{th}")
+    if source_bit_depth is None:
+        source_bit_depth = 16 if any(np.asarray(t[m]).dtype == np.uint16 for t in tiles for m in maps) else 8
+    elif isinstance(source_bit_depth, bool) or source_bit_depth not in (8, 16):
+        raise ValueError(f"source_bit_depth must be 8, 16 or None, got {source_bit_depth!r}")
     if bit_depth is None:
-        bit_depth = 16 if any(np.asarray(t[m]).dtype == np.uint16 for t in tiles for m in maps) else 8
+        bit_depth = source_bit_depth
+    if dither is None:
+        dither = bit_depth < source_bit_depth
     n = len(tiles)
     lay = atlas_layout(n, tw, th, columns=columns, spacing=spacing, margin=margin, extrude=extrude)
     choice(extrude_mode, "extrude_mode", ("edge", "wrap"))
@@ -462,6 +479,8 @@ def export_bundle(out_dir, *, name: str, tiles: Sequence[Mapping[str, np.ndarray
         "tile_h": th,
         "tile_count": n,
         "bit_depth": bit_depth,
+        "source_bit_depth": source_bit_depth,
+        "dithered": bool(dither and bit_depth < source_bit_depth),
         "maps": [{"name": m, "channels": int(shapes[m][2]) if len(shapes[m]) == 3 else 1} for m in maps],
         "main_map": maps[0],
         "normal_convention": normal_convention,
@@ -508,15 +527,15 @@ def _reason(exc: BaseException) -> str:
 
 def _write_file(path: Path, content, bit_depth: int) -> None:
     if isinstance(content, str):
-        with open(path, "w", encoding="utf-8", newline="\n") as f:
-            f.write(content)
+        _write_bytes(path, content.encode("utf-8"))
         return
-    from engine.io import save_image
+    _write_bytes(path, encode_png(np.asarray(content)))
 
-    q = np.asarray(content)
-    top = 255.0 if q.dtype == np.uint8 else 65535.0
-    save_image(path, q.astype(np.float32) / np.float32(top), bit_depth=16 if q.dtype == np.uint16 else 8)
-    os.chmod(path, 0o666 & ~_umask())  # save_image's temporary file is private (0600)
+
+def _write_bytes(path: Path, data: bytes) -> None:
+    """Every byte of the bundle goes through here (tests simulate a full disk on it)."""
+    with open(path, "wb") as f:
+        f.write(data)
 
 
 def _write_atomically(out: Path, files: Mapping[str, object], bit_depth: int, *, overwrite: bool) -> None:
