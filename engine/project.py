@@ -30,7 +30,7 @@ import zipfile
 import zlib
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from pathlib import Path, PurePosixPath
+from pathlib import Path
 
 import numpy as np
 
@@ -118,8 +118,8 @@ def project_from_tileset(*, sources, tiles: Sequence, name: str = "tileset", tem
     """
     def as_maps(v, what):
         if isinstance(v, Mapping):
-            return {str(k): as_image(a, f"{what}[{k!r}]") for k, a in v.items()}
-        return {"albedo": as_image(v, what)}
+            return {str(k): _as_float(a, f"{what}[{k!r}]") for k, a in v.items()}
+        return {"albedo": _as_float(v, what)}
 
     srcs = as_maps(sources, "sources")
     tiles = list(tiles)
@@ -201,6 +201,18 @@ def export_project(project: Project, out_dir, **options) -> dict:
         options["normal_convention"] = project.normal_convention
     return export_bundle(out_dir, name=project.name, tiles=[c.maps for c in cands],
                          index_matrix=project.layout, preview=project.preview, manifest_extra=extra, **options)
+
+
+def _as_float(a, what: str) -> np.ndarray:
+    """Like ``as_image`` but uint8/uint16 are divided exactly as ``engine.io.load_image`` does,
+    so a project built from integer arrays holds the same floats as one built from loaded files."""
+    arr = np.asarray(a)
+    if arr.dtype in (np.uint8, np.uint16):
+        arr = arr[:, :, None] if arr.ndim == 2 else arr
+        if arr.ndim != 3:
+            raise ValueError(f"{what} must be shaped (H, W) or (H, W, C), got {np.shape(a)}")
+        return arr.astype(np.float32) / (255.0 if arr.dtype == np.uint8 else 65535.0)
+    return as_image(a, what)
 
 
 # ---------------------------------------------------------------- consistency
@@ -403,8 +415,7 @@ def _umask() -> int:
 def _safe_entry(name: str) -> bool:
     if not name or "\\" in name or "\x00" in name or name.startswith("/") or re.match(r"^[A-Za-z]:", name):
         return False
-    parts = PurePosixPath(name).parts
-    return all(part not in ("..", ".", "") for part in parts) and not name.endswith("/")
+    return all(part not in ("..", ".", "") for part in name.split("/"))
 
 
 def load_project(path, *, max_pixels: int = MAX_PIXELS, max_entry_bytes: int = MAX_ENTRY_BYTES,
@@ -437,7 +448,7 @@ def load_project(path, *, max_pixels: int = MAX_PIXELS, max_entry_bytes: int = M
         seen = set()
         total = 0
         for info in infos:
-            if not _safe_entry(info.filename):
+            if not _safe_entry(info.filename[:-1] if info.is_dir() else info.filename):
                 fail(f"entry {info.filename!r} has an unsafe path (absolute, '..' or backslash); refused")
             if info.filename in seen:
                 fail(f"entry {info.filename!r} appears twice")
@@ -486,8 +497,7 @@ def _read_image(entry, read, fail, max_pixels, cap) -> np.ndarray:
         q = decode_png(data, max_pixels=max_pixels)
     except PNGError as exc:
         fail(f"entry {entry!r}: {exc}")
-    top = np.float32(255.0 if q.dtype == np.uint8 else 65535.0)
-    return q.astype(np.float32) / top
+    return _as_float(q, entry)
 
 
 class _Spec:
