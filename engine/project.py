@@ -39,8 +39,8 @@ from engine.export import export_bundle, quantize
 from engine.export._png import PNGError, decode_png, encode_png
 from engine.materials import MAP_KINDS, NORMAL_CONVENTIONS, resolve_kinds
 
-__all__ = ["Candidate", "Project", "ProjectError", "export_project", "load_project",
-           "project_from_tileset", "save_project", "PROJECT_VERSION", "PROJECT_SUFFIX"]
+__all__ = ["Candidate", "Project", "ProjectError", "export_project", "load_project", "newer_recovery",
+           "project_from_tileset", "recovery_path", "save_project", "PROJECT_VERSION", "PROJECT_SUFFIX"]
 
 PROJECT_FORMAT = "quilt-studio-project"
 PROJECT_VERSION = 1
@@ -408,6 +408,23 @@ def _umask() -> int:
     m = os.umask(0)
     os.umask(m)
     return m
+
+
+def recovery_path(path) -> Path:
+    """Where the editor autosaves a project saved at ``path`` (a hidden sibling file)."""
+    p = Path(os.fspath(path))
+    return p.with_name(f".{p.stem}.recovery{PROJECT_SUFFIX}")
+
+
+def newer_recovery(path) -> Path | None:
+    """The recovery file of ``path`` if it exists and is newer than ``path`` (offer it after a crash)."""
+    p = Path(os.fspath(path))
+    r = recovery_path(p)
+    if not r.is_file():
+        return None
+    if p.is_file() and p.stat().st_mtime_ns >= r.stat().st_mtime_ns:
+        return None
+    return r
 
 
 # ---------------------------------------------------------------- loading

@@ -358,3 +358,11 @@ def test_read_only_folder_real(tmp_path):
         assert list(ro.iterdir()) == []
     finally:
         ro.chmod(0o755)
+
+
+@pytest.mark.skipif(not Path("/sys/fs").is_dir(), reason="needs Linux sysfs (a folder nobody, not even root, can write)")
+def test_unwritable_system_folder_real():
+    with pytest.raises(ExportError, match="cannot export to /sys/fs/quilt_bundle") as info:
+        export_bundle("/sys/fs/quilt_bundle", name="a", tiles=make_tiles(1))
+    assert "nothing was written" in str(info.value)
+    assert not Path("/sys/fs/quilt_bundle").exists()

@@ -15,7 +15,8 @@ import pytest
 import engine.project as project_mod
 from engine.export._png import encode_png
 from engine.project import (
-    Candidate, Project, ProjectError, export_project, load_project, project_from_tileset, save_project,
+    Candidate, Project, ProjectError, export_project, load_project, newer_recovery, project_from_tileset,
+    recovery_path, save_project,
 )
 
 
@@ -276,3 +277,17 @@ def test_image_of_wrong_size_or_channels_is_refused(tmp_path, good):
 def test_candidate_dataclass_defaults():
     c = Candidate(maps={"albedo": np.zeros((2, 2, 3), np.float32)})
     assert c.patch_origin is None and not c.locked and c.params == {}
+
+
+def test_recovery_file(tmp_path):
+    path = tmp_path / "work.quiltproj"
+    assert recovery_path(path) == tmp_path / ".work.recovery.quiltproj"
+    assert newer_recovery(path) is None
+    save_project(path, make_project(8))
+    assert newer_recovery(path) is None
+    save_project(recovery_path(path), make_project(8, rng=5))
+    os.utime(path, ns=(1, 1))
+    assert newer_recovery(path) == recovery_path(path)
+    assert_same(load_project(newer_recovery(path)), make_project(8, rng=5))
+    os.utime(recovery_path(path), ns=(0, 0))
+    assert newer_recovery(path) is None
