@@ -46,6 +46,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                    help="output bits per channel (default: the project's; 16 -> 8 is dithered)")
     p.add_argument("--dither", action=argparse.BooleanOptionalAction, default=None,
                    help="dither when rounding (default: only when reducing a 16-bit project to 8 bits)")
+    p.add_argument("--tile-format", choices=("png", "tif"), default="png",
+                   help="format of the per-tile and preview files (atlases are always PNG)")
     p.add_argument("--seed", type=int, default=0, help="seed of the dither noise")
     p.add_argument("--overwrite", action="store_true", help="replace a non-empty --out folder")
     p.set_defaults(func=run)
@@ -61,7 +63,7 @@ def run(args) -> int:
     manifest = export_project(
         project, args.out, columns=args.atlas_columns, spacing=args.spacing, margin=args.margin,
         extrude=args.extrude, extrude_mode=args.extrude_mode, bit_depth=args.bit_depth,
-        dither=args.dither, rng=args.seed, overwrite=args.overwrite,
+        dither=args.dither, rng=args.seed, tile_format=args.tile_format, overwrite=args.overwrite,
     )
     print(f"quilt-studio export: wrote {manifest['tile_count']} tiles x {len(manifest['maps'])} maps "
           f"({manifest['tile_w']}x{manifest['tile_h']}, {manifest['bit_depth']}-bit) to {args.out}", file=sys.stderr)

@@ -334,7 +334,8 @@ def export_bundle(out_dir, *, name: str, tiles: Sequence[Mapping[str, np.ndarray
                   manifest_extra: Mapping | None = None, normal_convention: str = "opengl",
                   weights: Sequence[float] | None = None, source_bit_depth: int | None = None,
                   dither: bool | None = None, rng=0,
-                  godot_path_prefix: str | None = None, overwrite: bool = False) -> dict:
+                  godot_path_prefix: str | None = None, tile_format: str = "png",
+                  overwrite: bool = False) -> dict:
     """Write the export bundle of ``tiles`` into the folder ``out_dir``; returns the manifest.
 
     Parameters
@@ -365,6 +366,9 @@ def export_bundle(out_dir, *, name: str, tiles: Sequence[Mapping[str, np.ndarray
         Per-tile probabilities, written as Tiled ``probability``.
     godot_path_prefix : str or None
         Prefix of the atlas path in the ``.tres`` (default ``res://<out_dir name>/``).
+    tile_format : "png" or "tif"
+        Format of the per-tile and preview files (atlases are always PNG, which
+        Tiled and Godot read). Both keep 16 bits.
     overwrite : bool
         Replace an existing non-empty ``out_dir`` (atomically) instead of refusing.
     """
@@ -406,6 +410,7 @@ def export_bundle(out_dir, *, name: str, tiles: Sequence[Mapping[str, np.ndarray
     n = len(tiles)
     lay = atlas_layout(n, tw, th, columns=columns, spacing=spacing, margin=margin, extrude=extrude)
     choice(extrude_mode, "extrude_mode", ("edge", "wrap"))
+    choice(tile_format, "tile_format", ("png", "tif"))
     mat = _index_matrix(index_matrix, n) if index_matrix is not None else None
     if weights is not None:
         weights = [float(w) for w in weights]
@@ -433,7 +438,7 @@ def export_bundle(out_dir, *, name: str, tiles: Sequence[Mapping[str, np.ndarray
     for i, qt in enumerate(q_tiles):
         entry = {"id": i, "files": {}, "atlas_rect": dict(zip("xywh", lay.rect(i), strict=True))}
         for m in maps:
-            fname = f"{name}_{i:03}_{m}.png"
+            fname = f"{name}_{i:03}_{m}.{tile_format}"
             files[fname] = qt[m]
             entry["files"][m] = fname
         for key, values in per_tile.items():
@@ -455,7 +460,7 @@ def export_bundle(out_dir, *, name: str, tiles: Sequence[Mapping[str, np.ndarray
     if preview is None and mat is not None:
         preview = {m: assemble_layout([qt[m] for qt in q_tiles], mat) for m in maps}
     for m, img in (preview or {}).items():
-        fname = f"{name}_preview_{m}.png"
+        fname = f"{name}_preview_{m}.{tile_format}"
         files[fname] = quantize(img, bit_depth, dither=dither, rng=gen)
         previews[m] = fname
     layout_files = {}
@@ -529,7 +534,18 @@ def _write_file(path: Path, content, bit_depth: int) -> None:
     if isinstance(content, str):
         _write_bytes(path, content.encode("utf-8"))
         return
-    _write_bytes(path, encode_png(np.asarray(content)))
+    q = np.asarray(content)
+    if path.suffix == ".tif":
+        import tifffile
+
+        buf = io.BytesIO()
+        tifffile.imwrite(buf, q[:, :, 0] if q.ndim == 3 and q.shape[2] == 1 else q,
+                         photometric="minisblack" if q.ndim == 2 or q.shape[2] < 3 else "rgb",
+                         extrasamples=("unassalpha",) if q.ndim == 3 and q.shape[2] in (2, 4) else None,
+                         compression="zlib", metadata=None)
+        _write_bytes(path, buf.getvalue())
+        return
+    _write_bytes(path, encode_png(q))
 
 
 def _write_bytes(path: Path, data: bytes) -> None:

@@ -366,3 +366,19 @@ def test_unwritable_system_folder_real():
         export_bundle("/sys/fs/quilt_bundle", name="a", tiles=make_tiles(1))
     assert "nothing was written" in str(info.value)
     assert not Path("/sys/fs/quilt_bundle").exists()
+
+
+@pytest.mark.parametrize("maps", [("albedo", "height"), ("rgba",)])
+def test_tiff_tiles_keep_16_bits(tmp_path, maps):
+    import tifffile
+
+    g = np.random.default_rng(9)
+    chans = {"albedo": 3, "height": 1, "rgba": 4}
+    tiles = [{m: g.integers(0, 65536, (6, 5, chans[m])).astype(np.uint16) for m in maps} for _ in range(2)]
+    man = export_bundle(tmp_path / "t", name="t", tiles=tiles, tile_format="tif", index_matrix=[[0, 1]])
+    for i, entry in enumerate(man["tiles"]):
+        for m in maps:
+            assert entry["files"][m].endswith(".tif")
+            back = tifffile.imread(tmp_path / "t" / entry["files"][m])
+            assert back.dtype == np.uint16 and np.array_equal(back.reshape(tiles[i][m].shape), tiles[i][m])
+    assert man["atlas"]["images"][maps[0]].endswith(".png") and man["preview"][maps[0]].endswith(".tif")
