@@ -27,14 +27,35 @@ NORMAL_CONVENTIONS = ("opengl", "directx")
 MAP_KINDS = ("color", "normal", "height", "roughness", "ao", "metallic", "mask", "other")
 
 _KIND_BY_NAME = {
-    "albedo": "color", "basecolor": "color", "base_color": "color", "diffuse": "color",
-    "color": "color", "colour": "color", "main": "color",
-    "normal": "normal", "normals": "normal", "nrm": "normal", "norm": "normal",
-    "height": "height", "displacement": "height", "disp": "height", "bump": "height",
-    "roughness": "roughness", "rough": "roughness", "gloss": "roughness", "glossiness": "roughness",
-    "ao": "ao", "occlusion": "ao", "ambientocclusion": "ao", "ambient_occlusion": "ao",
-    "metallic": "metallic", "metalness": "metallic", "metal": "metallic",
-    "mask": "mask", "opacity": "mask", "alpha": "mask",
+    "albedo": "color",
+    "basecolor": "color",
+    "base_color": "color",
+    "diffuse": "color",
+    "color": "color",
+    "colour": "color",
+    "main": "color",
+    "normal": "normal",
+    "normals": "normal",
+    "nrm": "normal",
+    "norm": "normal",
+    "height": "height",
+    "displacement": "height",
+    "disp": "height",
+    "bump": "height",
+    "roughness": "roughness",
+    "rough": "roughness",
+    "gloss": "roughness",
+    "glossiness": "roughness",
+    "ao": "ao",
+    "occlusion": "ao",
+    "ambientocclusion": "ao",
+    "ambient_occlusion": "ao",
+    "metallic": "metallic",
+    "metalness": "metallic",
+    "metal": "metallic",
+    "mask": "mask",
+    "opacity": "mask",
+    "alpha": "mask",
 }
 
 
@@ -74,8 +95,14 @@ class Material:
         return {k: v[top : top + height, left : left + width] for k, v in self.maps.items()}
 
 
-def make_material(main, *, extra: Mapping | None = None, main_name: str = "albedo",
-                  kinds: Mapping | None = None, normal_convention: str = "opengl") -> Material:
+def make_material(
+    main,
+    *,
+    extra: Mapping | None = None,
+    main_name: str = "albedo",
+    kinds: Mapping | None = None,
+    normal_convention: str = "opengl",
+) -> Material:
     """Validate and bundle a main map with extra maps of the same size."""
     choice(normal_convention, "normal_convention", NORMAL_CONVENTIONS)
     if not isinstance(main_name, str) or not main_name:
@@ -87,8 +114,10 @@ def make_material(main, *, extra: Mapping | None = None, main_name: str = "albed
             raise ValueError(f"extra: bad or duplicate map name {name!r}")
         a = as_image(img, f"extra[{name!r}]")
         if a.shape[:2] != (h, w):
-            raise ValueError(f"extra[{name!r}] is {a.shape[1]}x{a.shape[0]}, the main map is {w}x{h}; "
-                             "maps of a material must be co-registered (same size)")
+            raise ValueError(
+                f"extra[{name!r}] is {a.shape[1]}x{a.shape[0]}, the main map is {w}x{h}; "
+                "maps of a material must be co-registered (same size)"
+            )
         maps[name] = a
     resolved = resolve_kinds(maps, kinds)
     for name, kind in resolved.items():
@@ -110,8 +139,14 @@ def resolve_kinds(names, kinds: Mapping | None = None) -> dict[str, str]:
     return out
 
 
-def material_error(maps_r1: Mapping, maps_r2: Mapping, *, weights: Mapping | None = None,
-                   main: str | None = None, metric: str = "euclid") -> np.ndarray:
+def material_error(
+    maps_r1: Mapping,
+    maps_r2: Mapping,
+    *,
+    weights: Mapping | None = None,
+    main: str | None = None,
+    metric: str = "euclid",
+) -> np.ndarray:
     """Weighted sum of per-map error maps (each scaled to mean 1 so weights are comparable).
 
     ``weights`` maps map names to non-negative floats; default: the main map (or
@@ -128,7 +163,12 @@ def material_error(maps_r1: Mapping, maps_r2: Mapping, *, weights: Mapping | Non
     for name, wgt in dict(weights).items():
         if name not in maps_r1:
             raise ValueError(f"weights names an unknown map {name!r}")
-        if isinstance(wgt, bool) or not isinstance(wgt, numbers.Real) or not np.isfinite(wgt) or wgt < 0:
+        if (
+            isinstance(wgt, bool)
+            or not isinstance(wgt, numbers.Real)
+            or not np.isfinite(wgt)
+            or wgt < 0
+        ):
             raise ValueError(f"weights[{name!r}] must be a finite number >= 0, got {wgt!r}")
         if wgt == 0:
             continue
@@ -186,7 +226,10 @@ def blend_normals(n1, n2, alpha) -> np.ndarray:
     a1 = as_image(n1, "n1")
     a2 = as_image(n2, "n2")
     if a1.shape != a2.shape or a1.shape[2] < 3:
-        raise ValueError(f"n1 and n2 must be equal-shaped normal maps with >= 3 channels, got {a1.shape}, {a2.shape}")
+        raise ValueError(
+            f"n1 and n2 must be equal-shaped normal maps with >= 3 channels, got {a1.shape}, "
+            f"{a2.shape}"
+        )
     al = _as_alpha(alpha, a1.shape[:2])
     out = np.where(al[..., None] >= 1.0, a1, a2).astype(np.float32)
     mixed = (al > 0) & (al < 1)
@@ -218,7 +261,9 @@ def _as_alpha(alpha, shape) -> np.ndarray:
     return al
 
 
-def apply_cut(maps_r1: Mapping, maps_r2: Mapping, alpha, *, kinds: Mapping | None = None) -> dict[str, np.ndarray]:
+def apply_cut(
+    maps_r1: Mapping, maps_r2: Mapping, alpha, *, kinds: Mapping | None = None
+) -> dict[str, np.ndarray]:
     """Composite every map of R1 over R2 with the same ``alpha`` (weight of R1, (h, w)).
 
     ``kinds`` gives each map's kind (default inferred from the names); maps of
@@ -230,7 +275,10 @@ def apply_cut(maps_r1: Mapping, maps_r2: Mapping, alpha, *, kinds: Mapping | Non
     if not isinstance(maps_r1, Mapping) or not isinstance(maps_r2, Mapping):
         raise TypeError("maps_r1 and maps_r2 must be mappings of map name -> image")
     if not maps_r1 or set(maps_r1) != set(maps_r2):
-        raise ValueError(f"maps_r1 and maps_r2 must name the same maps, got {sorted(maps_r1)} and {sorted(maps_r2)}")
+        raise ValueError(
+            f"maps_r1 and maps_r2 must name the same maps, got {sorted(maps_r1)} and "
+            f"{sorted(maps_r2)}"
+        )
     resolved = resolve_kinds(maps_r1, kinds)
     first = as_image(next(iter(maps_r1.values())), "maps_r1")
     al = _as_alpha(alpha, first.shape[:2])
@@ -239,7 +287,9 @@ def apply_cut(maps_r1: Mapping, maps_r2: Mapping, alpha, *, kinds: Mapping | Non
         a = as_image(maps_r1[name], f"maps_r1[{name!r}]")
         b = as_image(maps_r2[name], f"maps_r2[{name!r}]")
         if a.shape != b.shape or a.shape[:2] != al.shape:
-            raise ValueError(f"map {name!r}: r1 {a.shape}, r2 {b.shape} and alpha {al.shape} must agree")
+            raise ValueError(
+                f"map {name!r}: r1 {a.shape}, r2 {b.shape} and alpha {al.shape} must agree"
+            )
         if resolved[name] == "normal":
             if a.shape[2] < 3:
                 raise ValueError(f"normal map {name!r} needs 3 channels, got {a.shape[2]}")

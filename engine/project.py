@@ -39,8 +39,19 @@ from engine.export import export_bundle, quantize
 from engine.export._png import PNGError, decode_png, encode_png
 from engine.materials import MAP_KINDS, NORMAL_CONVENTIONS, resolve_kinds
 
-__all__ = ["Candidate", "Project", "ProjectError", "export_project", "load_project", "newer_recovery",
-           "project_from_tileset", "recovery_path", "save_project", "PROJECT_VERSION", "PROJECT_SUFFIX"]
+__all__ = [
+    "Candidate",
+    "Project",
+    "ProjectError",
+    "export_project",
+    "load_project",
+    "newer_recovery",
+    "project_from_tileset",
+    "recovery_path",
+    "save_project",
+    "PROJECT_VERSION",
+    "PROJECT_SUFFIX",
+]
 
 PROJECT_FORMAT = "quilt-studio-project"
 PROJECT_VERSION = 1
@@ -63,7 +74,9 @@ class Candidate:
     """One candidate tile: its images (one per map) and how it was made."""
 
     maps: dict[str, np.ndarray]
-    patch_origin: tuple[int, int] | None = None  # (row, col) of the patch source in the source image
+    patch_origin: tuple[int, int] | None = (
+        None  # (row, col) of the patch source in the source image
+    )
     seed: int | None = None
     locked: bool = False
     score: float | None = None
@@ -77,9 +90,13 @@ class Project:
     sources: dict[str, np.ndarray]  # map name -> float32 (H, W, C); the first is the main map
     name: str = "tileset"
     version: int = PROJECT_VERSION
-    source_paths: dict[str, str] = field(default_factory=dict)  # where the maps were loaded from (info)
+    source_paths: dict[str, str] = field(
+        default_factory=dict
+    )  # where the maps were loaded from (info)
     map_kinds: dict[str, str] = field(default_factory=dict)
-    map_weights: dict[str, float] = field(default_factory=dict)  # seam-error weights; empty = main only
+    map_weights: dict[str, float] = field(
+        default_factory=dict
+    )  # seam-error weights; empty = main only
     normal_convention: str = "opengl"
     bit_depth: int = 8
     parameters: dict = field(default_factory=dict)  # any JSON: every parameter of every step
@@ -105,17 +122,38 @@ class Project:
 
 # ---------------------------------------------------------------- building
 
-def project_from_tileset(*, sources, tiles: Sequence, name: str = "tileset", template=None,
-                         template_rect=None, patch_origins=None, seeds=None, scores=None, locked=None,
-                         picks=None, layout=None, parameters=None, project_seeds=None, bit_depth: int = 8,
-                         source_paths=None, map_kinds=None, map_weights=None, normal_convention: str = "opengl",
-                         waypoints=None, preview=None, extra=None) -> Project:
+
+def project_from_tileset(
+    *,
+    sources,
+    tiles: Sequence,
+    name: str = "tileset",
+    template=None,
+    template_rect=None,
+    patch_origins=None,
+    seeds=None,
+    scores=None,
+    locked=None,
+    picks=None,
+    layout=None,
+    parameters=None,
+    project_seeds=None,
+    bit_depth: int = 8,
+    source_paths=None,
+    map_kinds=None,
+    map_weights=None,
+    normal_convention: str = "opengl",
+    waypoints=None,
+    preview=None,
+    extra=None,
+) -> Project:
     """Build a validated :class:`Project` from plain arrays (for the ``tileset`` CLI and tests).
 
     ``sources`` is an image or {map: image}; ``tiles`` a list of images or of
     {map: image} (same maps as ``sources``); ``template`` likewise.
     ``patch_origins``, ``seeds``, ``scores``, ``locked`` are per-tile lists (or None).
     """
+
     def as_maps(v, what):
         if isinstance(v, Mapping):
             return {str(k): _as_float(a, f"{what}[{k!r}]") for k, a in v.items()}
@@ -133,20 +171,26 @@ def project_from_tileset(*, sources, tiles: Sequence, name: str = "tileset", tem
             raise ValueError(f"{what} must have one entry per tile ({n}), got {len(v)}")
         return v
 
-    po, sd, sc, lk = (per_tile(patch_origins, "patch_origins"), per_tile(seeds, "seeds"),
-                      per_tile(scores, "scores"), per_tile(locked, "locked"))
+    po, sd, sc, lk = (
+        per_tile(patch_origins, "patch_origins"),
+        per_tile(seeds, "seeds"),
+        per_tile(scores, "scores"),
+        per_tile(locked, "locked"),
+    )
     cands = []
     for i, t in enumerate(tiles):
         maps = as_maps(t, f"tiles[{i}]")
         if not isinstance(t, Mapping) and len(srcs) == 1:
             maps = {next(iter(srcs)): maps["albedo"]}
-        cands.append(Candidate(
-            maps=maps,
-            patch_origin=None if po[i] is None else (int(po[i][0]), int(po[i][1])),
-            seed=None if sd[i] is None else int(sd[i]),
-            locked=bool(lk[i]) if lk[i] is not None else False,
-            score=None if sc[i] is None else float(sc[i]),
-        ))
+        cands.append(
+            Candidate(
+                maps=maps,
+                patch_origin=None if po[i] is None else (int(po[i][0]), int(po[i][1])),
+                seed=None if sd[i] is None else int(sd[i]),
+                locked=bool(lk[i]) if lk[i] is not None else False,
+                score=None if sc[i] is None else float(sc[i]),
+            )
+        )
     tmpl = None
     if template is not None:
         tmpl = as_maps(template, "template")
@@ -158,22 +202,32 @@ def project_from_tileset(*, sources, tiles: Sequence, name: str = "tileset", tem
         if not isinstance(preview, Mapping) and len(srcs) == 1:
             prev = {next(iter(srcs)): prev["albedo"]}
     p = Project(
-        sources=srcs, name=name, source_paths=dict(source_paths or {}),
-        map_kinds=resolve_kinds(srcs, map_kinds), map_weights=dict(map_weights or {}),
-        normal_convention=normal_convention, bit_depth=bit_depth, parameters=dict(parameters or {}),
+        sources=srcs,
+        name=name,
+        source_paths=dict(source_paths or {}),
+        map_kinds=resolve_kinds(srcs, map_kinds),
+        map_weights=dict(map_weights or {}),
+        normal_convention=normal_convention,
+        bit_depth=bit_depth,
+        parameters=dict(parameters or {}),
         seeds=dict(project_seeds or {}),
         template_rect=None if template_rect is None else tuple(int(v) for v in template_rect),
-        template=tmpl, candidates=cands, picks=[int(i) for i in (picks or [])],
+        template=tmpl,
+        candidates=cands,
+        picks=[int(i) for i in (picks or [])],
         layout=None if layout is None else np.asarray(layout, dtype=np.int64),
-        waypoints={str(k): [(int(r), int(c)) for r, c in v] for k, v in dict(waypoints or {}).items()},
-        preview=prev, extra=dict(extra or {}),
+        waypoints={
+            str(k): [(int(r), int(c)) for r, c in v] for k, v in dict(waypoints or {}).items()
+        },
+        preview=prev,
+        extra=dict(extra or {}),
     )
     _check_project(p, "project")
     return p
 
 
 def export_project(project: Project, out_dir, **options) -> dict:
-    """Export a project's picked tiles with :func:`engine.export.export_bundle`; returns the manifest.
+    """Export the picked tiles with :func:`engine.export.export_bundle`; returns the manifest.
 
     ``options`` are passed on (columns, spacing, margin, extrude, bit_depth,
     dither, overwrite ...); bit depth defaults to the project's.
@@ -188,8 +242,14 @@ def export_project(project: Project, out_dir, **options) -> dict:
         "parameters": project.parameters,
         "seeds": {"project": project.seeds, "tiles": [c.seed for c in cands]},
         "scores": [c.score for c in cands],
-        "source_rects": [{"template": list(project.template_rect) if project.template_rect else None,
-                          "patch_origin": o, "candidate": i} for o, i in zip(origins, order, strict=True)],
+        "source_rects": [
+            {
+                "template": list(project.template_rect) if project.template_rect else None,
+                "patch_origin": o,
+                "candidate": i,
+            }
+            for o, i in zip(origins, order, strict=True)
+        ],
         "map_kinds": project.map_kinds,
         "map_weights": project.map_weights,
         "source_paths": project.source_paths,
@@ -199,8 +259,15 @@ def export_project(project: Project, out_dir, **options) -> dict:
         options["bit_depth"] = project.bit_depth
     if options.get("normal_convention") is None:
         options["normal_convention"] = project.normal_convention
-    return export_bundle(out_dir, name=project.name, tiles=[c.maps for c in cands],
-                         index_matrix=project.layout, preview=project.preview, manifest_extra=extra, **options)
+    return export_bundle(
+        out_dir,
+        name=project.name,
+        tiles=[c.maps for c in cands],
+        index_matrix=project.layout,
+        preview=project.preview,
+        manifest_extra=extra,
+        **options,
+    )
 
 
 def _as_float(a, what: str) -> np.ndarray:
@@ -217,14 +284,21 @@ def _as_float(a, what: str) -> np.ndarray:
 
 # ---------------------------------------------------------------- consistency
 
+
 def _check_project(p: Project, where: str) -> None:
     """Cross-field checks shared by building, saving and loading; raises ValueError."""
     if not isinstance(p, Project):
         raise TypeError(f"{where} must be a Project, got {type(p).__name__}")
     if not isinstance(p.name, str) or not _SAFE_NAME.match(p.name) or len(p.name) > 100:
-        raise ValueError(f"{where}: name must be a simple file-name part (letters, digits, . _ -), got {p.name!r}")
+        raise ValueError(
+            f"{where}: name must be a simple file-name part (letters, digits, . _ -), got "
+            f"{p.name!r}"
+        )
     if p.version != PROJECT_VERSION:
-        raise ValueError(f"{where}: version {p.version!r} is not supported (this build reads version {PROJECT_VERSION})")
+        raise ValueError(
+            f"{where}: version {p.version!r} is not supported (this build reads version "
+            f"{PROJECT_VERSION})"
+        )
     if not isinstance(p.sources, dict) or not p.sources:
         raise ValueError(f"{where}: sources must be a non-empty dict of map name -> image")
     for m in p.sources:
@@ -234,37 +308,64 @@ def _check_project(p: Project, where: str) -> None:
     hw = shapes[p.main_map][:2]
     for m, s in shapes.items():
         if len(s) != 3 or s[:2] != hw:
-            raise ValueError(f"{where}: source map {m!r} is shaped {s}; all maps must be (H, W, C) of the main map's size {hw}")
+            raise ValueError(
+                f"{where}: source map {m!r} is shaped {s}; all maps must be (H, W, C) of the main "
+                f"map's size {hw}"
+            )
     if p.normal_convention not in NORMAL_CONVENTIONS:
-        raise ValueError(f"{where}: normal_convention must be one of {NORMAL_CONVENTIONS}, got {p.normal_convention!r}")
+        raise ValueError(
+            f"{where}: normal_convention must be one of {NORMAL_CONVENTIONS}, got "
+            f"{p.normal_convention!r}"
+        )
     if p.bit_depth not in (8, 16) or isinstance(p.bit_depth, bool):
         raise ValueError(f"{where}: bit_depth must be 8 or 16, got {p.bit_depth!r}")
     for m, k in p.map_kinds.items():
         if m not in p.sources or k not in MAP_KINDS:
             raise ValueError(f"{where}: map_kinds has a bad entry {m!r}: {k!r}")
     for m, w in p.map_weights.items():
-        if m not in p.sources or isinstance(w, bool) or not isinstance(w, numbers.Real) or not math.isfinite(w) or w < 0:
+        if (
+            m not in p.sources
+            or isinstance(w, bool)
+            or not isinstance(w, numbers.Real)
+            or not math.isfinite(w)
+            or w < 0
+        ):
             raise ValueError(f"{where}: map_weights has a bad entry {m!r}: {w!r}")
     if p.template_rect is not None:
         r = p.template_rect
-        if len(r) != 4 or any(isinstance(v, bool) or not isinstance(v, numbers.Integral) for v in r) \
-                or r[2] < 1 or r[3] < 1 or r[0] < 0 or r[1] < 0:
-            raise ValueError(f"{where}: template_rect must be 4 integers (x, y, w, h) with w, h >= 1, got {r!r}")
+        if (
+            len(r) != 4
+            or any(isinstance(v, bool) or not isinstance(v, numbers.Integral) for v in r)
+            or r[2] < 1
+            or r[3] < 1
+            or r[0] < 0
+            or r[1] < 0
+        ):
+            raise ValueError(
+                f"{where}: template_rect must be 4 integers (x, y, w, h) with w, h >= 1, got {r!r}"
+            )
     tile_shape = None
 
     def check_tile(maps, what):
         nonlocal tile_shape
         if not isinstance(maps, dict) or list(maps) != list(p.sources):
-            raise ValueError(f"{where}: {what} must have the maps {list(p.sources)}, got "
-                             f"{list(maps) if isinstance(maps, dict) else type(maps).__name__}")
+            raise ValueError(
+                f"{where}: {what} must have the maps {list(p.sources)}, got "
+                f"{list(maps) if isinstance(maps, dict) else type(maps).__name__}"
+            )
         for m, a in maps.items():
             s = np.shape(a)
             if len(s) != 3 or s[2] != shapes[m][2]:
-                raise ValueError(f"{where}: {what}[{m!r}] is shaped {s}, expected (h, w, {shapes[m][2]})")
+                raise ValueError(
+                    f"{where}: {what}[{m!r}] is shaped {s}, expected (h, w, {shapes[m][2]})"
+                )
             if tile_shape is None:
                 tile_shape = s[:2]
             if s[:2] != tile_shape:
-                raise ValueError(f"{where}: {what}[{m!r}] is {s[1]}x{s[0]}, other tiles are {tile_shape[1]}x{tile_shape[0]}")
+                raise ValueError(
+                    f"{where}: {what}[{m!r}] is {s[1]}x{s[0]}, other tiles are "
+                    f"{tile_shape[1]}x{tile_shape[0]}"
+                )
 
     if p.template is not None:
         check_tile(p.template, "template")
@@ -272,12 +373,22 @@ def _check_project(p: Project, where: str) -> None:
         if not isinstance(c, Candidate):
             raise TypeError(f"{where}: candidates[{i}] must be a Candidate")
         check_tile(c.maps, f"candidates[{i}]")
-        if c.patch_origin is not None and (len(c.patch_origin) != 2 or any(
-                isinstance(v, bool) or not isinstance(v, numbers.Integral) for v in c.patch_origin)):
-            raise ValueError(f"{where}: candidates[{i}].patch_origin must be (row, col) integers or None")
-        if c.seed is not None and (isinstance(c.seed, bool) or not isinstance(c.seed, numbers.Integral)):
+        if c.patch_origin is not None and (
+            len(c.patch_origin) != 2
+            or any(
+                isinstance(v, bool) or not isinstance(v, numbers.Integral) for v in c.patch_origin
+            )
+        ):
+            raise ValueError(
+                f"{where}: candidates[{i}].patch_origin must be (row, col) integers or None"
+            )
+        if c.seed is not None and (
+            isinstance(c.seed, bool) or not isinstance(c.seed, numbers.Integral)
+        ):
             raise ValueError(f"{where}: candidates[{i}].seed must be an integer or None")
-        if c.score is not None and (isinstance(c.score, bool) or not isinstance(c.score, numbers.Real)):
+        if c.score is not None and (
+            isinstance(c.score, bool) or not isinstance(c.score, numbers.Real)
+        ):
             raise ValueError(f"{where}: candidates[{i}].score must be a number or None")
         if not isinstance(c.locked, bool) or not isinstance(c.params, dict):
             raise ValueError(f"{where}: candidates[{i}].locked must be a bool and params a dict")
@@ -291,15 +402,24 @@ def _check_project(p: Project, where: str) -> None:
         lay = np.asarray(p.layout)
         count = len(p.picks) if p.picks else n
         if lay.ndim != 2 or lay.size == 0 or not np.issubdtype(lay.dtype, np.integer):
-            raise ValueError(f"{where}: layout must be a non-empty 2-D integer matrix, got shape {lay.shape} {lay.dtype}")
+            raise ValueError(
+                f"{where}: layout must be a non-empty 2-D integer matrix, got shape {lay.shape} "
+                f"{lay.dtype}"
+            )
         if lay.min() < -1 or lay.max() >= count:
-            raise ValueError(f"{where}: layout cells must be exported tile ids in [0, {count - 1}] or -1")
+            raise ValueError(
+                f"{where}: layout cells must be exported tile ids in [0, {count - 1}] or -1"
+            )
     if not isinstance(p.waypoints, dict):
         raise ValueError(f"{where}: waypoints must be a dict of seam key -> [(row, col), ...]")
     for key, pts in p.waypoints.items():
         for pt in pts:
-            if len(pt) != 2 or any(isinstance(v, bool) or not isinstance(v, numbers.Integral) for v in pt):
-                raise ValueError(f"{where}: waypoints[{key!r}] must be (row, col) integer pairs, got {pt!r}")
+            if len(pt) != 2 or any(
+                isinstance(v, bool) or not isinstance(v, numbers.Integral) for v in pt
+            ):
+                raise ValueError(
+                    f"{where}: waypoints[{key!r}] must be (row, col) integer pairs, got {pt!r}"
+                )
     if p.preview is not None:
         if not isinstance(p.preview, dict) or set(p.preview) - set(p.sources):
             raise ValueError(f"{where}: preview keys must be map names")
@@ -312,6 +432,7 @@ def _check_project(p: Project, where: str) -> None:
 
 
 # ---------------------------------------------------------------- saving
+
 
 def _to_json(o):
     if isinstance(o, np.integer):
@@ -352,26 +473,45 @@ def save_project(path, project: Project) -> Path:
         "map_weights": {k: float(v) for k, v in project.map_weights.items()},
         "parameters": project.parameters,
         "seeds": project.seeds,
-        "template_rect": None if project.template_rect is None else [int(v) for v in project.template_rect],
-        "template": None if project.template is None else {
-            m: put(a, f"images/template_{m}.png") for m, a in project.template.items()},
+        "template_rect": None
+        if project.template_rect is None
+        else [int(v) for v in project.template_rect],
+        "template": None
+        if project.template is None
+        else {m: put(a, f"images/template_{m}.png") for m, a in project.template.items()},
         "candidates": [
-            {"images": {m: put(a, f"images/candidate_{i:04}_{m}.png") for m, a in c.maps.items()},
-             "patch_origin": None if c.patch_origin is None else [int(v) for v in c.patch_origin],
-             "seed": None if c.seed is None else int(c.seed), "locked": bool(c.locked),
-             "score": None if c.score is None else float(c.score), "params": c.params}
-            for i, c in enumerate(project.candidates)],
+            {
+                "images": {
+                    m: put(a, f"images/candidate_{i:04}_{m}.png") for m, a in c.maps.items()
+                },
+                "patch_origin": None
+                if c.patch_origin is None
+                else [int(v) for v in c.patch_origin],
+                "seed": None if c.seed is None else int(c.seed),
+                "locked": bool(c.locked),
+                "score": None if c.score is None else float(c.score),
+                "params": c.params,
+            }
+            for i, c in enumerate(project.candidates)
+        ],
         "picks": [int(k) for k in project.picks],
-        "layout": None if project.layout is None else np.asarray(project.layout).astype(int).tolist(),
-        "waypoints": {str(k): [[int(r), int(c)] for r, c in v] for k, v in project.waypoints.items()},
-        "preview": None if project.preview is None else {
-            m: put(a, f"images/preview_{m}.png") for m, a in project.preview.items()},
+        "layout": None
+        if project.layout is None
+        else np.asarray(project.layout).astype(int).tolist(),
+        "waypoints": {
+            str(k): [[int(r), int(c)] for r, c in v] for k, v in project.waypoints.items()
+        },
+        "preview": None
+        if project.preview is None
+        else {m: put(a, f"images/preview_{m}.png") for m, a in project.preview.items()},
         "extra": project.extra,
     }
     try:
         text = json.dumps(doc, indent=1, allow_nan=False, default=_to_json)
     except (TypeError, ValueError) as exc:
-        raise ProjectError(f"{p}: parameters, seeds, params or extra are not JSON-serialisable ({exc})") from None
+        raise ProjectError(
+            f"{p}: parameters, seeds, params or extra are not JSON-serialisable ({exc})"
+        ) from None
     parent = p.parent if str(p.parent) else Path(".")
     tmp = None
     try:
@@ -388,8 +528,10 @@ def save_project(path, project: Project) -> Path:
     except OSError as exc:
         if tmp is not None:
             Path(tmp).unlink(missing_ok=True)
-        raise ProjectError(f"{p}: cannot save the project ({exc.strerror or exc}); the previous file, "
-                           "if any, is unchanged") from exc
+        raise ProjectError(
+            f"{p}: cannot save the project ({exc.strerror or exc}); the previous file, "
+            "if any, is unchanged"
+        ) from exc
     except BaseException:
         if tmp is not None:
             Path(tmp).unlink(missing_ok=True)
@@ -417,7 +559,8 @@ def recovery_path(path) -> Path:
 
 
 def newer_recovery(path) -> Path | None:
-    """The recovery file of ``path`` if it exists and is newer than ``path`` (offer it after a crash)."""
+    """The recovery file of ``path`` if it exists and is newer than ``path`` (offer it after a "
+    "crash)."""
     p = Path(os.fspath(path))
     r = recovery_path(p)
     if not r.is_file():
@@ -429,15 +572,28 @@ def newer_recovery(path) -> Path | None:
 
 # ---------------------------------------------------------------- loading
 
+
 def _safe_entry(name: str) -> bool:
-    if not name or "\\" in name or "\x00" in name or name.startswith("/") or re.match(r"^[A-Za-z]:", name):
+    if (
+        not name
+        or "\\" in name
+        or "\x00" in name
+        or name.startswith("/")
+        or re.match(r"^[A-Za-z]:", name)
+    ):
         return False
     return all(part not in ("..", ".", "") for part in name.split("/"))
 
 
-def load_project(path, *, max_pixels: int = MAX_PIXELS, max_entry_bytes: int = MAX_ENTRY_BYTES,
-                 max_total_bytes: int = MAX_TOTAL_BYTES) -> Project:
-    """Read and strictly validate a ``.quiltproj`` file; any problem raises :class:`ProjectError`."""
+def load_project(
+    path,
+    *,
+    max_pixels: int = MAX_PIXELS,
+    max_entry_bytes: int = MAX_ENTRY_BYTES,
+    max_total_bytes: int = MAX_TOTAL_BYTES,
+) -> Project:
+    """Read and strictly validate a ``.quiltproj`` file; any problem raises "
+    ":class:`ProjectError`."""
     p = Path(os.fspath(path))
 
     def fail(msg: str):
@@ -466,17 +622,26 @@ def load_project(path, *, max_pixels: int = MAX_PIXELS, max_entry_bytes: int = M
         total = 0
         for info in infos:
             if not _safe_entry(info.filename[:-1] if info.is_dir() else info.filename):
-                fail(f"entry {info.filename!r} has an unsafe path (absolute, '..' or backslash); refused")
+                fail(
+                    f"entry {info.filename!r} has an unsafe path (absolute, '..' or backslash); "
+                    "refused"
+                )
             if info.filename in seen:
                 fail(f"entry {info.filename!r} appears twice")
             seen.add(info.filename)
             if info.flag_bits & 0x1:
                 fail(f"entry {info.filename!r} is encrypted")
             if info.file_size > max_entry_bytes:
-                fail(f"entry {info.filename!r} declares {info.file_size:,} bytes, over the limit of {max_entry_bytes:,}")
+                fail(
+                    f"entry {info.filename!r} declares {info.file_size:,} bytes, over the limit "
+                    f"of {max_entry_bytes:,}"
+                )
             total += info.file_size
         if total > max_total_bytes:
-            fail(f"the archive declares {total:,} uncompressed bytes, over the limit of {max_total_bytes:,}")
+            fail(
+                f"the archive declares {total:,} uncompressed bytes, over the limit of "
+                f"{max_total_bytes:,}"
+            )
 
         def read(entry: str, cap: int) -> bytes:
             if entry not in seen:
@@ -488,7 +653,10 @@ def load_project(path, *, max_pixels: int = MAX_PIXELS, max_entry_bytes: int = M
             except (zipfile.BadZipFile, zlib.error, EOFError, OSError, NotImplementedError) as exc:
                 fail(f"entry {entry!r} is truncated or corrupt ({exc})")
             if len(data) > min(cap, info.file_size):
-                fail(f"entry {entry!r} inflates beyond its declared size (possible zip bomb); refused")
+                fail(
+                    f"entry {entry!r} inflates beyond its declared size (possible zip bomb); "
+                    "refused"
+                )
             return data
 
         if "project.json" not in seen:
@@ -498,7 +666,9 @@ def load_project(path, *, max_pixels: int = MAX_PIXELS, max_entry_bytes: int = M
             doc = json.loads(raw.decode("utf-8"))
         except (UnicodeDecodeError, json.JSONDecodeError) as exc:
             fail(f"project.json is not valid JSON ({exc})")
-        project = _from_doc(doc, fail, lambda entry: _read_image(entry, read, fail, max_pixels, max_entry_bytes))
+        project = _from_doc(
+            doc, fail, lambda entry: _read_image(entry, read, fail, max_pixels, max_entry_bytes)
+        )
     try:
         _check_project(project, "project.json")
     except (TypeError, ValueError) as exc:
@@ -529,22 +699,36 @@ class _Spec:
         if key not in d:
             if optional:
                 return default
-            self.fail(f"project.json: missing key {where}.{key}" if where else f"project.json: missing key {key!r}")
+            self.fail(
+                f"project.json: missing key {where}.{key}"
+                if where
+                else f"project.json: missing key {key!r}"
+            )
         v = d[key]
         if v is None and optional:
             return default
         if isinstance(v, bool) and bool not in (types if isinstance(types, tuple) else (types,)):
-            self.fail(f"project.json: {where + '.' if where else ''}{key} has the wrong type (bool)")
+            self.fail(
+                f"project.json: {where + '.' if where else ''}{key} has the wrong type (bool)"
+            )
         if not isinstance(v, types):
             names = "/".join(t.__name__ for t in (types if isinstance(types, tuple) else (types,)))
-            self.fail(f"project.json: {where + '.' if where else ''}{key} must be {names}, got {type(v).__name__}")
+            self.fail(
+                f"project.json: {where + '.' if where else ''}{key} must be {names}, got "
+                f"{type(v).__name__}"
+            )
         return v
 
 
 def _int_list(s: _Spec, v, n, what):
-    if not isinstance(v, list) or (n is not None and len(v) != n) or any(
-            isinstance(x, bool) or not isinstance(x, int) for x in v):
-        s.fail(f"project.json: {what} must be a list of {n if n else ''} integers".replace("  ", " "))
+    if (
+        not isinstance(v, list)
+        or (n is not None and len(v) != n)
+        or any(isinstance(x, bool) or not isinstance(x, int) for x in v)
+    ):
+        s.fail(
+            f"project.json: {what} must be a list of {n if n else ''} integers".replace("  ", " ")
+        )
     return v
 
 
@@ -557,11 +741,18 @@ def _from_doc(doc, fail, image) -> Project:
         fail(f"project.json: format is {fmt!r}, expected {PROJECT_FORMAT!r}")
     version = s.get(doc, "version", int, "")
     if version > PROJECT_VERSION:
-        fail(f"project.json: version {version} was written by a newer Quilt Studio (this one reads {PROJECT_VERSION})")
+        fail(
+            f"project.json: version {version} was written by a newer Quilt Studio (this one reads "
+            f"{PROJECT_VERSION})"
+        )
     if version < 1:
         fail(f"project.json: bad version {version}")
     maps = s.get(doc, "maps", list, "")
-    if not maps or not all(isinstance(m, str) and _SAFE_NAME.match(m) for m in maps) or len(set(maps)) != len(maps):
+    if (
+        not maps
+        or not all(isinstance(m, str) and _SAFE_NAME.match(m) for m in maps)
+        or len(set(maps)) != len(maps)
+    ):
         fail("project.json: maps must be a non-empty list of distinct simple names")
 
     def map_images(d, where):
@@ -582,14 +773,18 @@ def _from_doc(doc, fail, image) -> Project:
         where = f"candidates[{i}]"
         imgs = map_images(s.get(c, "images", dict, where), f"{where}.images")
         po = s.get(c, "patch_origin", list, where, optional=True)
-        cands.append(Candidate(
-            maps=imgs,
-            patch_origin=None if po is None else tuple(_int_list(s, po, 2, f"{where}.patch_origin")),
-            seed=s.get(c, "seed", int, where, optional=True),
-            locked=s.get(c, "locked", bool, where),
-            score=s.get(c, "score", (int, float), where, optional=True),
-            params=s.get(c, "params", dict, where, optional=True, default={}),
-        ))
+        cands.append(
+            Candidate(
+                maps=imgs,
+                patch_origin=None
+                if po is None
+                else tuple(_int_list(s, po, 2, f"{where}.patch_origin")),
+                seed=s.get(c, "seed", int, where, optional=True),
+                locked=s.get(c, "locked", bool, where),
+                score=s.get(c, "score", (int, float), where, optional=True),
+                params=s.get(c, "params", dict, where, optional=True, default={}),
+            )
+        )
     rect = s.get(doc, "template_rect", list, "", optional=True)
     layout = s.get(doc, "layout", list, "", optional=True)
     if layout is not None:

@@ -27,27 +27,58 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p = subparsers.add_parser(
         "export",
         help="export a project's picked tiles as a bundle (PNGs, atlases, manifest, Tiled, Godot)",
-        description="Write the export bundle of a .quiltproj project: per-tile PNGs per map, one atlas per "
-        "map, a JSON manifest, the layout index matrix (CSV + JSON), a Tiled .tsx/.tmx, a Godot 4 .tres "
-        "and the preview. The folder appears complete or not at all.",
+        description="Write the export bundle of a .quiltproj project: per-tile PNGs per map, "
+        "one atlas per map, a JSON manifest, the layout index matrix (CSV + JSON), a Tiled "
+        ".tsx/.tmx, a Godot 4 .tres and the preview. The folder appears complete or not at all.",
     )
-    p.add_argument("project", metavar="PROJECT", help="a .quiltproj file (saved by the editor or the CLI)")
+    p.add_argument(
+        "project", metavar="PROJECT", help="a .quiltproj file (saved by the editor or the CLI)"
+    )
     p.add_argument("--out", required=True, metavar="DIR", help="bundle folder to create")
     p.add_argument("--name", default=None, help="file-name prefix (default: the project's name)")
-    p.add_argument("--atlas-columns", type=_positive, default=None, metavar="N",
-                   help="tiles per atlas row (default: about square, preferring no blank cells)")
-    p.add_argument("--spacing", type=_nonneg, default=0, metavar="N", help="pixels between atlas cells")
+    p.add_argument(
+        "--atlas-columns",
+        type=_positive,
+        default=None,
+        metavar="N",
+        help="tiles per atlas row (default: about square, preferring no blank cells)",
+    )
+    p.add_argument(
+        "--spacing", type=_nonneg, default=0, metavar="N", help="pixels between atlas cells"
+    )
     p.add_argument("--margin", type=_nonneg, default=0, metavar="N", help="pixels around the atlas")
-    p.add_argument("--extrude", type=_nonneg, default=0, metavar="N",
-                   help="pixels of edge bleed around every atlas tile")
-    p.add_argument("--extrude-mode", choices=("edge", "wrap"), default="edge",
-                   help="bleed by repeating the edge pixel (default) or the opposite edge")
-    p.add_argument("--bit-depth", type=int, choices=(8, 16), default=None,
-                   help="output bits per channel (default: the project's; 16 -> 8 is dithered)")
-    p.add_argument("--dither", action=argparse.BooleanOptionalAction, default=None,
-                   help="dither when rounding (default: only when reducing a 16-bit project to 8 bits)")
-    p.add_argument("--tile-format", choices=("png", "tif"), default="png",
-                   help="format of the per-tile and preview files (atlases are always PNG)")
+    p.add_argument(
+        "--extrude",
+        type=_nonneg,
+        default=0,
+        metavar="N",
+        help="pixels of edge bleed around every atlas tile",
+    )
+    p.add_argument(
+        "--extrude-mode",
+        choices=("edge", "wrap"),
+        default="edge",
+        help="bleed by repeating the edge pixel (default) or the opposite edge",
+    )
+    p.add_argument(
+        "--bit-depth",
+        type=int,
+        choices=(8, 16),
+        default=None,
+        help="output bits per channel (default: the project's; 16 -> 8 is dithered)",
+    )
+    p.add_argument(
+        "--dither",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="dither when rounding (default: only when reducing a 16-bit project to 8 bits)",
+    )
+    p.add_argument(
+        "--tile-format",
+        choices=("png", "tif"),
+        default="png",
+        help="format of the per-tile and preview files (atlases are always PNG)",
+    )
     p.add_argument("--seed", type=int, default=0, help="seed of the dither noise")
     p.add_argument("--overwrite", action="store_true", help="replace a non-empty --out folder")
     p.set_defaults(func=run)
@@ -61,10 +92,22 @@ def run(args) -> int:
     if args.name is not None:
         project.name = args.name
     manifest = export_project(
-        project, args.out, columns=args.atlas_columns, spacing=args.spacing, margin=args.margin,
-        extrude=args.extrude, extrude_mode=args.extrude_mode, bit_depth=args.bit_depth,
-        dither=args.dither, rng=args.seed, tile_format=args.tile_format, overwrite=args.overwrite,
+        project,
+        args.out,
+        columns=args.atlas_columns,
+        spacing=args.spacing,
+        margin=args.margin,
+        extrude=args.extrude,
+        extrude_mode=args.extrude_mode,
+        bit_depth=args.bit_depth,
+        dither=args.dither,
+        rng=args.seed,
+        tile_format=args.tile_format,
+        overwrite=args.overwrite,
     )
-    print(f"quilt-studio export: wrote {manifest['tile_count']} tiles x {len(manifest['maps'])} maps "
-          f"({manifest['tile_w']}x{manifest['tile_h']}, {manifest['bit_depth']}-bit) to {args.out}", file=sys.stderr)
+    print(
+        f"quilt-studio export: wrote {manifest['tile_count']} tiles x {len(manifest['maps'])} maps "
+        f"({manifest['tile_w']}x{manifest['tile_h']}, {manifest['bit_depth']}-bit) to {args.out}",
+        file=sys.stderr,
+    )
     return 0

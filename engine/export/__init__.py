@@ -49,8 +49,16 @@ from engine.export._png import encode_png
 from engine.materials import NORMAL_CONVENTIONS
 
 __all__ = [
-    "AtlasLayout", "ExportError", "assemble_layout", "atlas_layout", "export_bundle", "quantize",
-    "render_atlas", "tiled_tsx", "tiled_tmx", "godot_tres",
+    "AtlasLayout",
+    "ExportError",
+    "assemble_layout",
+    "atlas_layout",
+    "export_bundle",
+    "quantize",
+    "render_atlas",
+    "tiled_tsx",
+    "tiled_tmx",
+    "godot_tres",
 ]
 
 BUNDLE_FORMAT = "quilt-studio-bundle"
@@ -73,6 +81,7 @@ class ExportError(OSError):
 
 
 # ---------------------------------------------------------------- bit depth
+
 
 def quantize(pixels, bit_depth: int, *, dither: bool = True, rng=None) -> np.ndarray:
     """Float [0, 1] (or uint8/uint16) pixels -> uint8 or uint16 at ``bit_depth``.
@@ -108,6 +117,7 @@ def quantize(pixels, bit_depth: int, *, dither: bool = True, rng=None) -> np.nda
 
 
 # ---------------------------------------------------------------- atlas
+
 
 @dataclass(frozen=True, slots=True)
 class AtlasLayout:
@@ -158,8 +168,16 @@ def _default_columns(count: int) -> int:
     return best
 
 
-def atlas_layout(count: int, tile_w: int, tile_h: int, *, columns: int | None = None, spacing: int = 0,
-                 margin: int = 0, extrude: int = 0) -> AtlasLayout:
+def atlas_layout(
+    count: int,
+    tile_w: int,
+    tile_h: int,
+    *,
+    columns: int | None = None,
+    spacing: int = 0,
+    margin: int = 0,
+    extrude: int = 0,
+) -> AtlasLayout:
     """Grid layout of ``count`` tiles; ``columns=None`` makes it as square as possible."""
     count = _nonneg_int(count, "count")
     if count < 1:
@@ -181,10 +199,14 @@ def atlas_layout(count: int, tile_w: int, tile_h: int, *, columns: int | None = 
     cw, ch = tile_w + 2 * extrude, tile_h + 2 * extrude
     width = 2 * margin + columns * cw + (columns - 1) * spacing
     height = 2 * margin + rows * ch + (rows - 1) * spacing
-    return AtlasLayout(tile_w, tile_h, count, columns, rows, spacing, margin, extrude, width, height)
+    return AtlasLayout(
+        tile_w, tile_h, count, columns, rows, spacing, margin, extrude, width, height
+    )
 
 
-def render_atlas(tiles: Sequence[np.ndarray], layout: AtlasLayout, *, extrude_mode: str = "edge") -> np.ndarray:
+def render_atlas(
+    tiles: Sequence[np.ndarray], layout: AtlasLayout, *, extrude_mode: str = "edge"
+) -> np.ndarray:
     """Place same-shaped (h, w[, C]) tiles (any dtype) into an atlas of that dtype, background 0.
 
     ``extrude_mode`` "edge" repeats the border pixels into the extrusion band
@@ -223,25 +245,36 @@ def assemble_layout(tiles: Sequence[np.ndarray], index_matrix) -> np.ndarray:
 def _index_matrix(index_matrix, count: int) -> np.ndarray:
     m = np.asarray(index_matrix)
     if m.ndim != 2 or m.size == 0:
-        raise ValueError(f"index_matrix must be a non-empty 2-D (rows, cols) array, got shape {m.shape}")
-    if not np.issubdtype(m.dtype, np.integer):
-        if not np.issubdtype(m.dtype, np.floating) or not np.all(m == np.round(m)):
-            raise TypeError(f"index_matrix must hold integers, got dtype {m.dtype}")
+        raise ValueError(
+            f"index_matrix must be a non-empty 2-D (rows, cols) array, got shape {m.shape}"
+        )
+    if not np.issubdtype(m.dtype, np.integer) and (
+        not np.issubdtype(m.dtype, np.floating) or not np.all(m == np.round(m))
+    ):
+        raise TypeError(f"index_matrix must hold integers, got dtype {m.dtype}")
     m = m.astype(np.int64)
     if m.min() < -1 or m.max() >= count:
-        raise ValueError(f"index_matrix values must be tile ids in [0, {count - 1}] or -1 (empty), "
-                         f"got range [{m.min()}, {m.max()}]")
+        raise ValueError(
+            f"index_matrix values must be tile ids in [0, {count - 1}] or -1 (empty), "
+            f"got range [{m.min()}, {m.max()}]"
+        )
     return m
 
 
 # ---------------------------------------------------------------- Tiled / Godot text
 
-def tiled_tsx(*, name: str, image: str, layout: AtlasLayout, weights: Sequence[float] | None = None) -> str:
-    """Tiled tileset XML: one image (the atlas) with Tiled's margin/spacing, optional probabilities."""
+
+def tiled_tsx(
+    *, name: str, image: str, layout: AtlasLayout, weights: Sequence[float] | None = None
+) -> str:
+    """Tiled tileset XML: one image (the atlas) with Tiled's margin/spacing, optional "
+    "probabilities."""
     lines = [
         '<?xml version="1.0" encoding="UTF-8"?>',
-        f'<tileset version="1.8" tiledversion="1.8.2" name={quoteattr(name)} tilewidth="{layout.tile_w}" '
-        f'tileheight="{layout.tile_h}" spacing="{layout.tiled_spacing}" margin="{layout.tiled_margin}" '
+        f'<tileset version="1.8" tiledversion="1.8.2" name={quoteattr(name)} '
+        f'tilewidth="{layout.tile_w}" '
+        f'tileheight="{layout.tile_h}" spacing="{layout.tiled_spacing}" '
+        f'margin="{layout.tiled_margin}" '
         f'tilecount="{layout.count}" columns="{layout.columns}">',
         f' <image source={quoteattr(image)} width="{layout.width}" height="{layout.height}"/>',
     ]
@@ -258,23 +291,31 @@ def tiled_tmx(*, tsx: str, layout: AtlasLayout, index_matrix: np.ndarray, firstg
     rows, cols = m.shape
     gids = np.where(m >= 0, m + firstgid, 0)
     body = ",\n".join(",".join(str(int(g)) for g in row) for row in gids)
-    return "\n".join([
-        '<?xml version="1.0" encoding="UTF-8"?>',
-        f'<map version="1.8" tiledversion="1.8.2" orientation="orthogonal" renderorder="right-down" '
-        f'width="{cols}" height="{rows}" tilewidth="{layout.tile_w}" tileheight="{layout.tile_h}" '
-        f'infinite="0" nextlayerid="2" nextobjectid="1">',
-        f' <tileset firstgid="{firstgid}" source={quoteattr(tsx)}/>',
-        f' <layer id="1" name="layout" width="{cols}" height="{rows}">',
-        '  <data encoding="csv">',
-        body,
-        "</data>",
-        " </layer>",
-        "</map>",
-    ]) + "\n"
+    return (
+        "\n".join(
+            [
+                '<?xml version="1.0" encoding="UTF-8"?>',
+                '<map version="1.8" tiledversion="1.8.2" orientation="orthogonal" '
+                'renderorder="right-down" '
+                f'width="{cols}" height="{rows}" tilewidth="{layout.tile_w}" '
+                f'tileheight="{layout.tile_h}" '
+                f'infinite="0" nextlayerid="2" nextobjectid="1">',
+                f' <tileset firstgid="{firstgid}" source={quoteattr(tsx)}/>',
+                f' <layer id="1" name="layout" width="{cols}" height="{rows}">',
+                '  <data encoding="csv">',
+                body,
+                "</data>",
+                " </layer>",
+                "</map>",
+            ]
+        )
+        + "\n"
+    )
 
 
 def godot_tres(*, image_path: str, layout: AtlasLayout) -> str:
     """Godot 4 TileSet text resource with one TileSetAtlasSource over the atlas."""
+
     def s(v):
         return json.dumps(v)  # a double-quoted string with escapes, as Godot writes them
 
@@ -303,9 +344,12 @@ def godot_tres(*, image_path: str, layout: AtlasLayout) -> str:
 
 # ---------------------------------------------------------------- bundle
 
+
 def _check_name(value, what: str) -> str:
     if not isinstance(value, str) or not _SAFE_NAME.match(value) or len(value) > 100:
-        raise ValueError(f"{what} must be a simple file-name part (letters, digits, . _ -), got {value!r}")
+        raise ValueError(
+            f"{what} must be a simple file-name part (letters, digits, . _ -), got {value!r}"
+        )
     return value
 
 
@@ -328,14 +372,29 @@ def _json_default(o):
     raise TypeError(f"{type(o).__name__} is not JSON-serialisable")
 
 
-def export_bundle(out_dir, *, name: str, tiles: Sequence[Mapping[str, np.ndarray]], bit_depth: int | None = None,
-                  index_matrix=None, preview: Mapping[str, np.ndarray] | None = None, columns: int | None = None,
-                  spacing: int = 0, margin: int = 0, extrude: int = 0, extrude_mode: str = "edge",
-                  manifest_extra: Mapping | None = None, normal_convention: str = "opengl",
-                  weights: Sequence[float] | None = None, source_bit_depth: int | None = None,
-                  dither: bool | None = None, rng=0,
-                  godot_path_prefix: str | None = None, tile_format: str = "png",
-                  overwrite: bool = False) -> dict:
+def export_bundle(
+    out_dir,
+    *,
+    name: str,
+    tiles: Sequence[Mapping[str, np.ndarray]],
+    bit_depth: int | None = None,
+    index_matrix=None,
+    preview: Mapping[str, np.ndarray] | None = None,
+    columns: int | None = None,
+    spacing: int = 0,
+    margin: int = 0,
+    extrude: int = 0,
+    extrude_mode: str = "edge",
+    manifest_extra: Mapping | None = None,
+    normal_convention: str = "opengl",
+    weights: Sequence[float] | None = None,
+    source_bit_depth: int | None = None,
+    dither: bool | None = None,
+    rng=0,
+    godot_path_prefix: str | None = None,
+    tile_format: str = "png",
+    overwrite: bool = False,
+) -> dict:
     """Write the export bundle of ``tiles`` into the folder ``out_dir``; returns the manifest.
 
     Parameters
@@ -394,13 +453,19 @@ def export_bundle(out_dir, *, name: str, tiles: Sequence[Mapping[str, np.ndarray
             shp = np.shape(t[m])
             shapes.setdefault(m, shp)
             if shp != shapes[m]:
-                raise ValueError(f"tiles[{i}][{m!r}] is shaped {shp}, tiles[0][{m!r}] is {shapes[m]}")
+                raise ValueError(
+                    f"tiles[{i}][{m!r}] is shaped {shp}, tiles[0][{m!r}] is {shapes[m]}"
+                )
     th, tw = shapes[maps[0]][:2]
     for m in maps:
         if shapes[m][:2] != (th, tw):
-            raise ValueError(f"map {m!r} tiles are {shapes[m][1]}x{shapes[m][0]}, main map tiles are {tw}x{th}")
+            raise ValueError(
+                f"map {m!r} tiles are {shapes[m][1]}x{shapes[m][0]}, main map tiles are {tw}x{th}"
+            )
     if source_bit_depth is None:
-        source_bit_depth = 16 if any(np.asarray(t[m]).dtype == np.uint16 for t in tiles for m in maps) else 8
+        source_bit_depth = (
+            16 if any(np.asarray(t[m]).dtype == np.uint16 for t in tiles for m in maps) else 8
+        )
     elif isinstance(source_bit_depth, bool) or source_bit_depth not in (8, 16):
         raise ValueError(f"source_bit_depth must be 8, 16 or None, got {source_bit_depth!r}")
     if bit_depth is None:
@@ -416,15 +481,16 @@ def export_bundle(out_dir, *, name: str, tiles: Sequence[Mapping[str, np.ndarray
         weights = [float(w) for w in weights]
         if len(weights) != n or not all(math.isfinite(w) and w >= 0 for w in weights):
             raise ValueError(f"weights must be {n} finite numbers >= 0")
-    if preview is not None:
-        if not isinstance(preview, Mapping) or set(preview) - set(maps):
-            raise ValueError(f"preview must be a dict whose keys are among the maps {maps}")
+    if preview is not None and (not isinstance(preview, Mapping) or set(preview) - set(maps)):
+        raise ValueError(f"preview must be a dict whose keys are among the maps {maps}")
     extra = dict(_jsonable(dict(manifest_extra or {}), "manifest_extra"))
     per_tile = {}
     for key in ("scores", "source_rects"):
         if key in extra and extra[key] is not None:
             if not isinstance(extra[key], list) or len(extra[key]) != n:
-                raise ValueError(f"manifest_extra[{key!r}] must be a list with one entry per tile ({n})")
+                raise ValueError(
+                    f"manifest_extra[{key!r}] must be a list with one entry per tile ({n})"
+                )
             per_tile[key] = extra[key]
     if godot_path_prefix is None:
         godot_path_prefix = f"res://{out.name}/" if out.name else "res://"
@@ -447,8 +513,11 @@ def export_bundle(out_dir, *, name: str, tiles: Sequence[Mapping[str, np.ndarray
             entry["weight"] = weights[i]
         x, y, w, h = lay.rect(i)
         frames[entry["files"][maps[0]]] = {
-            "frame": {"x": x, "y": y, "w": w, "h": h}, "rotated": False, "trimmed": False,
-            "spriteSourceSize": {"x": 0, "y": 0, "w": w, "h": h}, "sourceSize": {"w": w, "h": h},
+            "frame": {"x": x, "y": y, "w": w, "h": h},
+            "rotated": False,
+            "trimmed": False,
+            "spriteSourceSize": {"x": 0, "y": 0, "w": w, "h": h},
+            "sourceSize": {"w": w, "h": h},
         }
         tile_entries.append(entry)
     atlases = {}
@@ -466,9 +535,19 @@ def export_bundle(out_dir, *, name: str, tiles: Sequence[Mapping[str, np.ndarray
     layout_files = {}
     if mat is not None:
         cells = mat.tolist()
-        files[f"{name}_layout.json"] = json.dumps(
-            {"tile_w": tw, "tile_h": th, "cols": int(mat.shape[1]), "rows": int(mat.shape[0]), "cells": cells},
-            indent=1) + "\n"
+        files[f"{name}_layout.json"] = (
+            json.dumps(
+                {
+                    "tile_w": tw,
+                    "tile_h": th,
+                    "cols": int(mat.shape[1]),
+                    "rows": int(mat.shape[0]),
+                    "cells": cells,
+                },
+                indent=1,
+            )
+            + "\n"
+        )
         buf = io.StringIO()
         csv.writer(buf, lineterminator="\n").writerows(cells)
         files[f"{name}_layout.csv"] = buf.getvalue()
@@ -486,20 +565,41 @@ def export_bundle(out_dir, *, name: str, tiles: Sequence[Mapping[str, np.ndarray
         "bit_depth": bit_depth,
         "source_bit_depth": source_bit_depth,
         "dithered": bool(dither and bit_depth < source_bit_depth),
-        "maps": [{"name": m, "channels": int(shapes[m][2]) if len(shapes[m]) == 3 else 1} for m in maps],
+        "maps": [
+            {"name": m, "channels": int(shapes[m][2]) if len(shapes[m]) == 3 else 1} for m in maps
+        ],
         "main_map": maps[0],
         "normal_convention": normal_convention,
         "tiles": tile_entries,
         "atlas": {
-            "columns": lay.columns, "rows": lay.rows, "spacing": lay.spacing, "margin": lay.margin,
-            "extrude": lay.extrude, "extrude_mode": extrude_mode, "width": lay.width, "height": lay.height,
+            "columns": lay.columns,
+            "rows": lay.rows,
+            "spacing": lay.spacing,
+            "margin": lay.margin,
+            "extrude": lay.extrude,
+            "extrude_mode": extrude_mode,
+            "width": lay.width,
+            "height": lay.height,
             "images": atlases,
         },
-        "layout": ({"cols": int(mat.shape[1]), "rows": int(mat.shape[0]), "cells": mat.tolist(),
-                    "files": layout_files} if mat is not None else None),
+        "layout": (
+            {
+                "cols": int(mat.shape[1]),
+                "rows": int(mat.shape[0]),
+                "cells": mat.tolist(),
+                "files": layout_files,
+            }
+            if mat is not None
+            else None
+        ),
         "preview": previews,
-        "tiled": {"tsx": f"{name}.tsx", "tmx": f"{name}.tmx" if mat is not None else None,
-                  "margin": lay.tiled_margin, "spacing": lay.tiled_spacing, "firstgid": 1},
+        "tiled": {
+            "tsx": f"{name}.tsx",
+            "tmx": f"{name}.tmx" if mat is not None else None,
+            "margin": lay.tiled_margin,
+            "spacing": lay.tiled_spacing,
+            "firstgid": 1,
+        },
         "godot": {"tres": f"{name}.tres", "texture_path": godot_path_prefix + atlases[maps[0]]},
         "parameters": extra.pop("parameters", {}),
         "seeds": extra.pop("seeds", {}),
@@ -508,9 +608,13 @@ def export_bundle(out_dir, *, name: str, tiles: Sequence[Mapping[str, np.ndarray
         "extra": extra,
         "frames": frames,
         "meta": {
-            "app": "Quilt Studio", "version": str(BUNDLE_VERSION), "image": atlases[maps[0]],
-            "format": ("RGBA" if shapes[maps[0]][2:] == (4,) else "RGB") + str(bit_depth * (4 if shapes[maps[0]][2:] == (4,) else 3)),
-            "size": {"w": lay.width, "h": lay.height}, "scale": "1",
+            "app": "Quilt Studio",
+            "version": str(BUNDLE_VERSION),
+            "image": atlases[maps[0]],
+            "format": ("RGBA" if shapes[maps[0]][2:] == (4,) else "RGB")
+            + str(bit_depth * (4 if shapes[maps[0]][2:] == (4,) else 3)),
+            "size": {"w": lay.width, "h": lay.height},
+            "scale": "1",
         },
     }
     files[f"{name}.json"] = json.dumps(manifest, indent=1) + "\n"
@@ -539,10 +643,14 @@ def _write_file(path: Path, content, bit_depth: int) -> None:
         import tifffile
 
         buf = io.BytesIO()
-        tifffile.imwrite(buf, q[:, :, 0] if q.ndim == 3 and q.shape[2] == 1 else q,
-                         photometric="minisblack" if q.ndim == 2 or q.shape[2] < 3 else "rgb",
-                         extrasamples=("unassalpha",) if q.ndim == 3 and q.shape[2] in (2, 4) else None,
-                         compression="zlib", metadata=None)
+        tifffile.imwrite(
+            buf,
+            q[:, :, 0] if q.ndim == 3 and q.shape[2] == 1 else q,
+            photometric="minisblack" if q.ndim == 2 or q.shape[2] < 3 else "rgb",
+            extrasamples=("unassalpha",) if q.ndim == 3 and q.shape[2] in (2, 4) else None,
+            compression="zlib",
+            metadata=None,
+        )
         _write_bytes(path, buf.getvalue())
         return
     _write_bytes(path, encode_png(q))
@@ -554,18 +662,26 @@ def _write_bytes(path: Path, data: bytes) -> None:
         f.write(data)
 
 
-def _write_atomically(out: Path, files: Mapping[str, object], bit_depth: int, *, overwrite: bool) -> None:
+def _write_atomically(
+    out: Path, files: Mapping[str, object], bit_depth: int, *, overwrite: bool
+) -> None:
     parent = out.parent if str(out.parent) else Path(".")
     if out.exists() and not out.is_dir():
         raise ExportError(errno.EEXIST, f"cannot export to {out}: it exists and is not a folder")
     replace = out.is_dir() and any(out.iterdir())
     if replace and not overwrite:
-        raise ExportError(errno.EEXIST, f"cannot export to {out}: the folder is not empty (pass overwrite=True or --overwrite to replace it)")
+        raise ExportError(
+            errno.EEXIST,
+            f"cannot export to {out}: the folder is not empty (pass overwrite=True or --overwrite "
+            "to replace it)",
+        )
     try:
         parent.mkdir(parents=True, exist_ok=True)
         tmp = Path(tempfile.mkdtemp(dir=parent, prefix=f".{out.name}.tmp-"))
     except OSError as exc:
-        raise ExportError(exc.errno or errno.EIO, f"cannot export to {out}: {_reason(exc)}; nothing was written") from exc
+        raise ExportError(
+            exc.errno or errno.EIO, f"cannot export to {out}: {_reason(exc)}; nothing was written"
+        ) from exc
     old = None
     try:
         for rel, content in files.items():
@@ -586,7 +702,9 @@ def _write_atomically(out: Path, files: Mapping[str, object], bit_depth: int, *,
         if isinstance(exc, (KeyboardInterrupt, SystemExit)):
             raise
         err = exc.errno if isinstance(exc, OSError) and exc.errno else errno.EIO
-        raise ExportError(err, f"cannot export to {out}: {_reason(exc)}; nothing was written") from exc
+        raise ExportError(
+            err, f"cannot export to {out}: {_reason(exc)}; nothing was written"
+        ) from exc
     if old is not None:
         shutil.rmtree(old, ignore_errors=True)
 

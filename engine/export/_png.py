@@ -25,7 +25,12 @@ class PNGError(ValueError):
 
 
 def _chunk(tag: bytes, data: bytes) -> bytes:
-    return struct.pack(">I", len(data)) + tag + data + struct.pack(">I", zlib.crc32(tag + data) & 0xFFFFFFFF)
+    return (
+        struct.pack(">I", len(data))
+        + tag
+        + data
+        + struct.pack(">I", zlib.crc32(tag + data) & 0xFFFFFFFF)
+    )
 
 
 def encode_png(q: np.ndarray) -> bytes:
@@ -48,7 +53,12 @@ def encode_png(q: np.ndarray) -> bytes:
     raw[0, 1:] = rows[0]
     raw[1:, 1:] = filtered[1:]
     ihdr = struct.pack(">IIBBBBB", w, h, depth, _COLOR_TYPES[c], 0, 0, 0)
-    return _SIGNATURE + _chunk(b"IHDR", ihdr) + _chunk(b"IDAT", zlib.compress(raw.tobytes(), 6)) + _chunk(b"IEND", b"")
+    return (
+        _SIGNATURE
+        + _chunk(b"IHDR", ihdr)
+        + _chunk(b"IDAT", zlib.compress(raw.tobytes(), 6))
+        + _chunk(b"IEND", b"")
+    )
 
 
 @njit(cache=True, nogil=True)
@@ -118,7 +128,9 @@ def decode_png(data: bytes, *, max_pixels: int = 100_000_000) -> np.ndarray:
         raise PNGError("PNG has no IHDR chunk")
     w, h, depth, ctype, _comp, _filt, interlace = ihdr
     if ctype not in _CHANNELS or depth not in (8, 16) or interlace != 0:
-        raise PNGError(f"unsupported PNG (colour type {ctype}, depth {depth}, interlace {interlace})")
+        raise PNGError(
+            f"unsupported PNG (colour type {ctype}, depth {depth}, interlace {interlace})"
+        )
     if w < 1 or h < 1:
         raise PNGError(f"zero-sized PNG ({w}x{h})")
     if w * h > max_pixels:

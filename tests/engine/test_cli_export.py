@@ -19,8 +19,16 @@ def project_file(tmp_path):
     g = np.random.default_rng(0)
     src = g.integers(0, 65536, (32, 32, 3)).astype(np.uint16)
     tiles = [src[i : i + 8, i : i + 8] for i in range(4)]
-    p = project_from_tileset(sources=src, tiles=tiles, name="demo", bit_depth=16, picks=[3, 1, 0],
-                             layout=[[0, 1, 2], [2, 1, 0]], seeds=[5, 6, 7, 8], scores=[1, 2, 3, 4])
+    p = project_from_tileset(
+        sources=src,
+        tiles=tiles,
+        name="demo",
+        bit_depth=16,
+        picks=[3, 1, 0],
+        layout=[[0, 1, 2], [2, 1, 0]],
+        seeds=[5, 6, 7, 8],
+        scores=[1, 2, 3, 4],
+    )
     path = tmp_path / "demo.quiltproj"
     save_project(path, p)
     return path, src
@@ -29,15 +37,35 @@ def project_file(tmp_path):
 def test_cli_export_writes_the_bundle(tmp_path, project_file, capsys):
     path, src = project_file
     out = tmp_path / "bundle"
-    rc = main(["export", str(path), "--out", str(out), "--atlas-columns", "2", "--spacing", "2", "--margin", "1",
-               "--extrude", "1"])
+    rc = main(
+        [
+            "export",
+            str(path),
+            "--out",
+            str(out),
+            "--atlas-columns",
+            "2",
+            "--spacing",
+            "2",
+            "--margin",
+            "1",
+            "--extrude",
+            "1",
+        ]
+    )
     assert rc == 0
     assert "wrote 3 tiles" in capsys.readouterr().err
     man = json.loads((out / "demo.json").read_text())
-    assert man["atlas"]["columns"] == 2 and man["atlas"]["spacing"] == 2 and man["atlas"]["margin"] == 1
+    assert (
+        man["atlas"]["columns"] == 2
+        and man["atlas"]["spacing"] == 2
+        and man["atlas"]["margin"] == 1
+    )
     assert man["atlas"]["extrude"] == 1 and man["bit_depth"] == 16 and man["tile_count"] == 3
     tile0 = decode_png((out / "demo_000_albedo.png").read_bytes())
-    assert tile0.dtype == np.uint16 and np.array_equal(tile0, src[3:11, 3:11])  # pick 0 is candidate 3
+    assert tile0.dtype == np.uint16 and np.array_equal(
+        tile0, src[3:11, 3:11]
+    )  # pick 0 is candidate 3
     assert man["layout"]["cells"] == [[0, 1, 2], [2, 1, 0]]
     # 8-bit on request (dithered by default), refusing to overwrite without --overwrite
     assert main(["export", str(path), "--out", str(out), "--bit-depth", "8"]) == 1
@@ -53,7 +81,11 @@ def test_cli_export_errors_are_one_line(tmp_path, capsys):
     bad.write_text("not a zip")
     assert main(["export", str(bad), "--out", str(tmp_path / "o")]) == 1
     err = capsys.readouterr().err
-    assert err.startswith("quilt-studio export: error: ") and str(bad) in err and "Traceback" not in err
+    assert (
+        err.startswith("quilt-studio export: error: ")
+        and str(bad) in err
+        and "Traceback" not in err
+    )
     assert not (tmp_path / "o").exists()
     with pytest.raises(SystemExit):
         main(["export", str(bad), "--out", str(tmp_path / "o"), "--spacing", "-1"])
@@ -61,7 +93,11 @@ def test_cli_export_errors_are_one_line(tmp_path, capsys):
 
 def test_cli_export_subprocess(tmp_path, project_file):
     path, _ = project_file
-    res = subprocess.run([sys.executable, "-m", "quilt_gui", "export", str(path), "--out", str(tmp_path / "b")],
-                         capture_output=True, text=True, timeout=120)
+    res = subprocess.run(
+        [sys.executable, "-m", "quilt_gui", "export", str(path), "--out", str(tmp_path / "b")],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert res.returncode == 0, res.stderr
     assert (tmp_path / "b" / "demo.tsx").exists() and (tmp_path / "b" / "demo.tres").exists()

@@ -16,7 +16,13 @@ import pytest
 import engine.export
 import engine.io
 from engine.export import (
-    ExportError, assemble_layout, atlas_layout, export_bundle, godot_tres, quantize, render_atlas,
+    ExportError,
+    assemble_layout,
+    atlas_layout,
+    export_bundle,
+    godot_tres,
+    quantize,
+    render_atlas,
 )
 from engine.export._png import decode_png, encode_png
 
@@ -32,6 +38,7 @@ def make_tiles(n=6, h=12, w=10, rng=0, maps=("albedo", "height")):
 
 
 # ------------------------------------------------------------------ PNG codec
+
 
 @pytest.mark.parametrize("dtype", [np.uint8, np.uint16])
 @pytest.mark.parametrize("c", [1, 2, 3, 4])
@@ -53,6 +60,7 @@ def test_png_decoder_reads_pillow_filters_and_refuses_huge_declared_size(tmp_pat
 
 
 # ------------------------------------------------------------------ quantize
+
 
 def test_quantize_is_exact_on_the_target_grid_even_with_dither():
     k8 = np.arange(256, dtype=np.uint8)
@@ -87,14 +95,21 @@ def test_quantize_validates():
 
 # ------------------------------------------------------------------ atlas
 
-@pytest.mark.parametrize("count,columns,spacing,margin,extrude", [(6, 3, 2, 1, 1), (5, None, 0, 0, 0), (7, 2, 3, 4, 2)])
-def test_atlas_rects_do_not_overlap_and_follow_the_tiled_formula(count, columns, spacing, margin, extrude):
-    lay = atlas_layout(count, 10, 12, columns=columns, spacing=spacing, margin=margin, extrude=extrude)
+
+@pytest.mark.parametrize(
+    "count,columns,spacing,margin,extrude", [(6, 3, 2, 1, 1), (5, None, 0, 0, 0), (7, 2, 3, 4, 2)]
+)
+def test_atlas_rects_do_not_overlap_and_follow_the_tiled_formula(
+    count, columns, spacing, margin, extrude
+):
+    lay = atlas_layout(
+        count, 10, 12, columns=columns, spacing=spacing, margin=margin, extrude=extrude
+    )
     occupied = np.zeros((lay.height, lay.width), int)
     for i in range(count):
         x, y, w, h = lay.rect(i)
         r, c = divmod(i, lay.columns)
-        # Tiled / Godot: tile (c, r) starts at margin + c * (tile + spacing) with their margin/spacing
+        # Tiled / Godot: tile (c, r) starts at margin + c * (tile + spacing), in their terms
         assert x == lay.tiled_margin + c * (10 + lay.tiled_spacing)
         assert y == lay.tiled_margin + r * (12 + lay.tiled_spacing)
         occupied[y - extrude : y + h + extrude, x - extrude : x + w + extrude] += 1
@@ -109,10 +124,14 @@ def test_atlas_extrusion_repeats_edge_pixels():
     for i, t in enumerate(tiles):
         x, y, w, h = lay.rect(i)
         assert np.array_equal(atlas[y : y + h, x : x + w], t)
-        assert np.array_equal(atlas[y - 2 : y + h + 2, x - 2 : x + w + 2], np.pad(t, 2, mode="edge"))
+        assert np.array_equal(
+            atlas[y - 2 : y + h + 2, x - 2 : x + w + 2], np.pad(t, 2, mode="edge")
+        )
     wrapped = render_atlas(tiles, lay, extrude_mode="wrap")
     x, y, w, h = lay.rect(1)
-    assert np.array_equal(wrapped[y - 2 : y + h + 2, x - 2 : x + w + 2], np.pad(tiles[1], 2, mode="wrap"))
+    assert np.array_equal(
+        wrapped[y - 2 : y + h + 2, x - 2 : x + w + 2], np.pad(tiles[1], 2, mode="wrap")
+    )
     assert atlas[0, 0] == 0 and atlas[:, :2].max() == 0  # the margin stays empty
 
 
@@ -120,12 +139,17 @@ def test_assemble_layout():
     tiles = [np.full((2, 3), i + 1, np.uint8) for i in range(3)]
     img = assemble_layout(tiles, [[0, 2], [-1, 1]])
     assert img.shape == (4, 6)
-    assert np.array_equal(img[:2, 3:], tiles[2]) and img[2:, :3].max() == 0 and np.all(img[2:, 3:] == 2)
+    assert (
+        np.array_equal(img[:2, 3:], tiles[2])
+        and img[2:, :3].max() == 0
+        and np.all(img[2:, 3:] == 2)
+    )
     with pytest.raises(ValueError, match="index_matrix"):
         assemble_layout(tiles, [[0, 3]])
 
 
 # ------------------------------------------------------------------ bundle
+
 
 def test_bundle_files_manifest_and_identical_atlas_layout(tmp_path):
     tiles = make_tiles(6)
@@ -133,15 +157,39 @@ def test_bundle_files_manifest_and_identical_atlas_layout(tmp_path):
     scores = [0.5, 0.1, 0.2, 0.3, 0.4, 0.6]
     rects = [[i, 2 * i, 10, 12] for i in range(6)]
     out = tmp_path / "bundle"
-    man = export_bundle(out, name="rock", tiles=tiles, index_matrix=mat, columns=3, spacing=2, margin=1, extrude=1,
-                        manifest_extra={"parameters": {"n": 6, "method": "dp"}, "seeds": {"tileset": 7},
-                                        "scores": scores, "source_rects": rects, "note": "hi"},
-                        normal_convention="directx", weights=[1, 1, 2, 2, 1, 1])
+    man = export_bundle(
+        out,
+        name="rock",
+        tiles=tiles,
+        index_matrix=mat,
+        columns=3,
+        spacing=2,
+        margin=1,
+        extrude=1,
+        manifest_extra={
+            "parameters": {"n": 6, "method": "dp"},
+            "seeds": {"tileset": 7},
+            "scores": scores,
+            "source_rects": rects,
+            "note": "hi",
+        },
+        normal_convention="directx",
+        weights=[1, 1, 2, 2, 1, 1],
+    )
     names = sorted(os.listdir(out))
     expected = {f"rock_{i:03}_{m}.png" for i in range(6) for m in ("albedo", "height")}
-    expected |= {"rock_atlas_albedo.png", "rock_atlas_height.png", "rock.json", "rock_layout.csv",
-                 "rock_layout.json", "rock.tsx", "rock.tmx", "rock.tres", "rock_preview_albedo.png",
-                 "rock_preview_height.png"}
+    expected |= {
+        "rock_atlas_albedo.png",
+        "rock_atlas_height.png",
+        "rock.json",
+        "rock_layout.csv",
+        "rock_layout.json",
+        "rock.tsx",
+        "rock.tmx",
+        "rock.tres",
+        "rock_preview_albedo.png",
+        "rock_preview_height.png",
+    }
     assert set(names) == expected
     assert json.loads((out / "rock.json").read_text()) == man
     assert man["normal_convention"] == "directx" and man["bit_depth"] == 8
@@ -149,13 +197,21 @@ def test_bundle_files_manifest_and_identical_atlas_layout(tmp_path):
     assert man["scores"] == scores and man["extra"] == {"note": "hi"}
     assert [t["source_rect"] for t in man["tiles"]] == rects
     atlases = {m: read_png(out / man["atlas"]["images"][m]) for m in ("albedo", "height")}
-    assert atlases["albedo"].shape[:2] == atlases["height"].shape[:2] == (man["atlas"]["height"], man["atlas"]["width"])
+    assert (
+        atlases["albedo"].shape[:2]
+        == atlases["height"].shape[:2]
+        == (man["atlas"]["height"], man["atlas"]["width"])
+    )
     for i, t in enumerate(man["tiles"]):
         r = t["atlas_rect"]
         for m in ("albedo", "height"):
             tile_png = read_png(out / t["files"][m])
-            assert np.array_equal(tile_png, quantize(tiles[i][m], 8, dither=False))  # 8-bit source: rounded
-            assert np.array_equal(atlases[m][r["y"] : r["y"] + r["h"], r["x"] : r["x"] + r["w"]], tile_png)
+            assert np.array_equal(
+                tile_png, quantize(tiles[i][m], 8, dither=False)
+            )  # 8-bit source: rounded
+            assert np.array_equal(
+                atlases[m][r["y"] : r["y"] + r["h"], r["x"] : r["x"] + r["w"]], tile_png
+            )
         fr = man["frames"][t["files"]["albedo"]]["frame"]
         assert fr == r
     lay_json = json.loads((out / "rock_layout.json").read_text())
@@ -163,21 +219,44 @@ def test_bundle_files_manifest_and_identical_atlas_layout(tmp_path):
     with open(out / "rock_layout.csv", newline="") as f:
         assert [[int(v) for v in row] for row in csv.reader(f)] == mat.tolist()
     prev = read_png(out / "rock_preview_albedo.png")
-    assert np.array_equal(prev, assemble_layout([quantize(t["albedo"], 8, dither=False) for t in tiles], mat))
+    assert np.array_equal(
+        prev, assemble_layout([quantize(t["albedo"], 8, dither=False) for t in tiles], mat)
+    )
 
 
 def test_tsx_and_tmx_are_valid_xml_matching_the_manifest(tmp_path):
     tiles = make_tiles(6, maps=("albedo",))
     mat = np.array([[0, 1, -1], [5, 4, 3]])
-    man = export_bundle(tmp_path / "b", name="t", tiles=tiles, index_matrix=mat, columns=3, spacing=3, margin=2,
-                        extrude=1, weights=[1, 2, 3, 4, 5, 6])
+    man = export_bundle(
+        tmp_path / "b",
+        name="t",
+        tiles=tiles,
+        index_matrix=mat,
+        columns=3,
+        spacing=3,
+        margin=2,
+        extrude=1,
+        weights=[1, 2, 3, 4, 5, 6],
+    )
     ts = ET.parse(tmp_path / "b" / "t.tsx").getroot()
     assert ts.tag == "tileset"
-    assert {k: int(ts.get(k)) for k in ("tilewidth", "tileheight", "tilecount", "columns", "spacing", "margin")} == {
-        "tilewidth": 10, "tileheight": 12, "tilecount": 6, "columns": 3, "spacing": 5, "margin": 3}
+    assert {
+        k: int(ts.get(k))
+        for k in ("tilewidth", "tileheight", "tilecount", "columns", "spacing", "margin")
+    } == {
+        "tilewidth": 10,
+        "tileheight": 12,
+        "tilecount": 6,
+        "columns": 3,
+        "spacing": 5,
+        "margin": 3,
+    }
     img = ts.find("image")
     assert img.get("source") == man["atlas"]["images"]["albedo"]
-    assert (int(img.get("width")), int(img.get("height"))) == (man["atlas"]["width"], man["atlas"]["height"])
+    assert (int(img.get("width")), int(img.get("height"))) == (
+        man["atlas"]["width"],
+        man["atlas"]["height"],
+    )
     assert [float(t.get("probability")) for t in ts.findall("tile")] == [1, 2, 3, 4, 5, 6]
     mp = ET.parse(tmp_path / "b" / "t.tmx").getroot()
     assert mp.find("tileset").get("source") == "t.tsx" and mp.find("tileset").get("firstgid") == "1"
@@ -192,14 +271,18 @@ def parse_tres(text: str):
     sections = []
     head_re = re.compile(r'^\[(\w+)((?:\s+\w+=(?:"[^"]*"|[^\s\]]+))*)\]$')
     attr_re = re.compile(r'(\w+)=("[^"]*"|[^\s\]]+)')
-    line_re = re.compile(r'^([\w:/]+) = (.+)$')
-    value_re = re.compile(r'^(-?\d+|"[^"]*"|true|false|Vector2i\(-?\d+, -?\d+\)|(Ext|Sub)Resource\("[^"]+"\))$')
+    line_re = re.compile(r"^([\w:/]+) = (.+)$")
+    value_re = re.compile(
+        r'^(-?\d+|"[^"]*"|true|false|Vector2i\(-?\d+, -?\d+\)|(Ext|Sub)Resource\("[^"]+"\))$'
+    )
     for raw in text.splitlines():
         if not raw.strip():
             continue
         m = head_re.match(raw)
         if m:
-            sections.append((m.group(1), {k: v.strip('"') for k, v in attr_re.findall(m.group(2))}, {}))
+            sections.append(
+                (m.group(1), {k: v.strip('"') for k, v in attr_re.findall(m.group(2))}, {})
+            )
             continue
         m = line_re.match(raw)
         assert m and sections, f"not Godot resource syntax: {raw!r}"
@@ -210,14 +293,19 @@ def parse_tres(text: str):
 
 def test_godot_tres_structure(tmp_path):
     tiles = make_tiles(5, maps=("albedo",))
-    man = export_bundle(tmp_path / "tex", name="g", tiles=tiles, columns=2, spacing=1, margin=2, extrude=1)
+    man = export_bundle(
+        tmp_path / "tex", name="g", tiles=tiles, columns=2, spacing=1, margin=2, extrude=1
+    )
     sec = parse_tres((tmp_path / "tex" / "g.tres").read_text())
     kinds = [s[0] for s in sec]
     assert kinds == ["gd_resource", "ext_resource", "sub_resource", "resource"]
     head = sec[0][1]
     assert head["type"] == "TileSet" and head["format"] == "3" and int(head["load_steps"]) == 3
     ext = sec[1][1]
-    assert ext["type"] == "Texture2D" and ext["path"] == "res://tex/" + man["atlas"]["images"]["albedo"]
+    assert (
+        ext["type"] == "Texture2D"
+        and ext["path"] == "res://tex/" + man["atlas"]["images"]["albedo"]
+    )
     sub_attrs, sub = sec[2][1], sec[2][2]
     assert sub_attrs["type"] == "TileSetAtlasSource"
     assert sub["texture"] == f'ExtResource("{ext["id"]}")'
@@ -234,7 +322,9 @@ def test_godot_tres_structure(tmp_path):
     for i, t in enumerate(man["tiles"]):
         c, r = i % 2, i // 2
         x, y = 3 + c * (10 + 3), 3 + r * (12 + 3)
-        assert np.array_equal(atlas[y : y + 12, x : x + 10], read_png(tmp_path / "tex" / t["files"]["albedo"]))
+        assert np.array_equal(
+            atlas[y : y + 12, x : x + 10], read_png(tmp_path / "tex" / t["files"]["albedo"])
+        )
     assert godot_tres(image_path='res://a "b".png', layout=atlas_layout(1, 2, 2)).count('\\"') == 2
 
 
@@ -260,16 +350,23 @@ def test_sixteen_bit_tiles_are_exact_copies_of_source_pixels(tmp_path):
     assert out.dtype == np.uint16 and outh.dtype == np.uint16
     keep1, keep2 = alpha == 1, alpha == 0
     assert keep1.sum() > 50 and keep2.sum() > 50
-    assert np.array_equal(out[keep1], src16[:16, :16][keep1]) and np.array_equal(out[keep2], src16[20:36, 20:36][keep2])
-    assert np.array_equal(outh[keep1], gray16[:16, :16][keep1]) and np.array_equal(outh[keep2], gray16[20:36, 20:36][keep2])
+    assert np.array_equal(out[keep1], src16[:16, :16][keep1]) and np.array_equal(
+        out[keep2], src16[20:36, 20:36][keep2]
+    )
+    assert np.array_equal(outh[keep1], gray16[:16, :16][keep1]) and np.array_equal(
+        outh[keep2], gray16[20:36, 20:36][keep2]
+    )
     # uint16 input auto-selects 16-bit; 8-bit only on request, dithered
-    assert export_bundle(tmp_path / "auto", name="a", tiles=[{"m": src16[:8, :8]}])["bit_depth"] == 16
+    assert (
+        export_bundle(tmp_path / "auto", name="a", tiles=[{"m": src16[:8, :8]}])["bit_depth"] == 16
+    )
     man8 = export_bundle(tmp_path / "eight", name="e", tiles=[{"m": src16[:8, :8]}], bit_depth=8)
     assert read_png(tmp_path / "eight" / "e_000_m.png").dtype == np.uint8 and man8["bit_depth"] == 8
     assert man8["dithered"] and man8["source_bit_depth"] == 16
 
 
 # ------------------------------------------------------------------ validation
+
 
 def test_bundle_validates_inputs(tmp_path):
     tiles = make_tiles(2)
@@ -282,13 +379,16 @@ def test_bundle_validates_inputs(tmp_path):
     with pytest.raises(ValueError, match="scores"):
         export_bundle(tmp_path / "x", name="a", tiles=tiles, manifest_extra={"scores": [1]})
     with pytest.raises(ValueError, match="JSON"):
-        export_bundle(tmp_path / "x", name="a", tiles=tiles, manifest_extra={"parameters": {"f": object()}})
+        export_bundle(
+            tmp_path / "x", name="a", tiles=tiles, manifest_extra={"parameters": {"f": object()}}
+        )
     with pytest.raises(ValueError, match="spacing"):
         export_bundle(tmp_path / "x", name="a", tiles=tiles, spacing=-1)
     assert not (tmp_path / "x").exists()
 
 
 # ------------------------------------------------------------------ atomicity
+
 
 def leftovers(parent: Path, name: str):
     return [p.name for p in parent.iterdir() if p.name.startswith(f".{name}.")]
@@ -346,8 +446,10 @@ def test_read_only_folder_simulated(tmp_path, monkeypatch):
     assert list(tmp_path.iterdir()) == []
 
 
-@pytest.mark.skipif(not hasattr(os, "geteuid") or os.geteuid() == 0,
-                    reason="running as root: file permissions do not stop root from writing")
+@pytest.mark.skipif(
+    not hasattr(os, "geteuid") or os.geteuid() == 0,
+    reason="running as root: file permissions do not stop root from writing",
+)
 def test_read_only_folder_real(tmp_path):
     ro = tmp_path / "ro"
     ro.mkdir()
@@ -360,7 +462,10 @@ def test_read_only_folder_real(tmp_path):
         ro.chmod(0o755)
 
 
-@pytest.mark.skipif(not Path("/sys/fs").is_dir(), reason="needs Linux sysfs (a folder nobody, not even root, can write)")
+@pytest.mark.skipif(
+    not Path("/sys/fs").is_dir(),
+    reason="needs Linux sysfs (a folder nobody, not even root, can write)",
+)
 def test_unwritable_system_folder_real():
     with pytest.raises(ExportError, match="cannot export to /sys/fs/quilt_bundle") as info:
         export_bundle("/sys/fs/quilt_bundle", name="a", tiles=make_tiles(1))
@@ -374,11 +479,20 @@ def test_tiff_tiles_keep_16_bits(tmp_path, maps):
 
     g = np.random.default_rng(9)
     chans = {"albedo": 3, "height": 1, "rgba": 4}
-    tiles = [{m: g.integers(0, 65536, (6, 5, chans[m])).astype(np.uint16) for m in maps} for _ in range(2)]
-    man = export_bundle(tmp_path / "t", name="t", tiles=tiles, tile_format="tif", index_matrix=[[0, 1]])
+    tiles = [
+        {m: g.integers(0, 65536, (6, 5, chans[m])).astype(np.uint16) for m in maps}
+        for _ in range(2)
+    ]
+    man = export_bundle(
+        tmp_path / "t", name="t", tiles=tiles, tile_format="tif", index_matrix=[[0, 1]]
+    )
     for i, entry in enumerate(man["tiles"]):
         for m in maps:
             assert entry["files"][m].endswith(".tif")
             back = tifffile.imread(tmp_path / "t" / entry["files"][m])
-            assert back.dtype == np.uint16 and np.array_equal(back.reshape(tiles[i][m].shape), tiles[i][m])
-    assert man["atlas"]["images"][maps[0]].endswith(".png") and man["preview"][maps[0]].endswith(".tif")
+            assert back.dtype == np.uint16 and np.array_equal(
+                back.reshape(tiles[i][m].shape), tiles[i][m]
+            )
+    assert man["atlas"]["images"][maps[0]].endswith(".png") and man["preview"][maps[0]].endswith(
+        ".tif"
+    )

@@ -1,4 +1,4 @@
-"""Materials: one cut applied to every map; normal maps stay unit length; exact copies off the blend."""
+"""Materials: one cut for every map; normals stay unit length; exact copies off the blend."""
 
 from __future__ import annotations
 
@@ -8,8 +8,14 @@ from scipy.ndimage import distance_transform_edt
 
 from engine.export import quantize
 from engine.materials import (
-    apply_cut, blend_normals, convert_normal_convention, decode_normals, encode_normals, infer_kind,
-    make_material, material_error,
+    apply_cut,
+    blend_normals,
+    convert_normal_convention,
+    decode_normals,
+    encode_normals,
+    infer_kind,
+    make_material,
+    material_error,
 )
 from engine.seams import find_seam
 
@@ -35,11 +41,21 @@ def feather(mask: np.ndarray, half_width: float) -> np.ndarray:
 def overlap():
     g = np.random.default_rng(0)
     h, w = 40, 24
+
     # quantized like an 8-bit file so "exact copy" has a meaning
     def q(a):
         return quantize(a, 8, dither=False).astype(np.float32) / 255
-    r1 = {"albedo": q(g.random((h, w, 3))), "normal": q(random_normals((h, w), 1)), "height": q(g.random((h, w, 1)))}
-    r2 = {"albedo": q(g.random((h, w, 3))), "normal": q(random_normals((h, w), 2)), "height": q(g.random((h, w, 1)))}
+
+    r1 = {
+        "albedo": q(g.random((h, w, 3))),
+        "normal": q(random_normals((h, w), 1)),
+        "height": q(g.random((h, w, 1))),
+    }
+    r2 = {
+        "albedo": q(g.random((h, w, 3))),
+        "normal": q(random_normals((h, w), 2)),
+        "height": q(g.random((h, w, 1))),
+    }
     return r1, r2
 
 
@@ -54,12 +70,18 @@ def test_one_cut_lands_on_the_same_pixels_in_every_map(overlap):
     from_r2 = {m: np.all(out[m] == r2[m], axis=2) for m in out}
     for m in out:
         assert out[m].dtype == np.float32 and out[m].shape == r1[m].shape
-        differ = np.any(r1[m] != r2[m], axis=2)  # where R1 and R2 differ, the source is identifiable
+        differ = np.any(
+            r1[m] != r2[m], axis=2
+        )  # where R1 and R2 differ, the source is identifiable
         assert differ.mean() > 0.99
         assert np.all(from_r1[m][alpha == 1]) and np.all(from_r2[m][alpha == 0]), m  # exact copies
         assert np.array_equal(from_r1[m] & differ, (alpha == 1) & differ), m  # ... and nowhere else
         assert np.array_equal(from_r2[m] & differ, (alpha == 0) & differ), m
-    assert (alpha == 1).sum() > 100 and (alpha == 0).sum() > 100 and ((alpha > 0) & (alpha < 1)).sum() > 50
+    assert (
+        (alpha == 1).sum() > 100
+        and (alpha == 0).sum() > 100
+        and ((alpha > 0) & (alpha < 1)).sum() > 50
+    )
     # a hard cut: the partition of every map equals the seam mask exactly
     hard = apply_cut(r1, r2, seam.mask.astype(np.float32))
     for m in hard:
@@ -89,7 +111,9 @@ def test_blend_normals_opposite_vectors_and_alpha_channel():
     out = blend_normals(up, down, np.array([[0.5]], np.float32))
     assert abs(np.linalg.norm(decode_normals(out)) - 1) < 1e-6  # no zero vector
     rgba1 = np.concatenate([up, [[[0.2]]]], axis=2).astype(np.float32)
-    rgba2 = np.concatenate([encode_normals(np.array([[[1.0, 0, 0]]])), [[[0.6]]]], axis=2).astype(np.float32)
+    rgba2 = np.concatenate([encode_normals(np.array([[[1.0, 0, 0]]])), [[[0.6]]]], axis=2).astype(
+        np.float32
+    )
     mixed = blend_normals(rgba1, rgba2, np.array([[0.5]], np.float32))
     assert mixed.shape == (1, 1, 4) and abs(mixed[0, 0, 3] - 0.4) < 1e-6
     v = decode_normals(mixed)[0, 0]
@@ -100,8 +124,14 @@ def test_material_error_weights(overlap):
     r1, r2 = overlap
     main_only = material_error(r1, r2)
     d = r1["albedo"].astype(np.float64) - r2["albedo"]
-    assert main_only.shape == d.shape[:2] and np.corrcoef(main_only.ravel(), np.sqrt((d * d).sum(axis=2)).ravel())[0, 1] > 0.9
-    assert np.array_equal(material_error(r1, r2, main="height"), material_error({"h": r1["height"]}, {"h": r2["height"]}))
+    assert (
+        main_only.shape == d.shape[:2]
+        and np.corrcoef(main_only.ravel(), np.sqrt((d * d).sum(axis=2)).ravel())[0, 1] > 0.9
+    )
+    assert np.array_equal(
+        material_error(r1, r2, main="height"),
+        material_error({"h": r1["height"]}, {"h": r2["height"]}),
+    )
     mix = material_error(r1, r2, weights={"albedo": 1.0, "height": 2.0})
     ea = material_error(r1, r2, main="albedo")
     eh = material_error(r1, r2, main="height")
@@ -114,25 +144,38 @@ def test_material_error_weights(overlap):
 
 def test_make_material_and_kinds():
     g = np.random.default_rng(0)
-    m = make_material(g.random((8, 9, 3)), extra={"rock_Normal": random_normals((8, 9), 0), "Roughness": g.random((8, 9))},
-                      normal_convention="directx")
+    m = make_material(
+        g.random((8, 9, 3)),
+        extra={"rock_Normal": random_normals((8, 9), 0), "Roughness": g.random((8, 9))},
+        normal_convention="directx",
+    )
     assert m.names == ("albedo", "rock_Normal", "Roughness") and m.shape == (8, 9)
     assert m.kinds == {"albedo": "color", "rock_Normal": "normal", "Roughness": "roughness"}
     assert m.normal_convention == "directx"
-    assert set(m.crop(1, 2, 3, 4)) == set(m.names) and m.crop(1, 2, 3, 4)["Roughness"].shape == (3, 4, 1)
+    assert set(m.crop(1, 2, 3, 4)) == set(m.names) and m.crop(1, 2, 3, 4)["Roughness"].shape == (
+        3,
+        4,
+        1,
+    )
     with pytest.raises(ValueError, match="co-registered"):
         make_material(g.random((8, 9)), extra={"height": g.random((8, 8))})
     with pytest.raises(ValueError, match="normal_convention"):
         make_material(g.random((8, 9)), normal_convention="metal")
     with pytest.raises(ValueError, match="3 channels"):
         make_material(g.random((8, 9)), extra={"normal": g.random((8, 9))})
-    assert infer_kind("AO") == "ao" and infer_kind("displacement") == "height" and infer_kind("foo") == "other"
+    assert (
+        infer_kind("AO") == "ao"
+        and infer_kind("displacement") == "height"
+        and infer_kind("foo") == "other"
+    )
 
 
 def test_convert_normal_convention_flips_green_only():
     n = random_normals((4, 5), 3)
     dx = convert_normal_convention(n, source="opengl", target="directx")
-    assert np.allclose(dx[..., 1], 1 - n[..., 1]) and np.array_equal(dx[..., [0, 2]], n[..., [0, 2]])
+    assert np.allclose(dx[..., 1], 1 - n[..., 1]) and np.array_equal(
+        dx[..., [0, 2]], n[..., [0, 2]]
+    )
     assert np.allclose(convert_normal_convention(dx, source="directx", target="opengl"), n)
     assert np.array_equal(convert_normal_convention(n, source="opengl", target="opengl"), n)
 

@@ -15,8 +15,15 @@ import pytest
 import engine.project as project_mod
 from engine.export._png import encode_png
 from engine.project import (
-    Candidate, Project, ProjectError, export_project, load_project, newer_recovery, project_from_tileset,
-    recovery_path, save_project,
+    Candidate,
+    Project,
+    ProjectError,
+    export_project,
+    load_project,
+    newer_recovery,
+    project_from_tileset,
+    recovery_path,
+    save_project,
 )
 
 
@@ -30,20 +37,44 @@ def make_project(bit_depth=16, rng=0) -> Project:
     src = {"albedo": albedo, "normal": normal, "height": height}
     tiles = [{m: a[i : i + 16, 2 * i : 2 * i + 12] for m, a in src.items()} for i in range(5)]
     return project_from_tileset(
-        sources=src, tiles=tiles, name="rock", template={m: a[:16, :12] for m, a in src.items()},
-        template_rect=(3, 4, 12, 16), patch_origins=[(i, i + 1) for i in range(5)], seeds=[10, 11, 12, 13, 14],
-        scores=[0.5, 0.25, 1.0, 2.0, 0.125], locked=[False, True, False, False, True], picks=[4, 0, 2],
-        layout=[[0, 1, 2], [2, -1, 0]], parameters={"tileset": {"n": 5, "method": "dp", "rho": 3.0}},
-        project_seeds={"template": 1, "candidates": 2}, bit_depth=bit_depth,
-        source_paths={"albedo": "/photos/rock.png"}, map_weights={"albedo": 1.0, "height": 0.5},
-        normal_convention="directx", waypoints={"candidate:1": [(3, 4), (9, 5)]},
+        sources=src,
+        tiles=tiles,
+        name="rock",
+        template={m: a[:16, :12] for m, a in src.items()},
+        template_rect=(3, 4, 12, 16),
+        patch_origins=[(i, i + 1) for i in range(5)],
+        seeds=[10, 11, 12, 13, 14],
+        scores=[0.5, 0.25, 1.0, 2.0, 0.125],
+        locked=[False, True, False, False, True],
+        picks=[4, 0, 2],
+        layout=[[0, 1, 2], [2, -1, 0]],
+        parameters={"tileset": {"n": 5, "method": "dp", "rho": 3.0}},
+        project_seeds={"template": 1, "candidates": 2},
+        bit_depth=bit_depth,
+        source_paths={"albedo": "/photos/rock.png"},
+        map_weights={"albedo": 1.0, "height": 0.5},
+        normal_convention="directx",
+        waypoints={"candidate:1": [(3, 4), (9, 5)]},
         extra={"editor": {"zoom": 2.0}},
     )
 
 
 def assert_same(a: Project, b: Project):
-    for f in ("name", "version", "source_paths", "map_kinds", "map_weights", "normal_convention", "bit_depth",
-              "parameters", "seeds", "template_rect", "picks", "waypoints", "extra"):
+    for f in (
+        "name",
+        "version",
+        "source_paths",
+        "map_kinds",
+        "map_weights",
+        "normal_convention",
+        "bit_depth",
+        "parameters",
+        "seeds",
+        "template_rect",
+        "picks",
+        "waypoints",
+        "extra",
+    ):
         assert getattr(a, f) == getattr(b, f), f
     assert list(a.sources) == list(b.sources)
     for m in a.sources:
@@ -53,7 +84,13 @@ def assert_same(a: Project, b: Project):
     assert np.array_equal(a.layout, b.layout)
     assert len(a.candidates) == len(b.candidates)
     for ca, cb in zip(a.candidates, b.candidates, strict=True):
-        assert (ca.patch_origin, ca.seed, ca.locked, ca.score, ca.params) == (cb.patch_origin, cb.seed, cb.locked, cb.score, cb.params)
+        assert (ca.patch_origin, ca.seed, ca.locked, ca.score, ca.params) == (
+            cb.patch_origin,
+            cb.seed,
+            cb.locked,
+            cb.score,
+            cb.params,
+        )
         for m in ca.maps:
             assert np.array_equal(ca.maps[m], cb.maps[m])
 
@@ -66,7 +103,9 @@ def test_round_trip_is_exact(tmp_path, bit_depth):
     assert_same(p, q)
     top = 65535 if bit_depth == 16 else 255
     k = np.round(q.sources["albedo"] * top)
-    assert np.array_equal(k, np.round(p.sources["albedo"] * top)) and k.max() > 255 * (bit_depth == 16)
+    assert np.array_equal(k, np.round(p.sources["albedo"] * top)) and k.max() > 255 * (
+        bit_depth == 16
+    )
     # saving the loaded project gives the same bytes (deterministic archive)
     save_project(tmp_path / "b.quiltproj", q)
     assert (tmp_path / "a.quiltproj").read_bytes() == (tmp_path / "b.quiltproj").read_bytes()
@@ -117,6 +156,7 @@ def test_invalid_project_is_refused_before_writing(tmp_path):
 
 # ------------------------------------------------------------------ hostile and broken files
 
+
 def rewrite(src: Path, dst: Path, *, doc_edit=None, entries=None, drop=()):
     """Copy a project zip changing project.json and/or adding raw entries."""
     with zipfile.ZipFile(src) as zin, zipfile.ZipFile(dst, "w", zipfile.ZIP_DEFLATED) as zout:
@@ -151,8 +191,17 @@ def expect_refused(path, *patterns):
     return msg
 
 
-@pytest.mark.parametrize("entry", ["../evil.png", "/abs/evil.png", "images/../../evil.png", "C:/evil.png",
-                                   "images\\evil.png", "./x.png"])
+@pytest.mark.parametrize(
+    "entry",
+    [
+        "../evil.png",
+        "/abs/evil.png",
+        "images/../../evil.png",
+        "C:/evil.png",
+        "images\\evil.png",
+        "./x.png",
+    ],
+)
 def test_entries_escaping_the_archive_are_refused(tmp_path, good, entry):
     bad = rewrite(good, tmp_path / "bad.quiltproj", entries={entry: b"x"})
     expect_refused(bad, "unsafe path")
@@ -162,7 +211,9 @@ def test_json_image_reference_escaping_is_refused(tmp_path, good):
     def edit(doc):
         doc["sources"]["albedo"] = "../../etc/passwd"
 
-    expect_refused(rewrite(good, tmp_path / "b.quiltproj", doc_edit=edit), "not a safe archive path")
+    expect_refused(
+        rewrite(good, tmp_path / "b.quiltproj", doc_edit=edit), "not a safe archive path"
+    )
 
 
 def test_truncated_zip_is_refused(tmp_path, good):
@@ -184,25 +235,36 @@ def test_corrupt_entry_is_refused(tmp_path, good):
     expect_refused(bad, "images/source_albedo.png")
 
 
-@pytest.mark.parametrize("edit,pattern", [
-    (lambda d: d.pop("candidates"), "missing key 'candidates'"),
-    (lambda d: d.pop("maps"), "missing key 'maps'"),
-    (lambda d: d["candidates"][0].pop("images"), "missing key candidates[0].images"),
-    (lambda d: d.__setitem__("picks", ["a"]), "picks"),
-    (lambda d: d.__setitem__("bit_depth", "16"), "bit_depth must be int"),
-    (lambda d: d.__setitem__("bit_depth", 12), "bit_depth must be 8 or 16"),
-    (lambda d: d["candidates"][1].__setitem__("locked", "yes"), "candidates[1].locked"),
-    (lambda d: d["candidates"][1].__setitem__("seed", 1.5), "candidates[1].seed"),
-    (lambda d: d.__setitem__("layout", [[0, 1], [2]]), "layout"),
-    (lambda d: d.__setitem__("layout", [[0, 7]]), "layout cells"),
-    (lambda d: d.__setitem__("template_rect", [1, 2, 3]), "template_rect"),
-    (lambda d: d.__setitem__("normal_convention", "vulkan"), "normal_convention"),
-    (lambda d: d.__setitem__("version", 99), "newer Quilt Studio"),
-    (lambda d: d.__setitem__("format", "zip"), "format"),
-    (lambda d: d.__setitem__("maps", ["albedo", "normal"]), "sources must map exactly"),
-    (lambda d: d["sources"].__setitem__("normal", "images/missing.png"), "missing from the archive"),
-    (lambda d: d["candidates"][0]["images"].__setitem__("albedo", "images/source_albedo.png"), "candidates[0]"),
-])
+@pytest.mark.parametrize(
+    "edit,pattern",
+    [
+        (lambda d: d.pop("candidates"), "missing key 'candidates'"),
+        (lambda d: d.pop("maps"), "missing key 'maps'"),
+        (lambda d: d["candidates"][0].pop("images"), "missing key candidates[0].images"),
+        (lambda d: d.__setitem__("picks", ["a"]), "picks"),
+        (lambda d: d.__setitem__("bit_depth", "16"), "bit_depth must be int"),
+        (lambda d: d.__setitem__("bit_depth", 12), "bit_depth must be 8 or 16"),
+        (lambda d: d["candidates"][1].__setitem__("locked", "yes"), "candidates[1].locked"),
+        (lambda d: d["candidates"][1].__setitem__("seed", 1.5), "candidates[1].seed"),
+        (lambda d: d.__setitem__("layout", [[0, 1], [2]]), "layout"),
+        (lambda d: d.__setitem__("layout", [[0, 7]]), "layout cells"),
+        (lambda d: d.__setitem__("template_rect", [1, 2, 3]), "template_rect"),
+        (lambda d: d.__setitem__("normal_convention", "vulkan"), "normal_convention"),
+        (lambda d: d.__setitem__("version", 99), "newer Quilt Studio"),
+        (lambda d: d.__setitem__("format", "zip"), "format"),
+        (lambda d: d.__setitem__("maps", ["albedo", "normal"]), "sources must map exactly"),
+        (
+            lambda d: d["sources"].__setitem__("normal", "images/missing.png"),
+            "missing from the archive",
+        ),
+        (
+            lambda d: d["candidates"][0]["images"].__setitem__(
+                "albedo", "images/source_albedo.png"
+            ),
+            "candidates[0]",
+        ),
+    ],
+)
 def test_wrong_types_and_missing_keys_are_refused(tmp_path, good, edit, pattern):
     expect_refused(rewrite(good, tmp_path / "b.quiltproj", doc_edit=edit), pattern)
 
@@ -217,12 +279,16 @@ def test_not_json_and_not_zip(tmp_path, good):
     (tmp_path / "empty.quiltproj").write_bytes(b"")
     expect_refused(tmp_path / "empty.quiltproj", "empty")
     expect_refused(tmp_path / "missing.quiltproj", "no such file")
-    expect_refused(rewrite(good, tmp_path / "nojson.quiltproj", drop=("project.json",)), "missing project.json")
+    expect_refused(
+        rewrite(good, tmp_path / "nojson.quiltproj", drop=("project.json",)), "missing project.json"
+    )
 
 
 def test_oversized_entries_are_refused(tmp_path, good, monkeypatch):
     # a real zip bomb in miniature: 64 MB of zeros deflates to ~64 kB
-    bomb = rewrite(good, tmp_path / "bomb.quiltproj", entries={"images/bomb.bin": b"\0" * (64 * 2**20)})
+    bomb = rewrite(
+        good, tmp_path / "bomb.quiltproj", entries={"images/bomb.bin": b"\0" * (64 * 2**20)}
+    )
     assert bomb.stat().st_size < 2**20
     monkeypatch.setattr(project_mod, "MAX_ENTRY_BYTES", 16 * 2**20)
     with pytest.raises(ProjectError, match="over the limit"):
@@ -254,14 +320,26 @@ def test_png_declaring_a_huge_image_is_refused_before_inflating(tmp_path, good):
     ihdr = struct.pack(">IIBBBBB", 60000, 60000, 8, 2, 0, 0, 0)
 
     def chunk(tag, body):
-        return struct.pack(">I", len(body)) + tag + body + struct.pack(">I", zlib.crc32(tag + body) & 0xFFFFFFFF)
+        return (
+            struct.pack(">I", len(body))
+            + tag
+            + body
+            + struct.pack(">I", zlib.crc32(tag + body) & 0xFFFFFFFF)
+        )
 
-    png = b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", zlib.compress(b"\0" * 1000)) + chunk(b"IEND", b"")
+    png = (
+        b"\x89PNG\r\n\x1a\n"
+        + chunk(b"IHDR", ihdr)
+        + chunk(b"IDAT", zlib.compress(b"\0" * 1000))
+        + chunk(b"IEND", b"")
+    )
 
     def edit(doc):
         doc["sources"]["albedo"] = "images/huge.png"
 
-    bad = rewrite(good, tmp_path / "huge.quiltproj", doc_edit=edit, entries={"images/huge.png": png})
+    bad = rewrite(
+        good, tmp_path / "huge.quiltproj", doc_edit=edit, entries={"images/huge.png": png}
+    )
     expect_refused(bad, "images/huge.png", "over the limit")
 
 
@@ -269,8 +347,12 @@ def test_image_of_wrong_size_or_channels_is_refused(tmp_path, good):
     def edit(doc):
         doc["sources"]["height"] = "images/odd.png"
 
-    bad = rewrite(good, tmp_path / "odd.quiltproj", doc_edit=edit,
-                  entries={"images/odd.png": encode_png(np.zeros((5, 5), np.uint8))})
+    bad = rewrite(
+        good,
+        tmp_path / "odd.quiltproj",
+        doc_edit=edit,
+        entries={"images/odd.png": encode_png(np.zeros((5, 5), np.uint8))},
+    )
     expect_refused(bad, "height")
 
 

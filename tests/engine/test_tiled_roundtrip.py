@@ -14,38 +14,71 @@ from engine.export import export_bundle
 from engine.export._png import decode_png
 
 TILED = shutil.which("tiled")
-pytestmark = pytest.mark.skipif(TILED is None, reason="Tiled is not installed (Debian package 'tiled'; .ci/run installs it)")
+pytestmark = pytest.mark.skipif(
+    TILED is None, reason="Tiled is not installed (Debian package 'tiled'; .ci/run installs it)"
+)
 
 
 def tiled(*args, cwd):
     env = dict(os.environ, QT_QPA_PLATFORM="offscreen", XDG_RUNTIME_DIR=str(cwd))
-    res = subprocess.run([TILED, *args], capture_output=True, text=True, cwd=cwd, env=env, timeout=60)
+    res = subprocess.run(
+        [TILED, *args], capture_output=True, text=True, cwd=cwd, env=env, timeout=60
+    )
     assert res.returncode == 0, f"tiled {' '.join(args)} failed: {res.stderr}"
 
 
-@pytest.mark.parametrize("count,columns,spacing,margin,extrude", [(6, 3, 2, 1, 1), (8, None, 0, 0, 0), (5, 2, 1, 3, 2)])
+@pytest.mark.parametrize(
+    "count,columns,spacing,margin,extrude", [(6, 3, 2, 1, 1), (8, None, 0, 0, 0), (5, 2, 1, 3, 2)]
+)
 def test_tiled_reads_the_tileset_and_map(tmp_path, count, columns, spacing, margin, extrude):
     g = np.random.default_rng(count)
     tiles = [{"albedo": g.random((12, 10, 3)).astype(np.float32)} for _ in range(count)]
     cells = g.integers(-1, count, (5, 7))
     out = tmp_path / "bundle"
-    man = export_bundle(out, name="set", tiles=tiles, index_matrix=cells, columns=columns, spacing=spacing,
-                        margin=margin, extrude=extrude, weights=list(range(1, count + 1)))
-    tiled("--export-map", "json", str(out / man["tiled"]["tmx"]), str(tmp_path / "map.json"), cwd=tmp_path)
-    tiled("--export-tileset", "json", str(out / man["tiled"]["tsx"]), str(tmp_path / "tileset.json"), cwd=tmp_path)
+    man = export_bundle(
+        out,
+        name="set",
+        tiles=tiles,
+        index_matrix=cells,
+        columns=columns,
+        spacing=spacing,
+        margin=margin,
+        extrude=extrude,
+        weights=list(range(1, count + 1)),
+    )
+    tiled(
+        "--export-map",
+        "json",
+        str(out / man["tiled"]["tmx"]),
+        str(tmp_path / "map.json"),
+        cwd=tmp_path,
+    )
+    tiled(
+        "--export-tileset",
+        "json",
+        str(out / man["tiled"]["tsx"]),
+        str(tmp_path / "tileset.json"),
+        cwd=tmp_path,
+    )
     ts = json.loads((tmp_path / "tileset.json").read_text())
     mp = json.loads((tmp_path / "map.json").read_text())
 
     at = man["atlas"]
     assert (ts["tilewidth"], ts["tileheight"]) == (man["tile_w"], man["tile_h"])
     assert (ts["imagewidth"], ts["imageheight"]) == (at["width"], at["height"])
-    assert (ts["margin"], ts["spacing"], ts["columns"]) == (man["tiled"]["margin"], man["tiled"]["spacing"], at["columns"])
+    assert (ts["margin"], ts["spacing"], ts["columns"]) == (
+        man["tiled"]["margin"],
+        man["tiled"]["spacing"],
+        at["columns"],
+    )
     # Tiled counts every cell of the atlas grid; blank cells only appear when the grid is not full
     assert ts["tilecount"] == at["columns"] * at["rows"]
     if count % at["columns"] == 0:
         assert ts["tilecount"] == man["tile_count"]
     probs = {t["id"]: t["probability"] for t in ts.get("tiles", [])}
-    assert [probs.get(i, 1.0) for i in range(count)] == [float(i + 1) for i in range(count)]  # 1 is Tiled's default
+    assert [probs.get(i, 1.0) for i in range(count)] == [
+        float(i + 1) for i in range(count)
+    ]  # 1 is Tiled's default
     # the tile regions Tiled computes hold exactly our tiles
     atlas = decode_png((out / at["images"]["albedo"]).read_bytes())
     for i, entry in enumerate(man["tiles"]):
@@ -55,10 +88,17 @@ def test_tiled_reads_the_tileset_and_map(tmp_path, count, columns, spacing, marg
         tile = decode_png((out / entry["files"]["albedo"]).read_bytes())
         assert np.array_equal(atlas[y : y + ts["tileheight"], x : x + ts["tilewidth"]], tile)
 
-    assert (mp["width"], mp["height"], mp["tilewidth"], mp["tileheight"]) == (7, 5, man["tile_w"], man["tile_h"])
+    assert (mp["width"], mp["height"], mp["tilewidth"], mp["tileheight"]) == (
+        7,
+        5,
+        man["tile_w"],
+        man["tile_h"],
+    )
     assert len(mp["tilesets"]) == 1 and mp["tilesets"][0]["firstgid"] == 1
     (layer,) = mp["layers"]
     gids = np.array(layer["data"]).reshape(5, 7)
-    expected = np.where(np.array(man["layout"]["cells"]) >= 0, np.array(man["layout"]["cells"]) + 1, 0)
+    expected = np.where(
+        np.array(man["layout"]["cells"]) >= 0, np.array(man["layout"]["cells"]) + 1, 0
+    )
     assert np.array_equal(gids, expected)
     assert np.array_equal(gids, np.where(cells >= 0, cells + 1, 0))
