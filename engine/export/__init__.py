@@ -44,7 +44,7 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
-from engine._validate import as_image, as_rng, choice
+from engine._validate import as_rng, choice
 from engine.export._png import encode_png
 from engine.materials import NORMAL_CONVENTIONS
 
@@ -102,9 +102,19 @@ def quantize(pixels, bit_depth: int, *, dither: bool = True, rng=None) -> np.nda
     if raw.dtype == np.uint8 and bit_depth == 16:
         return raw.astype(np.uint16) * np.uint16(257)
     gen = as_rng(rng)
-    a = np.asarray(as_image(raw, "pixels") if raw.ndim in (2, 3) else raw, dtype=np.float64)
-    if raw.ndim == 2:
-        a = a[:, :, 0]
+    if raw.dtype == bool:
+        a = raw.astype(np.float64)
+    elif np.issubdtype(raw.dtype, np.integer):
+        info = np.iinfo(raw.dtype)
+        if info.min < 0:
+            raise TypeError(f"pixels must be float in [0, 1] or unsigned integers, got {raw.dtype}")
+        a = raw.astype(np.float64) / info.max
+    elif np.issubdtype(raw.dtype, np.floating):
+        a = raw.astype(np.float64)
+        if not np.all(np.isfinite(a)):
+            raise ValueError("pixels contains NaN or infinite values")
+    else:
+        raise TypeError(f"pixels must be a numeric array, got dtype {raw.dtype}")
     top = 255.0 if bit_depth == 8 else 65535.0
     x = np.clip(a, 0.0, 1.0) * top
     r = np.round(x)

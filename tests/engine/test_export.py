@@ -91,6 +91,14 @@ def test_dither_16_to_8_keeps_the_mean_where_rounding_bands():
 def test_quantize_validates():
     with pytest.raises(ValueError, match="bit_depth"):
         quantize(np.zeros((2, 2)), 12)
+    with pytest.raises(ValueError, match="NaN"):
+        quantize(np.array([0.5, np.nan]), 8)
+    with pytest.raises(TypeError, match="unsigned"):
+        quantize(np.array([1, -1]), 8)
+    assert np.array_equal(
+        quantize(np.array([0, 257 * 3, 65535], np.uint16), 8, dither=False), [0, 3, 255]
+    )
+    assert quantize(np.zeros((2, 3, 4, 5), np.float32), 16).shape == (2, 3, 4, 5)
 
 
 # ------------------------------------------------------------------ atlas
