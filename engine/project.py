@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from engine._validate import as_image
-from engine.export import export_bundle, quantize
+from engine.export import _umask, export_bundle, quantize
 from engine.export._png import PNGError, decode_png, encode_png
 from engine.materials import MAP_KINDS, NORMAL_CONVENTIONS, resolve_kinds
 
@@ -544,12 +544,6 @@ def _zinfo(name: str, *, stored: bool = False) -> zipfile.ZipInfo:
     zi.compress_type = zipfile.ZIP_STORED if stored else zipfile.ZIP_DEFLATED
     zi.external_attr = 0o644 << 16
     return zi
-
-
-def _umask() -> int:
-    m = os.umask(0)
-    os.umask(m)
-    return m
 
 
 def recovery_path(path) -> Path:

@@ -720,6 +720,12 @@ def _write_atomically(
 
 
 def _umask() -> int:
-    m = os.umask(0)
-    os.umask(m)
-    return m
+    """The process umask, read without changing it (os.umask would race other threads)."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as f:
+            for line in f:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError):
+        pass
+    return 0o022
