@@ -111,3 +111,29 @@ def run(args) -> int:
         file=sys.stderr,
     )
     return 0
+
+
+# ---------------------------------------------------------------- for other sub-commands
+
+
+def add_project_option(parser: argparse.ArgumentParser) -> None:
+    """Add ``--project FILE`` to another sub-command (e.g. ``tileset``)."""
+    parser.add_argument(
+        "--project",
+        metavar="FILE",
+        default=None,
+        help="also save everything as a .quiltproj project (opens in the editor; "
+        "`quilt-studio export FILE --out DIR` exports it)",
+    )
+
+
+def save_project_option(args, **project_kwargs) -> None:
+    """If ``--project`` was given, build the project with
+    :func:`engine.project.project_from_tileset` (same keyword arguments) and save it."""
+    path = getattr(args, "project", None)
+    if not path:
+        return
+    from engine.project import project_from_tileset, save_project
+
+    save_project(path, project_from_tileset(**project_kwargs))
+    print(f"quilt-studio: wrote project {path}", file=sys.stderr)

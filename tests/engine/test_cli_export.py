@@ -101,3 +101,24 @@ def test_cli_export_subprocess(tmp_path, project_file):
     )
     assert res.returncode == 0, res.stderr
     assert (tmp_path / "b" / "demo.tsx").exists() and (tmp_path / "b" / "demo.tres").exists()
+
+
+def test_project_option_helpers(tmp_path):
+    import argparse
+
+    from engine.cli.export import add_project_option, save_project_option
+    from engine.project import load_project
+
+    parser = argparse.ArgumentParser()
+    add_project_option(parser)
+    g = np.random.default_rng(1)
+    src = g.random((16, 16, 3)).astype(np.float32)
+    save_project_option(parser.parse_args([]), sources=src, tiles=[src[:8, :8]])  # no-op
+    assert list(tmp_path.iterdir()) == []
+    args = parser.parse_args(["--project", str(tmp_path / "p.quiltproj")])
+    save_project_option(args, sources=src, tiles=[src[:8, :8], src[8:, 8:]], picks=[1])
+    p = load_project(tmp_path / "p.quiltproj")
+    assert len(p.candidates) == 2 and p.picks == [1]
+    assert np.array_equal(
+        p.candidates[1].maps["albedo"], np.round(src[8:, 8:] * 255) / np.float32(255)
+    )
