@@ -259,6 +259,9 @@ def export_project(project: Project, out_dir, **options) -> dict:
         options["bit_depth"] = project.bit_depth
     if options.get("normal_convention") is None:
         options["normal_convention"] = project.normal_convention
+    wts = [c.params.get("weight") for c in cands]
+    if "weights" not in options and all(isinstance(w, (int, float)) for w in wts):
+        options["weights"] = wts  # candidate params {"weight": w} -> Tiled tile probability
     return export_bundle(
         out_dir,
         name=project.name,

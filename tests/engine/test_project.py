@@ -373,3 +373,12 @@ def test_recovery_file(tmp_path):
     assert_same(load_project(newer_recovery(path)), make_project(8, rng=5))
     os.utime(recovery_path(path), ns=(0, 0))
     assert newer_recovery(path) is None
+
+
+def test_candidate_weights_become_tile_probabilities(tmp_path):
+    p = make_project(8)
+    for i, c in enumerate(p.candidates):
+        c.params["weight"] = i + 0.5
+    man = export_project(p, tmp_path / "w")
+    assert [t["weight"] for t in man["tiles"]] == [4.5, 0.5, 2.5]  # picks 4, 0, 2
+    assert 'probability="4.5"' in (tmp_path / "w" / "rock.tsx").read_text()
