@@ -1,0 +1,223 @@
+"""Quality measures of tiles, joints and synthesized images (DESIGN.md "Quality").
+
+All measures work on the colour channels in [0, 1] (alpha dropped, gray kept as one
+channel); absolute differences are averaged over channels.
+
+* :func:`border_ratio` — mean |A's last column − B's first column| over the mean |difference
+  of adjacent columns| inside A and B (B right of A; ``direction="vertical"``: B below A,
+  rows instead of columns). 1.0: the joint is as smooth as the texture itself.
+* :func:`wrap_border_ratio` — a tile against itself across its wrap.
+* :func:`grid_border_ratio` — the same ratio along the lines of a block grid.
+* :func:`detail_ratio` — variance of the Laplacian of a tile over that of the source.
+* :func:`grid_score` — normalised autocorrelation at a lag of one tile period minus the
+  source's own at the same lag (a repeated tile scores about 1.0).
+* :func:`seam_stats` — criterion (sum) and peak (max) of the error along a seam.
+
+A ratio whose denominator is zero (a perfectly flat texture) is 1.0 when the numerator is
+also zero and ``inf`` otherwise.
+"""
+
+from __future__ import annotations
+
+import numbers
+
+import numpy as np
+
+from engine._validate import as_error_map, as_image, choice
+from engine.errormap import colour_channels
+
+DIRECTIONS = ("horizontal", "vertical")
+WRAP_DIRECTIONS = ("both", "horizontal", "vertical")
+
+__all__ = [
+    "border_ratio",
+    "detail_ratio",
+    "grid_border_ratio",
+    "grid_score",
+    "seam_stats",
+    "wrap_border_ratio",
+]
+
+
+def _colour(image, name: str, *, min_size: int = 1) -> np.ndarray:
+    return colour_channels(as_image(image, name, min_size=min_size))
+
+
+def _ratio(num: float, den: float) -> float:
+    if den > 0:
+        return float(num / den)
+    return 1.0 if num == 0 else float("inf")
+
+
+def _col_steps(x: np.ndarray) -> np.ndarray:
+    """|x[:, i+1] − x[:, i]| averaged over channels, (H, W−1) float64."""
+    return np.abs(np.diff(x.astype(np.float64, copy=False), axis=1)).mean(axis=2)
+
+
+def border_ratio(a, b, *, direction: str = "horizontal") -> float:
+    """Border ratio of ``b`` placed right of (``"horizontal"``) or below (``"vertical"``) ``a``.
+
+    ``a`` and ``b`` must have the same height (horizontal) or width (vertical).
+
+    Examples
+    --------
+    >>> t = np.tile(np.arange(8.0) / 8, (4, 1))  # a ramp: every step 1/8
+    >>> round(border_ratio(t, t), 3)  # the joint jumps 7/8 back to 0
+    7.0
+    """
+    choice(direction, "direction", DIRECTIONS)
+    x = _colour(a, "a")
+    y = _colour(b, "b")
+    if direction == "vertical":
+        x, y = x.transpose(1, 0, 2), y.transpose(1, 0, 2)
+    if x.shape[0] != y.shape[0] or x.shape[2] != y.shape[2]:
+        side = "height" if direction == "horizontal" else "width"
+        raise ValueError(
+            f"a and b must have the same {side} and channels for a {direction} joint, "
+            f"got shapes {np.shape(a)} and {np.shape(b)}"
+        )
+    joint = np.abs(x[:, -1].astype(np.float64) - y[:, 0]).mean()
+    sa, sb = _col_steps(x), _col_steps(y)
+    n = sa.size + sb.size
+    inner = (sa.sum() + sb.sum()) / n if n else 0.0
+    return _ratio(joint, inner)
+
+
+def wrap_border_ratio(tile, *, direction: str = "both") -> float:
+    """Border ratio of ``tile`` against itself across its wrap.
+
+    ``"horizontal"``: the last column against the first (the tile repeated left-right);
+    ``"vertical"``: the last row against the first; ``"both"`` (default): the mean of the two.
+    """
+    choice(direction, "direction", WRAP_DIRECTIONS)
+    t = as_image(tile, "tile")
+    if direction == "both":
+        return 0.5 * (border_ratio(t, t) + border_ratio(t, t, direction="vertical"))
+    return border_ratio(t, t, direction=direction)
+
+
+def _period(period, name: str = "period") -> tuple[int, int]:
+    if isinstance(period, numbers.Integral) and not isinstance(period, bool):
+        period = (period, period)
+    try:
+        ph, pw = (int(v) for v in period)
+    except (TypeError, ValueError):
+        raise TypeError(f"{name} must be an int or a (ph, pw) pair, got {period!r}") from None
+    if ph < 1 or pw < 1:
+        raise ValueError(f"{name} must be positive, got {(ph, pw)}")
+    return ph, pw
+
+
+def grid_border_ratio(image, period, *, offset=(0, 0), direction: str = "both") -> float:
+    """Border ratio measured along the lines of a block grid in ``image``.
+
+    Grid lines run between pixel ``k - 1`` and ``k`` for every ``k = offset + n * period``
+    strictly inside the image (per axis; ``period`` and ``offset`` are (rows, cols)). The ratio
+    is mean |difference across grid lines| / mean |difference of adjacent columns (rows)
+    elsewhere|: vertical lines use column steps, horizontal lines row steps. ``"both"``
+    (default) returns the mean of the two directions that have lines.
+    """
+    choice(direction, "direction", WRAP_DIRECTIONS)
+    x = _colour(image, "image")
+    ph, pw = _period(period)
+    oy, ox = (int(v) for v in offset)
+    ratios = []
+    for axis, step, off in ((1, pw, ox), (0, ph, oy)):
+        if direction != "both" and direction != DIRECTIONS[1 - axis]:
+            continue
+        steps = _col_steps(x if axis == 1 else x.transpose(1, 0, 2))
+        k = np.arange(1, steps.shape[1] + 1)  # the line between k-1 and k
+        on = (k - off) % step == 0
+        if on.any() and (~on).any():
+            ratios.append(_ratio(steps[:, on].mean(), steps[:, ~on].mean()))
+    if not ratios:
+        raise ValueError(
+            f"no grid line of period {(ph, pw)} and offset {(oy, ox)} lies inside the "
+            f"{x.shape[1]}x{x.shape[0]} image"
+        )
+    return float(np.mean(ratios))
+
+
+def _laplacian_variance(x: np.ndarray) -> float:
+    """Variance of the 4-neighbour Laplacian over the interior, averaged over channels."""
+    lap = (
+        x[:-2, 1:-1].astype(np.float64)
+        + x[2:, 1:-1]
+        + x[1:-1, :-2]
+        + x[1:-1, 2:]
+        - 4.0 * x[1:-1, 1:-1]
+    )
+    return float(lap.reshape(-1, x.shape[2]).var(axis=0).mean())
+
+
+def detail_ratio(tile, source) -> float:
+    """Variance of the Laplacian of ``tile`` over that of ``source`` (interior pixels).
+
+    Blurring (cross-fading) lowers it below 1; a cut-based tile keeps it near 1.
+    """
+    vt = _laplacian_variance(_colour(tile, "tile", min_size=3))
+    vs = _laplacian_variance(_colour(source, "source", min_size=3))
+    if vs == 0:
+        raise ValueError("source has no detail (its Laplacian is zero everywhere)")
+    return vt / vs
+
+
+def _autocorrelation(x: np.ndarray, lag: tuple[int, int]) -> float:
+    """Pearson correlation of ``x`` with itself shifted by ``lag``, averaged over channels."""
+    dy, dx = lag
+    h, w = x.shape[:2]
+    p = x[: h - dy, : w - dx].reshape(-1, x.shape[2]).astype(np.float64)
+    q = x[dy:, dx:].reshape(-1, x.shape[2]).astype(np.float64)
+    p -= p.mean(axis=0)
+    q -= q.mean(axis=0)
+    num = (p * q).sum(axis=0)
+    den = np.sqrt((p * p).sum(axis=0) * (q * q).sum(axis=0))
+    flat = den == 0
+    r = np.where(flat, 0.0, num / np.where(flat, 1.0, den))
+    r[flat & np.all(p == q, axis=0)] = 1.0  # a flat image repeats itself exactly
+    return float(r.mean())
+
+
+def grid_score(image, period, *, source) -> float:
+    """Grid visibility of ``image`` synthesized from tiles (or blocks) of ``period`` (ph, pw).
+
+    The normalised autocorrelation of ``image`` at lags (ph, 0) and (0, pw), minus the
+    source's own at the same lags, averaged over the lags that fit in both images. One
+    tile repeated scores about 1.0; a synthesis as varied as its source scores about 0.
+    """
+    x = _colour(image, "image")
+    s = _colour(source, "source")
+    ph, pw = _period(period)
+    scores = [
+        _autocorrelation(x, lag) - _autocorrelation(s, lag)
+        for lag in ((ph, 0), (0, pw))
+        if all(lag[0] < a.shape[0] and lag[1] < a.shape[1] for a in (x, s))
+    ]
+    if not scores:
+        raise ValueError(
+            f"period {(ph, pw)} must be smaller than the image ({x.shape[1]}x{x.shape[0]}) and "
+            f"the source ({s.shape[1]}x{s.shape[0]}) along at least one axis"
+        )
+    return float(np.mean(scores))
+
+
+def seam_stats(seam, error=None) -> tuple[float, float]:
+    """(criterion, peak): sum and maximum of the error along a seam.
+
+    ``seam`` is an :class:`engine.seams.Seam` (its own figures are returned) or an (N, 2)
+    (row, col) path; with ``error`` the figures are measured on that map instead (e.g. the
+    seam of one metric judged by another).
+    """
+    path = getattr(seam, "path", seam)
+    if error is None:
+        if not hasattr(seam, "criterion"):
+            raise TypeError("seam_stats needs an error map when seam is a plain path")
+        return float(seam.criterion), float(seam.peak)
+    e = as_error_map(error)
+    p = np.asarray(path, dtype=np.intp).reshape(-1, 2)
+    if p.size == 0:
+        raise ValueError("seam has no path pixels")
+    if (p < 0).any() or (p[:, 0] >= e.shape[0]).any() or (p[:, 1] >= e.shape[1]).any():
+        raise ValueError(f"seam path leaves the {e.shape[1]}x{e.shape[0]} error map")
+    v = e[p[:, 0], p[:, 1]]
+    return float(v.sum()), float(v.max())
