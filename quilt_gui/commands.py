@@ -1,0 +1,186 @@
+"""Undo commands: each changes the document (never a widget) through its ``apply_*`` methods.
+
+A drag (slider, rectangle) is one undo step: the view gives every change of one drag the
+same ``merge_id`` and :meth:`QUndoCommand.mergeWith` folds them together.
+"""
+
+from __future__ import annotations
+
+import itertools
+from typing import TYPE_CHECKING
+
+from PySide6.QtGui import QUndoCommand
+
+if TYPE_CHECKING:
+    from quilt_gui.document import CandidateEntry, Document
+
+_merge_ids = itertools.count(1)
+
+
+def new_merge_id() -> int:
+    """A fresh id for one drag gesture (every change of the gesture shares it)."""
+    return next(_merge_ids)
+
+
+class _Mergeable(QUndoCommand):
+    ID = -1
+
+    def __init__(self, text: str, merge_id: int | None) -> None:
+        super().__init__(text)
+        self.merge_id = merge_id
+
+    def id(self) -> int:  # noqa: A003 - Qt API
+        return self.ID if self.merge_id is not None else -1
+
+    def _can_merge(self, other: QUndoCommand) -> bool:
+        return (
+            type(other) is type(self)
+            and self.merge_id is not None
+            and other.merge_id == self.merge_id
+        )
+
+
+class SetParams(_Mergeable):
+    ID = 1
+
+    def __init__(
+        self, doc: Document, values: dict, *, merge_id: int | None = None, text: str | None = None
+    ) -> None:
+        if text is None:
+            text = "Change " + ", ".join(values)
+        super().__init__(text, merge_id)
+        self.doc = doc
+        self.new = dict(values)
+        self.old = {k: doc.params[k] for k in values}
+
+    def redo(self) -> None:
+        self.doc.apply_params(self.new)
+
+    def undo(self) -> None:
+        self.doc.apply_params(self.old)
+
+    def mergeWith(self, other: QUndoCommand) -> bool:  # noqa: N802 - Qt API
+        if not self._can_merge(other) or set(other.new) != set(self.new):
+            return False
+        self.new = dict(other.new)
+        if self.new == self.old:
+            self.setObsolete(True)
+        return True
+
+
+class SetTemplateRect(_Mergeable):
+    ID = 2
+
+    def __init__(
+        self, doc: Document, rect, *, merge_id: int | None = None, text: str = "Move tile rectangle"
+    ) -> None:
+        super().__init__(text, merge_id)
+        self.doc = doc
+        self.new = rect
+        self.old = doc.template_rect
+
+    def redo(self) -> None:
+        self.doc.apply_template_rect(self.new)
+
+    def undo(self) -> None:
+        self.doc.apply_template_rect(self.old)
+
+    def mergeWith(self, other: QUndoCommand) -> bool:  # noqa: N802 - Qt API
+        if not self._can_merge(other):
+            return False
+        self.new = other.new
+        if self.new == self.old:
+            self.setObsolete(True)
+        return True
+
+
+class SetWaypoints(QUndoCommand):
+    def __init__(self, doc: Document, waypoints: dict, text: str) -> None:
+        super().__init__(text)
+        self.doc = doc
+        self.new = {k: list(v) for k, v in waypoints.items()}
+        self.old = {k: list(v) for k, v in doc.waypoints.items()}
+
+    def redo(self) -> None:
+        self.doc.apply_waypoints(self.new)
+
+    def undo(self) -> None:
+        self.doc.apply_waypoints(self.old)
+
+
+class SetPicks(QUndoCommand):
+    def __init__(self, doc: Document, picks: list[int], text: str) -> None:
+        super().__init__(text)
+        self.doc = doc
+        self.new = list(picks)
+        self.old = list(doc.picks)
+
+    def redo(self) -> None:
+        self.doc.apply_picks(self.new)
+
+    def undo(self) -> None:
+        self.doc.apply_picks(self.old)
+
+
+class SetCandidates(QUndoCommand):
+    """All candidates and picks at once (a finished generation).
+
+    ``old`` is the (candidates, picks) before the generation started streamed its
+    entries in; ``already_applied`` skips the first ``redo`` for that case.
+    """
+
+    def __init__(
+        self,
+        doc: Document,
+        entries: list[CandidateEntry],
+        picks: list[int],
+        text: str,
+        *,
+        old=None,
+        already_applied: bool = False,
+    ) -> None:
+        super().__init__(text)
+        self.doc = doc
+        self.new, self.new_picks = list(entries), list(picks)
+        self.old, self.old_picks = (list(doc.candidates), list(doc.picks)) if old is None else old
+        self._skip = already_applied
+
+    def redo(self) -> None:
+        if self._skip:
+            self._skip = False
+            if self.doc.picks != self.new_picks:
+                self.doc.apply_picks(self.new_picks)
+            return
+        self.doc.apply_candidates(self.new, self.new_picks)
+
+    def undo(self) -> None:
+        self.doc.apply_candidates(self.old, self.old_picks)
+
+
+class ReplaceCandidate(QUndoCommand):
+    def __init__(self, doc: Document, index: int, entry: CandidateEntry, text: str) -> None:
+        super().__init__(text)
+        self.doc = doc
+        self.index = index
+        self.new = entry
+        self.old = doc.candidates[index]
+
+    def redo(self) -> None:
+        self.doc.apply_candidate(self.index, self.new)
+
+    def undo(self) -> None:
+        self.doc.apply_candidate(self.index, self.old)
+
+
+class SetLayout(QUndoCommand):
+    def __init__(self, doc: Document, layout, text: str) -> None:
+        super().__init__(text)
+        self.doc = doc
+        self.new = layout
+        self.old = doc.layout
+
+    def redo(self) -> None:
+        self.doc.apply_layout(self.new)
+
+    def undo(self) -> None:
+        self.doc.apply_layout(self.old)

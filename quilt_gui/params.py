@@ -1,0 +1,346 @@
+"""Every user parameter of the editor in one table: type, default, range, label, tooltip.
+
+The parameters panel is built from :data:`PARAMS`; the document stores a flat dict
+``{key: value}``; :func:`engine_options` turns it into the keyword arguments of the
+engine calls. Keeping the table here means a new option is one line, not three widgets.
+"""
+
+from __future__ import annotations
+
+import contextlib
+from dataclasses import dataclass
+from typing import Any
+
+SEAM_METHODS = ("dp", "dijkstra", "minimax", "oscillating", "oscillating-optimal", "resistance")
+METRICS = ("euclid", "ssd", "lab")
+BLENDS = ("none", "feather", "adaptive")
+
+
+@dataclass(frozen=True)
+class Param:
+    key: str
+    default: Any
+    label: str
+    tip: str
+    group: str
+    minimum: float | None = None
+    maximum: float | None = None
+    choices: tuple = ()
+    step: float = 1
+    decimals: int = 2
+
+    @property
+    def kind(self) -> type:
+        return type(self.default)
+
+    def coerce(self, value: Any) -> Any:
+        """``value`` converted to this parameter's type and clamped; ValueError if invalid."""
+        if self.choices:
+            if value not in self.choices:
+                raise ValueError(
+                    f"{self.key} must be one of {', '.join(map(str, self.choices))}, got {value!r}"
+                )
+            return value
+        if isinstance(self.default, bool):
+            return bool(value)
+        v = self.kind(value)
+        if self.minimum is not None:
+            v = max(self.kind(self.minimum), v)
+        if self.maximum is not None:
+            v = min(self.kind(self.maximum), v)
+        return v
+
+
+_P = Param
+PARAMS: tuple[Param, ...] = (
+    # -- template search
+    _P(
+        "tile_min",
+        64,
+        "Tile min",
+        "Smallest tile side the template search may choose (px).",
+        "Template",
+        8,
+        4096,
+    ),
+    _P(
+        "tile_max",
+        192,
+        "Tile max",
+        "Largest tile side the template search may choose (px).",
+        "Template",
+        8,
+        4096,
+    ),
+    _P(
+        "overlap",
+        16,
+        "Overlap w_T",
+        "Width of the border regions R_L/R_R and R_T/R_B that are "
+        "matched and stitched (px). About 1/10 of the tile.",
+        "Template",
+        2,
+        256,
+    ),
+    # -- seam
+    _P(
+        "method",
+        "dp",
+        "Seam method",
+        "How the minimum-error seam through each overlap is found:\n"
+        "dp: dynamic programming, one pixel per row (Efros & Freeman)\n"
+        "dijkstra: shortest path, may wind\n"
+        "minimax: smallest worst error, then sum (Long & Mould)\n"
+        "oscillating: anytime control-point search (Somol & Haindl)\n"
+        "resistance: minimum resistance walk (Bhatia)",
+        "Seam",
+        choices=SEAM_METHODS,
+    ),
+    _P(
+        "metric",
+        "euclid",
+        "Error metric",
+        "Per-pixel error between the overlapping regions.",
+        "Seam",
+        choices=METRICS,
+    ),
+    _P(
+        "o_max",
+        8,
+        "o_max",
+        "Oscillating search: largest block of control points moved at once.",
+        "Seam",
+        1,
+        64,
+    ),
+    _P(
+        "max_run",
+        8,
+        "Max run",
+        "Resistance cut: longest straight run of the walk (px).",
+        "Seam",
+        1,
+        256,
+    ),
+    _P(
+        "blend",
+        "adaptive",
+        "Blending",
+        "After the cut: none (hard cut), feather (fixed width) or "
+        "adaptive (width follows the error along the seam, parameter rho).",
+        "Seam",
+        choices=BLENDS,
+    ),
+    _P(
+        "width",
+        4,
+        "Feather width",
+        "Width of the feather ramp across the seam (px).",
+        "Seam",
+        0,
+        64,
+    ),
+    _P("rho", 3, "rho", "Adaptive blending strength (Somol & Haindl, default 3).", "Seam", 0, 16),
+    # -- candidates
+    _P(
+        "n_candidates",
+        30,
+        "Candidates",
+        "How many variant tiles 'Generate' makes.",
+        "Candidates",
+        1,
+        500,
+    ),
+    _P(
+        "patch_size",
+        0,
+        "Patch size",
+        "Side of the patch stitched into each candidate (px); 0 = the tile size.",
+        "Candidates",
+        0,
+        4096,
+    ),
+    _P(
+        "patch_overlap",
+        0,
+        "Patch ring w_P",
+        "Width of the ring in which the closed patch seam runs (px); 0 = the template overlap.",
+        "Candidates",
+        0,
+        256,
+    ),
+    _P(
+        "margin",
+        2,
+        "Margin",
+        "Outer pixels of every tile that always stay the template's, so all tiles connect (px).",
+        "Candidates",
+        0,
+        32,
+    ),
+    _P(
+        "neighbourhood",
+        5,
+        "Neighbourhood",
+        "Random patch positions are refined within this many pixels.",
+        "Candidates",
+        0,
+        64,
+    ),
+    _P(
+        "seed",
+        1,
+        "Seed",
+        "Random seed of the candidates (same seed, same tiles).",
+        "Candidates",
+        0,
+        2**31 - 1,
+    ),
+    # -- preview
+    _P("preview_rows", 6, "Rows", "Rows of tiles in the preview.", "Preview", 1, 64),
+    _P("preview_cols", 6, "Columns", "Columns of tiles in the preview.", "Preview", 1, 64),
+    _P(
+        "no_equal_neighbours",
+        True,
+        "No equal neighbours",
+        "Never put the same tile next to itself in the preview layout.",
+        "Preview",
+    ),
+    _P(
+        "layout_seed",
+        1,
+        "Layout seed",
+        "Random seed of the preview layout (Re-roll changes it).",
+        "Preview",
+        0,
+        2**31 - 1,
+    ),
+    # -- quilting / transfer
+    _P(
+        "out_width",
+        384,
+        "Output width",
+        "Width of the synthesized texture (px).",
+        "Quilting",
+        16,
+        8192,
+    ),
+    _P(
+        "out_height",
+        384,
+        "Output height",
+        "Height of the synthesized texture (px).",
+        "Quilting",
+        16,
+        8192,
+    ),
+    _P(
+        "block",
+        48,
+        "Block",
+        "Block size B (px): must capture the texture's structures.",
+        "Quilting",
+        4,
+        1024,
+    ),
+    _P(
+        "q_overlap", 0, "Overlap", "Overlap between blocks (px); 0 = block / 6.", "Quilting", 0, 512
+    ),
+    _P(
+        "select",
+        "best",
+        "Selection",
+        "random: any block; best: among blocks within the tolerance "
+        "of the best match (Efros & Freeman); bhatia: random with extension (Bhatia).",
+        "Quilting",
+        choices=("random", "best", "bhatia"),
+    ),
+    _P(
+        "tolerance",
+        0.1,
+        "Tolerance",
+        "Best-match selection: accept blocks whose error is within (1 + tolerance) of the best.",
+        "Quilting",
+        0.0,
+        2.0,
+        step=0.05,
+    ),
+    _P(
+        "q_method",
+        "dp",
+        "Seam method",
+        "Seam method between blocks.",
+        "Quilting",
+        choices=SEAM_METHODS,
+    ),
+    _P(
+        "q_blend",
+        "none",
+        "Blending",
+        "Blending across the block seams.",
+        "Quilting",
+        choices=BLENDS,
+    ),
+    _P(
+        "tileable",
+        False,
+        "Tileable output",
+        "Make the synthesized texture wrap around.",
+        "Quilting",
+    ),
+    _P("q_seed", 1, "Seed", "Random seed of the synthesis.", "Quilting", 0, 2**31 - 1),
+    _P(
+        "alpha",
+        0.5,
+        "Transfer alpha",
+        "Texture transfer: weight of the texture match against the "
+        "target correspondence (the first pass; iterations raise it).",
+        "Transfer",
+        0.0,
+        1.0,
+        step=0.05,
+    ),
+    _P(
+        "iterations",
+        3,
+        "Iterations",
+        "Texture transfer passes, each with a block 2/3 the size.",
+        "Transfer",
+        1,
+        8,
+    ),
+)
+
+BY_KEY: dict[str, Param] = {p.key: p for p in PARAMS}
+GROUPS: tuple[str, ...] = tuple(dict.fromkeys(p.group for p in PARAMS))
+DEFAULTS: dict[str, Any] = {p.key: p.default for p in PARAMS}
+
+#: Parameters whose change invalidates the seamless tile (and everything after it).
+SEAMLESS_KEYS = frozenset(
+    {"overlap", "method", "metric", "o_max", "max_run", "blend", "width", "rho"}
+)
+CANDIDATE_KEYS = frozenset(
+    {"n_candidates", "patch_size", "patch_overlap", "margin", "neighbourhood", "seed"}
+)
+PREVIEW_KEYS = frozenset({"preview_rows", "preview_cols", "no_equal_neighbours", "layout_seed"})
+QUILT_KEYS = frozenset(p.key for p in PARAMS if p.group in ("Quilting", "Transfer"))
+
+
+def coerce_all(values: dict) -> dict:
+    """Defaults updated with every known, valid entry of ``values`` (others are ignored)."""
+    out = dict(DEFAULTS)
+    for k, v in (values or {}).items():
+        if k in BY_KEY:
+            with contextlib.suppress(TypeError, ValueError):
+                out[k] = BY_KEY[k].coerce(v)
+    return out
+
+
+def seam_options(p: dict, *, method_key: str = "method") -> dict:
+    """Options of the seam method ``p[method_key]`` (only those the method takes)."""
+    method = p[method_key]
+    if method.startswith("oscillating"):
+        return {"o_max": p["o_max"]}
+    if method == "resistance":
+        return {"max_run": p["max_run"]}
+    return {}

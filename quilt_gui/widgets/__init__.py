@@ -1,0 +1,1 @@
+"""Widgets of the editor (views subscribe to the document)."""
