@@ -1,0 +1,441 @@
+"""Template tile search: position and size of the tile rectangle (ALGORITHMS.md §1.6).
+
+The tile rectangle ``rect = (x, y, w, h)`` is the tile's *period*: the finished tile is
+``w`` x ``h`` pixels. Its *footprint* in the source extends ``overlap`` (w_T) pixels further
+right and down, ``(x, y, w + overlap, h + overlap)``: the left border region R_L is columns
+``[x, x + w_T)`` and R_R columns ``[x + w, x + w + w_T)`` (both over the footprint's rows);
+R_T / R_B are rows ``[y, y + w_T)`` / ``[y + h, y + h + w_T)``.
+
+The search minimises the mean RGB Euclidean distance between R_L and R_R and between R_T and
+R_B, in the paper's two phases (horizontal: every x and width at once, vertical: every y and
+height with the columns fixed), optionally refined by redoing the horizontal phase on the
+chosen rows until the rectangle is stable (at most three times).
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+from scipy import ndimage
+
+from engine._validate import as_image
+from engine.cancel import Cancelled, is_cancelled
+from engine.errormap import colour_channels
+from engine.events import Progress, Snapshot, drain
+
+__all__ = [
+    "Template",
+    "TemplateUpdate",
+    "default_overlap",
+    "find_template",
+    "iter_find_template",
+    "template_cost",
+]
+
+_CHUNK = 8  # shifts per kernel call between cancel checks / progress events
+
+
+@dataclass(frozen=True, slots=True)
+class TemplateUpdate(Snapshot):
+    """The best tile rectangle so far: ``rect = (x, y, w, h)``, its ``cost`` and phase."""
+
+    rect: tuple[int, int, int, int]
+    cost: float
+    overlap: int
+    phase: str = ""
+
+
+@dataclass(frozen=True, slots=True)
+class Template:
+    """Result of the template search.
+
+    Attributes
+    ----------
+    rect : (x, y, w, h)
+        The tile rectangle in source pixels; the tile is ``w`` x ``h``.
+    overlap : int
+        w_T, the width of the border regions R_L/R_R/R_T/R_B.
+    cost : float
+        Mean of ``cost_horizontal`` and ``cost_vertical``.
+    cost_horizontal, cost_vertical : float
+        Mean RGB Euclidean distance R_L vs R_R and R_T vs R_B.
+    warnings : tuple of str
+        Anything the caller should show the user (clamped range, flat source...).
+    """
+
+    rect: tuple[int, int, int, int]
+    overlap: int
+    cost: float
+    cost_horizontal: float = 0.0
+    cost_vertical: float = 0.0
+    warnings: tuple[str, ...] = ()
+
+    @property
+    def footprint(self) -> tuple[int, int, int, int]:
+        """Source rectangle (x, y, w, h) the seamless tile is made from (rect + overlap)."""
+        x, y, w, h = self.rect
+        return (x, y, w + self.overlap, h + self.overlap)
+
+
+# --------------------------------------------------------------------------- validation
+def as_size(value, name: str) -> tuple[int, int]:
+    """An int ``n`` -> (n, n); a pair ``(h, w)`` of ints -> (h, w); both >= 1."""
+    if isinstance(value, numbers.Integral) and not isinstance(value, bool):
+        pair = (int(value), int(value))
+    elif (
+        isinstance(value, (tuple, list))
+        and len(value) == 2
+        and all(isinstance(v, numbers.Integral) and not isinstance(v, bool) for v in value)
+    ):
+        pair = (int(value[0]), int(value[1]))
+    else:
+        raise TypeError(f"{name} must be an int or an (h, w) pair of ints, got {value!r}")
+    if min(pair) < 1:
+        raise ValueError(f"{name} must be >= 1, got {value!r}")
+    return pair
+
+
+def default_overlap(tile_min, tile_max=None) -> int:
+    """w_T ≈ 1/10 of the expected tile size (the mean of the range), at least 2."""
+    lo = as_size(tile_min, "tile_min")
+    hi = as_size(tile_max if tile_max is not None else tile_min, "tile_max")
+    expected = (lo[0] + lo[1] + hi[0] + hi[1]) / 4.0
+    return max(2, int(round(expected / 10.0)))
+
+
+def _excluded_mask(excluded, shape: tuple[int, int]) -> np.ndarray | None:
+    if excluded is None:
+        return None
+    m = np.asarray(excluded)
+    if m.ndim == 3 and m.shape[2] == 1:
+        m = m[:, :, 0]
+    if m.shape != tuple(shape):
+        raise ValueError(
+            f"excluded must be a (H, W) mask of the source's size {tuple(shape)}, got {m.shape}"
+        )
+    m = m.astype(bool)
+    if m.all():
+        raise ValueError("excluded covers the whole source: no tile can be taken from it")
+    return m if m.any() else None
+
+
+def _resolve_range(shape, tile_min, tile_max, overlap):
+    """Validated ((hmin, wmin), (hmax, wmax), overlap, warnings) for a source of ``shape``."""
+    H, W = shape
+    lo = as_size(tile_min, "tile_min")
+    hi = as_size(tile_max if tile_max is not None else tile_min, "tile_max")
+    if lo[0] > hi[0] or lo[1] > hi[1]:
+        raise ValueError(f"tile_min {lo} must not exceed tile_max {hi} (as (h, w))")
+    if overlap is None:
+        overlap = default_overlap(lo, hi)
+    if isinstance(overlap, bool) or not isinstance(overlap, numbers.Integral):
+        raise TypeError(f"overlap must be an integer, got {overlap!r}")
+    overlap = int(overlap)
+    if overlap < 2:
+        raise ValueError(f"overlap must be >= 2, got {overlap}")
+    if 2 * overlap > min(lo):
+        raise ValueError(
+            f"overlap {overlap} is too wide for tile_min {lo}: it must be at most half the "
+            "smallest tile side"
+        )
+    if lo[0] + overlap > H or lo[1] + overlap > W:
+        raise ValueError(
+            f"the source ({W}x{H}) is smaller than the minimum tile {lo[1]}x{lo[0]} plus the "
+            f"overlap {overlap}: choose a smaller tile_min or a larger source"
+        )
+    notes = []
+    fit = (min(hi[0], H - overlap), min(hi[1], W - overlap))
+    if fit != hi:
+        notes.append(
+            f"tile_max {hi[1]}x{hi[0]} plus overlap {overlap} does not fit the {W}x{H} source; "
+            f"using tile_max {fit[1]}x{fit[0]}"
+        )
+    return lo, fit, overlap, notes
+
+
+def flat_warning(source: np.ndarray) -> str | None:
+    """A warning text when ``source`` is (nearly) a single colour, else None."""
+    if float(np.ptp(source.reshape(-1, source.shape[2]), axis=0).max()) < 1e-6:
+        return (
+            "the source is a single flat colour: every tile (and every candidate) will be "
+            "identical"
+        )
+    return None
+
+
+# --------------------------------------------------------------------------- kernels
+@njit(cache=True, nogil=True)
+def _shift_sums(S, valid, use_valid, r0, r1, shifts, out_sum, out_cnt):  # pragma: no cover
+    """out_sum[k, x] = Σ_y d(S[y, x], S[y, x + shifts[k]]) over rows r0..r1-1 (valid pairs)."""
+    W = S.shape[1]
+    C = S.shape[2]
+    for k in range(shifts.shape[0]):
+        a = shifts[k]
+        for y in range(r0, r1):
+            for x in range(W - a):
+                if use_valid and not (valid[y, x] and valid[y, x + a]):
+                    continue
+                s = 0.0
+                for c in range(C):
+                    d = S[y, x, c] - S[y, x + a, c]
+                    s += d * d
+                out_sum[k, x] += math.sqrt(s)
+                out_cnt[k, x] += 1.0
+
+
+@njit(cache=True, nogil=True)
+def _runs_right(free):  # pragma: no cover
+    """Length of the run of True starting at every pixel and going right."""
+    H, W = free.shape
+    out = np.zeros((H, W), dtype=np.int64)
+    for y in range(H):
+        run = 0
+        for x in range(W - 1, -1, -1):
+            run = run + 1 if free[y, x] else 0
+            out[y, x] = run
+    return out
+
+
+def _runs_1d(free: np.ndarray) -> np.ndarray:
+    return _runs_right(np.ascontiguousarray(free[None, :]))[0]
+
+
+# --------------------------------------------------------------------------- phases
+class _Scan:
+    """One phase over shifts: the cost D(x, a) of every position and shift (means)."""
+
+    def __init__(self, S, valid, rows, shifts, overlap):
+        self.S = S
+        self.valid = valid
+        self.rows = rows
+        self.shifts = np.asarray(shifts, dtype=np.int64)
+        self.overlap = overlap
+        W = S.shape[1]
+        self.sum = np.zeros((self.shifts.size, W), dtype=np.float64)
+        self.cnt = np.zeros((self.shifts.size, W), dtype=np.float64)
+
+    def chunks(self):
+        """Run the kernel chunk by chunk; yields the number of shifts done so far."""
+        use_valid = self.valid is not None
+        valid = self.valid if use_valid else np.ones((1, 1), dtype=np.bool_)
+        for k0 in range(0, self.shifts.size, _CHUNK):
+            k1 = min(k0 + _CHUNK, self.shifts.size)
+            _shift_sums(self.S, valid, use_valid, self.rows[0], self.rows[1],
+                        self.shifts[k0:k1], self.sum[k0:k1], self.cnt[k0:k1])
+            yield k1
+
+    def costs(self, feasible_run: np.ndarray | None) -> np.ndarray:
+        """(K, W) mean cost of the border pair at x with shift shifts[k]; inf where invalid.
+
+        ``feasible_run[x]`` is the widest footprint allowed to start at column x.
+        """
+        K, W = self.sum.shape
+        w = self.overlap
+        cs = np.cumsum(np.pad(self.sum, ((0, 0), (1, 0))), axis=1)
+        cc = np.cumsum(np.pad(self.cnt, ((0, 0), (1, 0))), axis=1)
+        out = np.full((K, W), np.inf)
+        for k, a in enumerate(self.shifts):
+            n = W - int(a) - w + 1  # positions with the whole footprint inside
+            if n <= 0:
+                continue
+            s = cs[k, w : w + n] - cs[k, :n]
+            c = cc[k, w : w + n] - cc[k, :n]
+            with np.errstate(invalid="ignore", divide="ignore"):
+                d = np.where(c > 0, s / np.maximum(c, 1), np.inf)
+            if feasible_run is not None:
+                d = np.where(feasible_run[:n] >= int(a) + w, d, np.inf)
+            out[k, :n] = d
+        return out
+
+
+def _argmin(costs: np.ndarray, shifts: np.ndarray) -> tuple[int, int, float] | None:
+    k = int(np.argmin(costs))
+    kk, x = np.unravel_index(k, costs.shape)
+    c = float(costs[kk, x])
+    if not np.isfinite(c):
+        return None
+    return int(x), int(shifts[kk]), c
+
+
+def _pair_cost(S, valid, rows, x, a, overlap) -> float:
+    """Mean distance of columns [x, x+w_T) and [x+a, x+a+w_T) over ``rows``."""
+    r0, r1 = rows
+    A = S[r0:r1, x : x + overlap].astype(np.float64)
+    B = S[r0:r1, x + a : x + a + overlap].astype(np.float64)
+    d = np.sqrt(((A - B) ** 2).sum(axis=2))
+    if valid is not None:
+        ok = valid[r0:r1, x : x + overlap] & valid[r0:r1, x + a : x + a + overlap]
+        return float(d[ok].mean()) if ok.any() else math.inf
+    return float(d.mean())
+
+
+def _rect_costs(S, valid, rect, overlap) -> tuple[float, float]:
+    x, y, a, b = rect
+    St = np.ascontiguousarray(S[:, x : x + a + overlap].transpose(1, 0, 2))
+    vt = None if valid is None else np.ascontiguousarray(valid[:, x : x + a + overlap].T)
+    ch = _pair_cost(S, valid, (y, y + b + overlap), x, a, overlap)
+    cv = _pair_cost(St, vt, (0, a + overlap), y, b, overlap)
+    return ch, cv
+
+
+# --------------------------------------------------------------------------- API
+def template_cost(source, rect, *, overlap: int, excluded=None) -> tuple[float, float, float]:
+    """Cost of a given (e.g. user-dragged) rectangle: ``(cost, cost_horizontal, cost_vertical)``.
+
+    ``rect = (x, y, w, h)``; its footprint ``(x, y, w + overlap, h + overlap)`` must lie in
+    the source. Excluded pixels are left out of the means.
+    """
+    S = colour_channels(as_image(source, "source"))
+    H, W = S.shape[:2]
+    x, y, a, b = _check_rect(rect, overlap, (H, W))
+    ex = _excluded_mask(excluded, (H, W))
+    ch, cv = _rect_costs(S, None if ex is None else ~ex, (x, y, a, b), overlap)
+    return (ch + cv) / 2.0, ch, cv
+
+
+def _check_rect(rect, overlap, shape) -> tuple[int, int, int, int]:
+    H, W = shape
+    if isinstance(overlap, bool) or not isinstance(overlap, numbers.Integral) or overlap < 1:
+        raise ValueError(f"overlap must be a positive integer, got {overlap!r}")
+    try:
+        x, y, a, b = (int(v) for v in rect)
+    except (TypeError, ValueError):
+        raise TypeError(f"rect must be (x, y, w, h) integers, got {rect!r}") from None
+    if a < 2 * overlap or b < 2 * overlap:
+        raise ValueError(f"rect {rect!r} must be at least 2*overlap = {2 * overlap} px per side")
+    if x < 0 or y < 0 or x + a + overlap > W or y + b + overlap > H:
+        raise ValueError(
+            f"rect {rect!r} plus overlap {overlap} reaches outside the {W}x{H} source "
+            f"(the footprint is (x, y, w + overlap, h + overlap))"
+        )
+    return x, y, a, b
+
+
+def iter_find_template(source, *, tile_min, tile_max=None, overlap=None, excluded=None,
+                       refine: bool = True, cancel=None):
+    """Search the tile rectangle; returns a generator of events whose value is a Template.
+
+    Parameters
+    ----------
+    source : (H, W[, C]) array
+        The source image (any dtype; converted to float32 in [0, 1]).
+    tile_min, tile_max : int or (h, w)
+        Smallest and largest tile size (the tile period, without the overlap). A
+        ``tile_max`` that does not fit the source is clamped with a warning.
+    overlap : int or None
+        w_T; default ≈ 1/10 of the expected tile size (:func:`default_overlap`).
+    excluded : (H, W) bool array or None
+        Source pixels the tile footprint must not contain.
+    refine : bool
+        Redo the horizontal phase on the chosen rows until stable (≤ 3 rounds).
+    cancel : CancelToken or None
+        Once a first rectangle exists the search returns the best so far; before that it
+        raises :class:`engine.cancel.Cancelled`.
+
+    Yields :class:`TemplateUpdate` for every better rectangle and :class:`Progress`.
+    """
+    S = np.ascontiguousarray(colour_channels(as_image(source, "source")))
+    H, W = S.shape[:2]
+    lo, hi, overlap, notes = _resolve_range((H, W), tile_min, tile_max, overlap)
+    ex = _excluded_mask(excluded, (H, W))
+    valid = None if ex is None else ~ex
+    run0 = None
+    if valid is not None:
+        # widest exclusion-free footprint starting at column x over some h_min+w_T rows
+        h0 = lo[0] + overlap
+        runs = _runs_right(valid)
+        mins = ndimage.minimum_filter1d(runs, size=h0, axis=0, mode="constant", cval=0)
+        run0 = mins[h0 // 2 : h0 // 2 + H - h0 + 1].max(axis=0)
+        if run0.max(initial=0) < lo[1] + overlap:
+            raise ValueError(
+                f"no {lo[1]}x{lo[0]} tile (plus overlap {overlap}) fits outside the excluded "
+                "region; paint a smaller exclusion or lower tile_min"
+            )
+    flat = flat_warning(S)
+    if flat:
+        notes.append(flat)
+    for n in notes:
+        warnings.warn(n, stacklevel=2)
+    return _iter_find_template(S, valid, run0, lo, hi, overlap, bool(refine), cancel, tuple(notes))
+
+
+def _iter_find_template(S, valid, run0, lo, hi, overlap, refine, cancel, notes):
+    H, W = S.shape[:2]
+    a_shifts = np.arange(lo[1], hi[1] + 1)
+    b_shifts = np.arange(lo[0], hi[0] + 1)
+    rounds = 4 if refine else 1
+    total = rounds * (a_shifts.size + b_shifts.size)
+    done = 0
+    best: Template | None = None
+
+    def finish():
+        if best is None:
+            raise Cancelled("cancelled before the first tile rectangle was found")
+        return best
+
+    def scan(St, vt, rows, shifts, feasible, what):
+        nonlocal done
+        sc = _Scan(St, vt, rows, shifts, overlap)
+        for k in sc.chunks():
+            yield Progress(done + k, total, f"template: {what}")
+            if is_cancelled(cancel):
+                return None
+        done += shifts.size
+        return _argmin(sc.costs(feasible), shifts)
+
+    rows = (0, H)
+    feasible_h = run0
+    current = None
+    for _round in range(rounds):
+        hx = yield from scan(S, valid, rows, a_shifts, feasible_h, "horizontal phase")
+        if is_cancelled(cancel):
+            return finish()
+        if hx is None:
+            break
+        x, a, _ = hx
+        band = slice(x, x + a + overlap)
+        St = np.ascontiguousarray(S[:, band].transpose(1, 0, 2))
+        vt = None
+        feasible_v = None
+        if valid is not None:
+            vt = np.ascontiguousarray(valid[:, band].T)
+            feasible_v = _runs_1d(valid[:, band].all(axis=1))
+        vy = yield from scan(St, vt, (0, a + overlap), b_shifts, feasible_v, "vertical phase")
+        if is_cancelled(cancel):
+            return finish()
+        if vy is None:
+            break
+        y, b, _ = vy
+        rect = (x, y, a, b)
+        if rect == current:
+            break
+        current = rect
+        ch, cv = _rect_costs(S, valid, rect, overlap)
+        cost = (ch + cv) / 2.0
+        if best is None or cost < best.cost - 1e-12:
+            best = Template(rect=rect, overlap=overlap, cost=cost, cost_horizontal=ch,
+                            cost_vertical=cv, warnings=notes)
+            yield TemplateUpdate(rect=rect, cost=cost, overlap=overlap,
+                                 phase="search" if _round == 0 else "refine")
+        elif _round > 0:
+            break
+        # refinement: the horizontal phase again on the chosen rows
+        rows = (y, y + b + overlap)
+        if valid is not None:
+            feasible_h = _runs_1d(valid[rows[0] : rows[1]].all(axis=0))
+    if best is None:
+        raise ValueError(
+            "no tile rectangle fits the source outside the excluded region for this tile range"
+        )
+    yield Progress(total, total, "template: done")
+    return best
+
+
+def find_template(source, **options) -> Template:
+    """Drain :func:`iter_find_template` and return the :class:`Template`."""
+    return drain(iter_find_template(source, **options))

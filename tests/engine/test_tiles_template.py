@@ -1,0 +1,194 @@
+"""Template search (ALGORITHMS.md §1.6): phases against brute force, periodic oracle, events."""
+
+import warnings
+
+import numpy as np
+import pytest
+
+from engine.cancel import Cancelled, CancelToken
+from engine.events import Progress
+from engine.tiles import (
+    Template,
+    TemplateUpdate,
+    default_overlap,
+    find_template,
+    iter_find_template,
+    template_cost,
+)
+from engine.tiles.template import _argmin, _pair_cost, _Scan
+
+
+def periodic(period=(23, 29), shape=(90, 100), channels=3, seed=0):
+    rng = np.random.default_rng(seed)
+    cell = rng.random((period[0], period[1], channels), dtype=np.float32)
+    reps = (shape[0] // period[0] + 1, shape[1] // period[1] + 1, 1)
+    return np.tile(cell, reps)[: shape[0], : shape[1]]
+
+
+def brute_rect_cost(S, rect, w):
+    x, y, a, b = rect
+    S = S.astype(np.float64)
+    dh = np.sqrt(((S[y : y + b + w, x : x + w] - S[y : y + b + w, x + a : x + a + w]) ** 2).sum(2))
+    dv = np.sqrt(((S[y : y + w, x : x + a + w] - S[y + b : y + b + w, x : x + a + w]) ** 2).sum(2))
+    return (dh.mean() + dv.mean()) / 2
+
+
+@pytest.mark.parametrize("masked", [False, True])
+def test_scan_costs_match_brute_force(masked):
+    rng = np.random.default_rng(1)
+    S = rng.random((20, 40, 3), dtype=np.float32)
+    valid = rng.random((20, 40)) > 0.2 if masked else None
+    shifts = np.arange(8, 15)
+    w = 4
+    sc = _Scan(S, valid, (3, 17), shifts, w)
+    for _ in sc.chunks():
+        pass
+    costs = sc.costs(None)
+    for k, a in enumerate(shifts):
+        for x in range(40):
+            if x + a + w > 40:
+                assert costs[k, x] == np.inf
+                continue
+            want = _pair_cost(S, valid, (3, 17), x, int(a), w)
+            assert costs[k, x] == pytest.approx(want, rel=1e-6, abs=1e-9)
+    x, a, c = _argmin(costs, shifts)
+    assert c == pytest.approx(np.nanmin(costs))
+
+
+@pytest.mark.parametrize("dtype", [np.uint8, np.float32, np.float64])
+def test_periodic_source_finds_its_period(dtype):
+    S = periodic()
+    src = (S * 255).round().astype(np.uint8) if dtype == np.uint8 else S.astype(dtype)
+    before = src.copy()
+    t = find_template(src, tile_min=(18, 20), tile_max=(30, 34), overlap=4)
+    assert isinstance(t, Template)
+    x, y, w, h = t.rect
+    assert (h, w) == (23, 29)
+    assert t.cost == pytest.approx(0, abs=1e-6)
+    assert t.footprint == (x, y, w + 4, h + 4)
+    np.testing.assert_array_equal(src, before)
+
+
+def test_gray_source_and_reported_costs():
+    S = periodic(channels=1)[:, :, 0] * 0.5 + np.linspace(0, 0.3, 100)[None, :]
+    t = find_template(S, tile_min=20, tile_max=32, overlap=4)
+    cost, ch, cv = template_cost(S, t.rect, overlap=4)
+    assert cost == pytest.approx(t.cost)
+    assert (ch, cv) == pytest.approx((t.cost_horizontal, t.cost_vertical))
+    assert cost == pytest.approx(brute_rect_cost(S[:, :, None], t.rect, 4), rel=1e-6)
+
+
+def test_refine_never_worse_and_two_phase_near_brute_force():
+    rng = np.random.default_rng(3)
+    # smooth random field: costs vary smoothly, so a global brute force is meaningful
+    from scipy import ndimage
+
+    S = ndimage.gaussian_filter(rng.random((48, 52, 3)), (3, 3, 0)).astype(np.float32)
+    w = 3
+    coarse = find_template(S, tile_min=16, tile_max=22, overlap=w, refine=False)
+    fine = find_template(S, tile_min=16, tile_max=22, overlap=w, refine=True)
+    assert fine.cost <= coarse.cost + 1e-12
+    best = min(
+        brute_rect_cost(S, (x, y, a, b), w)
+        for a in range(16, 23)
+        for b in range(16, 23)
+        for x in range(0, 52 - a - w + 1, 2)
+        for y in range(0, 48 - b - w + 1, 2)
+    )
+    # two independent phases are a heuristic: within 2x of the (sub-sampled) global optimum
+    assert fine.cost <= 2.0 * best
+
+
+def test_stream_improves_and_ends_with_result():
+    S = periodic(shape=(80, 90))
+    gen = iter_find_template(S, tile_min=18, tile_max=30, overlap=3)
+    events = []
+    while True:
+        try:
+            events.append(next(gen))
+        except StopIteration as stop:
+            result = stop.value
+            break
+    ups = [e for e in events if isinstance(e, TemplateUpdate)]
+    assert ups and all(isinstance(e, (TemplateUpdate, Progress)) for e in events)
+    costs = [u.cost for u in ups]
+    assert costs == sorted(costs, reverse=True) and len(set(costs)) == len(costs)
+    assert ups[-1].rect == result.rect and ups[-1].cost == result.cost
+    prog = [e for e in events if isinstance(e, Progress)]
+    assert prog[-1].fraction == 1.0
+
+
+def test_excluded_region_is_avoided():
+    S = periodic(shape=(90, 100))
+    free = find_template(S, tile_min=20, tile_max=30, overlap=4)
+    ex = np.zeros(S.shape[:2], bool)
+    x, y, w, h = free.footprint
+    ex[y + h // 2, x + w // 2] = True  # one pixel in the middle of the best footprint
+    t = find_template(S, tile_min=20, tile_max=30, overlap=4, excluded=ex)
+    x, y, w, h = t.footprint
+    assert not ex[y : y + h, x : x + w].any()
+    assert t.rect[2:] == (29, 23)  # the period is still found elsewhere
+
+
+def test_cancel_before_and_after_first_rectangle():
+    S = periodic(shape=(80, 90))
+    token = CancelToken()
+    token.cancel()
+    with pytest.raises(Cancelled):
+        find_template(S, tile_min=18, tile_max=30, overlap=3, cancel=token)
+    token = CancelToken()
+    gen = iter_find_template(S, tile_min=18, tile_max=30, overlap=3, cancel=token)
+    first = None
+    while True:
+        try:
+            ev = next(gen)
+        except StopIteration as stop:
+            result = stop.value
+            break
+        if isinstance(ev, TemplateUpdate) and first is None:
+            first = ev
+            token.cancel()
+    assert result.rect == first.rect
+
+
+def test_bad_input_messages():
+    S = periodic(shape=(60, 70))
+    with pytest.raises(ValueError, match="smaller than the minimum tile"):
+        find_template(S, tile_min=64, tile_max=80, overlap=4)
+    with pytest.raises(ValueError, match="must not exceed tile_max"):
+        find_template(S, tile_min=30, tile_max=20, overlap=4)
+    with pytest.raises(ValueError, match="overlap"):
+        find_template(S, tile_min=10, tile_max=20, overlap=6)
+    with pytest.raises(TypeError, match="tile_min"):
+        find_template(S, tile_min="big", overlap=4)
+    with pytest.raises(ValueError, match="whole source"):
+        find_template(S, tile_min=20, overlap=4, excluded=np.ones((60, 70), bool))
+    ex = np.zeros((60, 70), bool)
+    ex[:, ::20] = True  # stripes: no 24-px-wide footprint is free
+    with pytest.raises(ValueError, match="excluded"):
+        find_template(S, tile_min=20, overlap=4, excluded=ex)
+    with pytest.raises(ValueError, match="excluded must be"):
+        find_template(S, tile_min=20, overlap=4, excluded=np.zeros((5, 5), bool))
+    with pytest.warns(UserWarning, match="does not fit"):
+        t = find_template(S, tile_min=20, tile_max=100, overlap=4)
+    assert t.rect[2] + 4 <= 70 and t.rect[3] + 4 <= 60
+    assert any("does not fit" in w for w in t.warnings)
+    with pytest.raises(ValueError, match="outside"):
+        template_cost(S, (50, 0, 20, 20), overlap=4)
+
+
+def test_flat_source_warns_and_still_works():
+    S = np.full((60, 60, 3), 0.4, np.float32)
+    with pytest.warns(UserWarning, match="flat"):
+        t = find_template(S, tile_min=20, tile_max=30, overlap=4)
+    assert t.cost == 0.0 and t.warnings
+
+
+def test_default_overlap_is_a_tenth_of_the_tile():
+    assert default_overlap(256) == 26
+    assert default_overlap(200, 300) == 25
+    assert default_overlap((10, 12)) == 2
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        t = find_template(periodic(), tile_min=20, tile_max=30)
+    assert t.overlap == 2 or t.overlap == default_overlap(20, 30)
