@@ -1,0 +1,458 @@
+"""Mutually connectable candidate tiles (ALGORITHMS.md §1.5, §1.8).
+
+Each candidate is the seamless template with one patch from another source position stitched
+in along a closed minimum-error path whose four corner points are pinned and which never
+enters the outer ``margin`` pixels, so every candidate keeps the template's border exactly and
+connects to every other. Per candidate ``k``:
+
+1. a source position ``s0`` uniform over the valid positions (outside ``excluded``);
+2. refined to ``s*`` = argmin over ``s0 + [-n, n]^2`` of the mean error between the source
+   window and the template over the ring band (offsets ``margin .. patch_overlap - 1``);
+3. :func:`engine.stitch.patch_cut` gives the closed cut; :func:`engine.materials.apply_cut`
+   applies it to every map.
+
+Candidates are independent: they run on a thread pool (``workers``) and are yielded as they
+finish (each carries its ``index``); the returned list is in index order. Candidate ``k`` is
+seeded from ``(seed, k)`` only, so the same seed gives identical tiles whatever the worker
+count or the number of candidates asked for.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+import warnings
+from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
+from dataclasses import dataclass, field
+
+import numpy as np
+from numba import njit
+
+from engine._validate import as_image, choice, positive_int
+from engine.cancel import Cancelled, CancelToken, check, is_cancelled
+from engine.errormap import METRICS, colour_channels
+from engine.events import Item, Progress, drain, frozen_array
+from engine.exclusion import valid_anchors
+from engine.materials import apply_cut
+from engine.seams import METHODS
+from engine.stitch import BLEND_MODES, patch_cut
+from engine.tiles.seamless import MAIN, SeamlessTile, as_maps, check_weights, seam_error
+from engine.tiles.template import _excluded_mask, as_size, flat_warning
+
+__all__ = ["CandidateTile", "candidate_seed", "candidates", "iter_candidates", "make_candidate"]
+
+
+@dataclass(frozen=True, slots=True)
+class CandidateTile(Item):
+    """One finished candidate tile.
+
+    Attributes
+    ----------
+    index : int
+        Its slot (0 .. n-1).
+    tile : (h, w, C) float32
+        The template with the patch stitched in.
+    maps : dict
+        The same candidate for every extra material map.
+    patch_rect : (x, y, w, h)
+        Where the patch comes from in the source.
+    patch_origin : (row, col)
+        Its top-left corner (what :func:`make_candidate` takes back).
+    target_rect : (x, y, w, h)
+        Where the patch window lies in the tile.
+    loop : (N, 2) int
+        The closed cut path (row, col) in tile coordinates.
+    mask, alpha : (h, w)
+        True / weight where the tile shows the patch.
+    scores : dict
+        ``criterion`` and ``peak`` (sum and max of the error on the loop), ``band_error``
+        (mean ring error of the chosen position), ``changed`` (share of tile pixels that
+        differ from the template), ``coverage`` (share inside the loop).
+    seed : int or None
+        The candidate's own seed (``None`` for a user-placed patch).
+    """
+
+    index: int
+    tile: np.ndarray
+    maps: dict
+    patch_rect: tuple[int, int, int, int]
+    patch_origin: tuple[int, int]
+    target_rect: tuple[int, int, int, int]
+    loop: np.ndarray
+    mask: np.ndarray
+    alpha: np.ndarray
+    scores: dict = field(default_factory=dict)
+    seed: int | None = None
+
+
+# --------------------------------------------------------------------------- seeds
+def candidate_seed(base: int, index: int) -> int:
+    """The seed of candidate ``index`` in a run seeded with ``base`` (63-bit int)."""
+    state = np.random.SeedSequence([int(base), int(index)]).generate_state(1, np.uint64)[0]
+    return int(state) & (2**63 - 1)
+
+
+def _base_seed(rng) -> int:
+    if isinstance(rng, numbers.Integral) and not isinstance(rng, bool):
+        if rng < 0:
+            raise ValueError(f"rng must be a non-negative seed, got {rng}")
+        return int(rng)
+    if rng is None or isinstance(rng, np.random.Generator):
+        gen = rng if rng is not None else np.random.default_rng()
+        return int(gen.integers(2**63))
+    raise TypeError(f"rng must be an int, a numpy Generator or None, got {type(rng).__name__}")
+
+
+# --------------------------------------------------------------------------- kernels
+@njit(cache=True, nogil=True)
+def _band_costs(S, U, rr, cc, y0, x0, out):  # pragma: no cover
+    """out[i, j] = mean over the band pixels of d(S[y0+i+r, x0+j+c], U[r, c])."""
+    ny, nx = out.shape
+    C = U.shape[2]
+    n = rr.shape[0]
+    for i in range(ny):
+        for j in range(nx):
+            s = 0.0
+            for k in range(n):
+                r = rr[k]
+                c = cc[k]
+                t = 0.0
+                for ch in range(C):
+                    d = S[y0 + i + r, x0 + j + c, ch] - U[r, c, ch]
+                    t += d * d
+                s += math.sqrt(t)
+            out[i, j] = s / n
+
+
+class _AnyCancel:
+    """Cancelled when any of the tokens is (duck-types :class:`CancelToken`)."""
+
+    __slots__ = ("tokens",)
+
+    def __init__(self, *tokens):
+        self.tokens = tuple(t for t in tokens if t is not None)
+
+    @property
+    def cancelled(self) -> bool:
+        return any(t.cancelled for t in self.tokens)
+
+    def raise_if_cancelled(self) -> None:
+        if self.cancelled:
+            raise Cancelled("cancelled")
+
+
+# --------------------------------------------------------------------------- setup
+class _Setup:
+    """Validated inputs shared by every candidate of one run."""
+
+    def __init__(self, source, template, *, patch_size, patch_overlap, margin, neighbourhood,
+                 method, metric, blend, width, rho, excluded, maps, weights, seam_options):
+        if not isinstance(template, SeamlessTile):
+            raise TypeError(
+                f"template must be a SeamlessTile (from make_seamless), got {type(template).__name__}"
+            )
+        self.S = as_image(source, "source")
+        H, W = self.S.shape[:2]
+        self.T = template
+        th, tw = template.tile.shape[:2]
+        if self.S.shape[2] != template.tile.shape[2]:
+            raise ValueError(
+                f"source has {self.S.shape[2]} channels, the template tile "
+                f"{template.tile.shape[2]}: use the source the template was made from"
+            )
+        self.ring = positive_int(
+            template.overlap if patch_overlap is None else patch_overlap, "patch_overlap",
+            minimum=2)
+        self.margin = positive_int(margin, "margin", minimum=0)
+        if self.margin >= self.ring:
+            raise ValueError(
+                f"margin must be smaller than patch_overlap, got margin={self.margin}, "
+                f"patch_overlap={self.ring}"
+            )
+        ph, pw = (th, tw) if patch_size is None else as_size(patch_size, "patch_size")
+        if ph > th or pw > tw:
+            raise ValueError(f"patch_size {(ph, pw)} must not exceed the tile size {(th, tw)}")
+        if ph > H or pw > W:
+            raise ValueError(f"patch_size {(ph, pw)} does not fit the {W}x{H} source")
+        if min(ph, pw) < 3 * self.ring:
+            raise ValueError(
+                f"patch_size {(ph, pw)} must be at least 3 * patch_overlap = {3 * self.ring} px "
+                "per side"
+            )
+        self.ph, self.pw = ph, pw
+        self.ty, self.tx = (th - ph) // 2, (tw - pw) // 2
+        self.n = positive_int(neighbourhood, "neighbourhood", minimum=0)
+        choice(blend, "blend", BLEND_MODES)
+        choice(method, "method", METHODS)
+        choice(metric, "metric", METRICS)
+        self.opts = dict(method=method, metric=metric, blend=blend, width=positive_int(
+            width, "width", minimum=0), rho=positive_int(rho, "rho", minimum=0), **seam_options)
+        self.metric = metric
+        extra = as_maps(maps, (H, W))
+        if set(extra) != set(template.maps):
+            raise ValueError(
+                f"maps {sorted(extra)} must be the material maps the template was made with "
+                f"{sorted(template.maps)}"
+            )
+        self.weights = check_weights(weights, extra)
+        self.stack = {MAIN: self.S, **extra}
+        tmaps = {MAIN: np.asarray(template.tile), **{k: np.asarray(v) for k, v in
+                                                      template.maps.items()}}
+        self.tmaps = tmaps
+        win = (slice(self.ty, self.ty + ph), slice(self.tx, self.tx + pw))
+        self.U = {k: v[win] for k, v in tmaps.items()}
+        ex = _excluded_mask(excluded, (H, W))
+        self.valid = None if ex is None else valid_anchors(ex, (ph, pw))
+        if self.valid is not None and not self.valid.any():
+            raise ValueError(
+                f"no {pw}x{ph} patch fits outside the excluded region: paint a smaller "
+                "exclusion or use a smaller patch_size"
+            )
+        self.notes = []
+        flat = flat_warning(self.S)
+        if flat:
+            self.notes.append(flat)
+        # ring band for the position refinement (offsets margin .. ring-1)
+        r, c = np.mgrid[0:ph, 0:pw]
+        d = np.minimum.reduce([r, c, ph - 1 - r, pw - 1 - c])
+        band = (d >= self.margin) & (d < self.ring)
+        self.rr = np.ascontiguousarray(r[band], dtype=np.int64)
+        self.cc = np.ascontiguousarray(c[band], dtype=np.int64)
+        self.Sc = np.ascontiguousarray(colour_channels(self.S))
+        self.Uc = np.ascontiguousarray(colour_channels(self.U[MAIN]))
+
+    def parameters(self) -> dict:
+        p = {k: v for k, v in self.opts.items() if isinstance(v, (int, float, str, bool))}
+        p.update(patch_size=[self.ph, self.pw], patch_overlap=self.ring, margin=self.margin,
+                 neighbourhood=self.n)
+        return p
+
+    # ---- positions
+    def random_origin(self, gen: np.random.Generator) -> tuple[int, int]:
+        H, W = self.S.shape[:2]
+        if self.valid is None:
+            return int(gen.integers(0, H - self.ph + 1)), int(gen.integers(0, W - self.pw + 1))
+        flat = np.flatnonzero(self.valid)
+        k = int(flat[int(gen.integers(0, flat.size))])
+        return divmod(k, self.valid.shape[1])
+
+    def refine(self, origin, n: int) -> tuple[tuple[int, int], float]:
+        """Best position in origin + [-n, n]^2 by the mean ring-band error."""
+        H, W = self.S.shape[:2]
+        y0, x0 = origin
+        ylo, yhi = max(0, y0 - n), min(H - self.ph, y0 + n)
+        xlo, xhi = max(0, x0 - n), min(W - self.pw, x0 + n)
+        out = np.empty((yhi - ylo + 1, xhi - xlo + 1), dtype=np.float64)
+        _band_costs(self.Sc, self.Uc, self.rr, self.cc, ylo, xlo, out)
+        if self.valid is not None:
+            out[~self.valid[ylo : yhi + 1, xlo : xhi + 1]] = np.inf
+        if not np.isfinite(out).any():  # the given origin itself must be valid
+            raise ValueError(f"patch_origin {origin} lies on the excluded region")
+        # ties -> the position nearest the drawn one (stable for flat sources)
+        yy, xx = np.mgrid[ylo : yhi + 1, xlo : xhi + 1]
+        order = np.lexsort(((np.abs(yy - y0) + np.abs(xx - x0)).ravel(), out.ravel()))
+        k = int(order[0])
+        return (int(yy.ravel()[k]), int(xx.ravel()[k])), float(out.ravel()[k])
+
+    # ---- one candidate
+    def make(self, index: int, seed: int | None, origin, n: int, cancel) -> CandidateTile:
+        check(cancel)
+        if origin is None:
+            origin = self.random_origin(np.random.default_rng(seed))
+        (sy, sx), band_error = self.refine(origin, n)
+        check(cancel)
+        win = (slice(sy, sy + self.ph), slice(sx, sx + self.pw))
+        Q = {k: v[win] for k, v in self.stack.items()}
+        err = seam_error(Q, self.U, self.weights, self.metric)
+        cut = patch_cut(Q[MAIN], self.U[MAIN], ring=self.ring, margin=self.margin, error=err,
+                        cancel=cancel, **self.opts)
+        check(cancel)
+        out = apply_cut(Q, self.U, cut.alpha)
+        ty, tx, ph, pw = self.ty, self.tx, self.ph, self.pw
+        tiles = {}
+        for k, v in self.tmaps.items():
+            t = v.copy()
+            t[ty : ty + ph, tx : tx + pw] = out[k]
+            tiles[k] = t
+        tile = tiles[MAIN]
+        m = self.margin
+        if m and not _ring_equal(tile, self.tmaps[MAIN], m):  # pragma: no cover - invariant
+            raise RuntimeError("a candidate changed the template's outer margin")
+        th, tw = tile.shape[:2]
+        mask = np.zeros((th, tw), dtype=bool)
+        mask[ty : ty + ph, tx : tx + pw] = cut.mask
+        alpha = np.zeros((th, tw), dtype=np.float32)
+        alpha[ty : ty + ph, tx : tx + pw] = cut.alpha
+        changed = float(np.any(tile != self.tmaps[MAIN], axis=2).mean())
+        scores = {
+            "criterion": float(cut.criterion),
+            "peak": float(cut.peak),
+            "band_error": band_error,
+            "changed": changed,
+            "coverage": float(mask.mean()),
+        }
+        fr = frozen_array
+        return CandidateTile(
+            index=int(index),
+            tile=fr(tile),
+            maps={k: fr(v) for k, v in tiles.items() if k != MAIN},
+            patch_rect=(sx, sy, pw, ph),
+            patch_origin=(sy, sx),
+            target_rect=(tx, ty, pw, ph),
+            loop=fr(np.asarray(cut.loop) + (ty, tx)),
+            mask=fr(mask),
+            alpha=fr(alpha),
+            scores=scores,
+            seed=seed,
+        )
+
+
+def _ring_equal(a: np.ndarray, b: np.ndarray, m: int) -> bool:
+    return bool(
+        np.array_equal(a[:m], b[:m])
+        and np.array_equal(a[-m:], b[-m:])
+        and np.array_equal(a[:, :m], b[:, :m])
+        and np.array_equal(a[:, -m:], b[:, -m:])
+    )
+
+
+# --------------------------------------------------------------------------- API
+def iter_candidates(source, template: SeamlessTile, n: int = 30, *, patch_size=None,
+                    patch_overlap=None, margin: int = 2, neighbourhood: int = 5,
+                    method: str = "dp", metric: str = "euclid", blend: str = "adaptive",
+                    width: int = 4, rho: int = 3, excluded=None, maps=None, weights=None,
+                    rng=None, workers: int = 2, cancel=None, **seam_options):
+    """Stream ``n`` connectable variants of ``template``; the generator's value is their list.
+
+    Parameters
+    ----------
+    source : (H, W[, C]) array
+        The source the template was made from.
+    template : SeamlessTile
+    n : int
+        Number of candidates.
+    patch_size : int or (h, w) or None
+        Patch window size (default: the tile size); centred in the tile.
+    patch_overlap : int or None
+        w_P, the ring in which the closed cut runs (default: the template's w_T).
+    margin : int
+        Outer pixels that always stay the template (default 2).
+    neighbourhood : int
+        n of the position refinement (search s0 + [-n, n]^2).
+    method, metric, blend, width, rho, **seam_options
+        Seam method, error metric, blending of the cut (see :mod:`engine.stitch`).
+    excluded : (H, W) bool or None
+        Source pixels no patch may contain.
+    maps, weights
+        The template's material maps (same names) and the seam error weights.
+    rng : int, Generator or None
+        The run's seed; candidate k uses :func:`candidate_seed` (seed, k).
+    workers : int
+        Threads (1 runs in the calling thread).
+    cancel : CancelToken or None
+        Stops the run; the candidates already finished are kept and returned.
+
+    Yields :class:`CandidateTile` items as they finish (any order; each has its ``index``)
+    and :class:`Progress`.
+    """
+    setup = _Setup(source, template, patch_size=patch_size, patch_overlap=patch_overlap,
+                   margin=margin, neighbourhood=neighbourhood, method=method, metric=metric,
+                   blend=blend, width=width, rho=rho, excluded=excluded, maps=maps,
+                   weights=weights, seam_options=seam_options)
+    n = positive_int(n, "n")
+    workers = positive_int(workers, "workers")
+    base = _base_seed(rng)
+    for note in setup.notes:
+        warnings.warn(note, stacklevel=2)
+    return _iter_candidates(setup, n, base, workers, cancel)
+
+
+def _iter_candidates(setup: _Setup, n: int, base: int, workers: int, cancel):
+    seeds = [candidate_seed(base, k) for k in range(n)]
+    made: dict[int, CandidateTile] = {}
+    yield Progress(0, n, "candidates")
+    if workers == 1:
+        for k in range(n):
+            if is_cancelled(cancel):
+                break
+            try:
+                c = setup.make(k, seeds[k], None, setup.n, cancel)
+            except Cancelled:
+                break
+            made[k] = c
+            yield c
+            yield Progress(len(made), n, f"candidate {k}")
+    else:
+        stop = CancelToken()
+        token = _AnyCancel(cancel, stop)
+        pool = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="candidates")
+        try:
+            pending = {pool.submit(setup.make, k, seeds[k], None, setup.n, token): k
+                       for k in range(n)}
+            while pending:
+                finished, _ = wait(pending, return_when=FIRST_COMPLETED)
+                for fut in sorted(finished, key=pending.get):
+                    k = pending.pop(fut)
+                    if fut.cancelled():
+                        continue
+                    try:
+                        c = fut.result()
+                    except Cancelled:
+                        continue
+                    made[k] = c
+                    yield c
+                    yield Progress(len(made), n, f"candidate {k}")
+                if is_cancelled(cancel):
+                    for fut in pending:
+                        fut.cancel()
+        finally:
+            stop.cancel()
+            pool.shutdown(wait=True, cancel_futures=True)
+    if len(made) < n:
+        yield Progress(len(made), n, "candidates: cancelled")
+    return [made[k] for k in sorted(made)]
+
+
+def candidates(source, template: SeamlessTile, n: int = 30, **options) -> list[CandidateTile]:
+    """Drain :func:`iter_candidates` and return the candidates in index order."""
+    return drain(iter_candidates(source, template, n, **options))
+
+
+def make_candidate(source, template: SeamlessTile, *, patch_origin=None, index: int = 0,
+                   seed: int | None = None, rng=None, neighbourhood: int | None = None,
+                   patch_size=None, patch_overlap=None, margin: int = 2, method: str = "dp",
+                   metric: str = "euclid", blend: str = "adaptive", width: int = 4,
+                   rho: int = 3, excluded=None, maps=None, weights=None, cancel=None,
+                   **seam_options) -> CandidateTile:
+    """Make one candidate: from a user-given ``patch_origin`` (row, col) or from a seed.
+
+    With ``patch_origin`` the patch is taken exactly there (``neighbourhood`` defaults to 0;
+    give one to let the position settle nearby). Without it the position is drawn from
+    ``seed`` (a candidate's own seed, to rebuild it) or, if that is None too, from ``rng``
+    (a re-roll). Raises :class:`engine.cancel.Cancelled` when cancelled.
+    """
+    setup = _Setup(source, template, patch_size=patch_size, patch_overlap=patch_overlap,
+                   margin=margin, neighbourhood=0 if neighbourhood is None else neighbourhood,
+                   method=method, metric=metric, blend=blend, width=width, rho=rho,
+                   excluded=excluded, maps=maps, weights=weights, seam_options=seam_options)
+    if isinstance(index, bool) or not isinstance(index, numbers.Integral) or index < 0:
+        raise ValueError(f"index must be a non-negative integer, got {index!r}")
+    origin = None
+    if patch_origin is not None:
+        try:
+            origin = (int(patch_origin[0]), int(patch_origin[1]))
+        except (TypeError, ValueError, IndexError):
+            raise TypeError(f"patch_origin must be (row, col), got {patch_origin!r}") from None
+        H, W = setup.S.shape[:2]
+        if not (0 <= origin[0] <= H - setup.ph and 0 <= origin[1] <= W - setup.pw):
+            raise ValueError(
+                f"patch_origin {origin} puts the {setup.pw}x{setup.ph} patch outside the "
+                f"{W}x{H} source"
+            )
+        n = setup.n
+        seed = None
+    else:
+        if seed is None:
+            seed = candidate_seed(_base_seed(rng), index)
+        n = 5 if neighbourhood is None else setup.n
+    return setup.make(index, seed, origin, n, cancel)

@@ -1,0 +1,369 @@
+"""Seamless tile from a template rectangle (ALGORITHMS.md §1.7).
+
+R_R is stitched over R_L (the tile's left edge then continues its own last column) and R_B
+over R_T (its top edge continues its last row). The second path is cyclic: its first and last
+control points (tile columns 0 and w-1, neighbours across the wrap) are equal, so the wrap
+has no corner seam. Every cut keeps the tile's own outer column/row from R1 (R_R, R_B) and the
+innermost overlap column/row from R2 (R_L, R_T), so the tile wraps and the stitched strips
+join the interior without a step.
+
+Material maps (normal, roughness...) follow the same cuts: the seam is searched on
+:func:`engine.materials.material_error` and applied with :func:`engine.materials.apply_cut`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from engine._validate import as_image, choice, positive_int
+from engine.cancel import check
+from engine.events import Progress, Snapshot, drain, frozen_array
+from engine.materials import apply_cut, material_error
+from engine.blend import BLEND_MODES, blend_weights
+from engine.seams import CYCLIC_METHODS, Seam, SeamUpdate, iter_find_seam
+from engine.tiles.template import Template, _check_rect, flat_warning
+
+__all__ = [
+    "MAIN",
+    "SeamlessTile",
+    "SeamlessUpdate",
+    "iter_make_seamless",
+    "make_seamless",
+]
+
+MAIN = "main"  # the key of the source itself in ``weights``
+OVERLAPS = ("horizontal", "vertical")
+
+
+@dataclass(frozen=True, slots=True)
+class SeamlessUpdate(Snapshot):
+    """The best seam so far in one overlap (``which``: "horizontal" or "vertical").
+
+    ``seam`` is canonical (rows run along the seam); ``path`` is (row, col) in the overlap
+    region as drawn (R_L frame: (h + w_T) x w_T; R_T frame: w_T x w); ``path_source`` in
+    source pixels. ``final`` marks the last update of that overlap.
+    """
+
+    which: str
+    seam: Seam
+    path: np.ndarray
+    path_source: np.ndarray
+    final: bool = False
+
+
+@dataclass(frozen=True)
+class SeamlessTile:
+    """A seamless tile and everything the editor draws about it.
+
+    Attributes
+    ----------
+    tile : (h, w, C) float32
+        The seamless tile (wraps left-right and top-bottom).
+    rect : (x, y, w, h)
+        Tile rectangle in the source; ``overlap`` is w_T.
+    regions : dict
+        ``R_L``, ``R_R`` ((h + w_T) x w_T, from the source) and ``R_T``, ``R_B``
+        (w_T x w, taken after the horizontal stitch).
+    region_rects : dict
+        Their rectangles (x, y, w, h) in source pixels.
+    errors : dict
+        ``"horizontal"``: error map of R_R vs R_L, ``"vertical"``: R_B vs R_T (as drawn).
+    seams : dict
+        The canonical :class:`engine.seams.Seam` of each overlap.
+    paths, paths_tile, paths_source : dict
+        Seam pixels (row, col) in the region as drawn, in the tile, and in the source.
+    alphas : dict
+        Weight of R1 (R_R, R_B) over each overlap region as drawn.
+    maps : dict
+        The same tile for every material map (same cuts).
+    criterion, peak : dict
+        Per overlap: sum and maximum of the error along the seam.
+    warnings : tuple of str
+    """
+
+    tile: np.ndarray
+    rect: tuple[int, int, int, int]
+    overlap: int
+    regions: dict
+    region_rects: dict
+    errors: dict
+    seams: dict
+    paths: dict
+    paths_tile: dict
+    paths_source: dict
+    alphas: dict
+    maps: dict = field(default_factory=dict)
+    criterion: dict = field(default_factory=dict)
+    peak: dict = field(default_factory=dict)
+    parameters: dict = field(default_factory=dict)
+    warnings: tuple[str, ...] = ()
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return self.tile.shape[:2]
+
+
+# --------------------------------------------------------------------------- helpers
+def as_maps(maps, shape: tuple[int, int], name: str = "maps") -> dict[str, np.ndarray]:
+    """Validate extra material maps: {name: image of the source's height and width}."""
+    if maps is None:
+        return {}
+    if not isinstance(maps, Mapping):
+        raise TypeError(f"{name} must be a mapping of map name -> image, got {type(maps).__name__}")
+    out = {}
+    for key, img in maps.items():
+        if not isinstance(key, str) or not key or key == MAIN:
+            raise ValueError(f"{name}: bad map name {key!r} ({MAIN!r} is the source itself)")
+        a = as_image(img, f"{name}[{key!r}]")
+        if a.shape[:2] != tuple(shape):
+            raise ValueError(
+                f"{name}[{key!r}] is {a.shape[1]}x{a.shape[0]}, the source is "
+                f"{shape[1]}x{shape[0]}; material maps must be co-registered (same size)"
+            )
+        out[key] = a
+    return out
+
+
+def check_weights(weights, names) -> dict | None:
+    if weights is None:
+        return None
+    if not isinstance(weights, Mapping):
+        raise TypeError(f"weights must be a mapping of map name -> weight, got {weights!r}")
+    for k in weights:
+        if k != MAIN and k not in names:
+            raise ValueError(f"weights names an unknown map {k!r} (use {MAIN!r} for the source)")
+    return dict(weights)
+
+
+def seam_error(stack_r1: dict, stack_r2: dict, weights, metric: str) -> np.ndarray:
+    """Error map of a (weighted) material; the source alone when ``weights`` is None."""
+    return np.asarray(
+        material_error(stack_r1, stack_r2, weights=weights, main=MAIN, metric=metric),
+        dtype=np.float64,
+    )
+
+
+def iter_seam(error, *, method, cyclic=False, waypoints=(), cancel=None, **options):
+    """Stream the :class:`SeamUpdate` events of :func:`engine.seams.iter_find_seam`.
+
+    ``cyclic`` with a method that has no cyclic mode (the graph methods, the walk) pins the
+    first and last rows to one common column instead: the best column of ``E[0] + E[-1]``
+    (ALGORITHMS §1.7, DP-mode fallback).
+    """
+    if cyclic and method not in CYCLIC_METHODS:
+        e = np.asarray(error, dtype=np.float64)
+        pinned = {int(r) for r, _ in waypoints}
+        v = int(np.argmin(e[0] + e[-1]))
+        kw = {}
+        if 0 not in pinned:
+            kw["start"] = v
+        if e.shape[0] - 1 not in pinned:
+            kw["end"] = v
+        return (yield from iter_find_seam(error, method=method, waypoints=tuple(waypoints),
+                                          cancel=cancel, **kw, **options))
+    return (yield from iter_find_seam(error, method=method, waypoints=tuple(waypoints),
+                                      cyclic=bool(cyclic), cancel=cancel, **options))
+
+
+def _restrict(error: np.ndarray, lo: int, hi: int) -> np.ndarray:
+    """Make columns outside [lo, hi] prohibitively expensive (finite, for every method)."""
+    out = error.copy()
+    big = float(error.sum()) + 1.0
+    out[:, :lo] = big
+    out[:, hi + 1 :] = big
+    return out
+
+
+def _allowed(width: int, blend: str, feather: int) -> tuple[int, int]:
+    """Control-point range that keeps column 0 from R1 and column width-1 from R2."""
+    pad = math.ceil(feather / 2) if blend == "feather" else 0
+    lo, hi = pad, width - 2 - pad
+    return (lo, hi) if lo <= hi else (0, width - 2)
+
+
+def _check_waypoints(waypoints) -> dict:
+    if waypoints is None:
+        return {}
+    if not isinstance(waypoints, Mapping):
+        raise TypeError("waypoints must be a mapping {'horizontal': [(r, c)...], 'vertical': ...}")
+    out = {}
+    for k, pts in waypoints.items():
+        choice(k, "waypoints key", OVERLAPS)
+        arr = np.asarray(list(pts), dtype=np.int64).reshape(-1, 2)
+        out[k] = [(int(r), int(c)) for r, c in arr]
+    return out
+
+
+# --------------------------------------------------------------------------- API
+def iter_make_seamless(source, rect, *, overlap=None, method: str = "dp", metric: str = "euclid",
+                       blend: str = "none", width: int = 4, rho: int = 3, waypoints=None,
+                       maps=None, weights=None, cancel=None, **seam_options):
+    """Make the tile of ``rect`` seamless; returns a generator whose value is a SeamlessTile.
+
+    Parameters
+    ----------
+    source : (H, W[, C]) array
+    rect : (x, y, w, h) or Template
+        The tile rectangle (see :mod:`engine.tiles.template`); a :class:`Template` also
+        gives ``overlap``.
+    overlap : int
+        w_T (required with a plain rectangle).
+    method, metric, blend, width, rho, **seam_options
+        Seam method (:data:`engine.seams.METHODS`), error metric, blending (``none``,
+        ``feather`` of ``width`` px, ``adaptive`` with ρ) and method options.
+    waypoints : {"horizontal": [(r, c), ...], "vertical": [...]} or None
+        Points the seams must pass, in each overlap region's coordinates as drawn.
+    maps : {name: (H, W[, C]) image} or None
+        Extra co-registered material maps; they get the same cuts.
+    weights : {name: float} or None
+        Seam error weights per map (``"main"`` is the source); default: the source only.
+    cancel : CancelToken or None
+        Raises :class:`engine.cancel.Cancelled` (anytime seam methods stop early first).
+
+    Yields :class:`SeamlessUpdate` snapshots (every seam improvement) and :class:`Progress`.
+    """
+    S = as_image(source, "source")
+    H, W = S.shape[:2]
+    if isinstance(rect, Template):
+        overlap = rect.overlap if overlap is None else overlap
+        rect = rect.rect
+    if overlap is None:
+        raise TypeError("overlap is required when rect is a plain (x, y, w, h) rectangle")
+    x, y, a, b = _check_rect(rect, overlap, (H, W))
+    choice(blend, "blend", BLEND_MODES)
+    positive_int(width, "width", minimum=0)
+    positive_int(rho, "rho", minimum=0)
+    extra = as_maps(maps, (H, W))
+    wts = check_weights(weights, extra)
+    wps = _check_waypoints(waypoints)
+    seam_error({MAIN: S[:1, :1]}, {MAIN: S[:1, :1]}, None, metric)  # validates metric early
+    notes = []
+    flat = flat_warning(S)
+    if flat:
+        notes.append(flat)
+    params = dict(method=method, metric=metric, blend=blend, width=int(width), rho=int(rho),
+                  **{k: v for k, v in seam_options.items() if isinstance(v, (int, float, str))})
+    return _iter_make_seamless(S, extra, (x, y, a, b), int(overlap), method, metric, blend,
+                               int(width), int(rho), wps, wts, cancel, seam_options, params,
+                               tuple(notes))
+
+
+def _iter_make_seamless(S, extra, rect, wT, method, metric, blend, width, rho, wps, wts, cancel,
+                        seam_options, params, notes):
+    x, y, a, b = rect
+    stack = {MAIN: S, **extra}
+    F = {k: v[y : y + b + wT, x : x + a + wT] for k, v in stack.items()}
+    R_L = {k: v[:, :wT] for k, v in F.items()}
+    R_R = {k: v[:, a : a + wT] for k, v in F.items()}
+    yield Progress(0, 2, "seamless: horizontal stitch")
+
+    # ---- horizontal: R1 = R_R kept on the left (the tile's left edge), R2 = R_L; canonical
+    E_h = seam_error(R_R, R_L, wts, metric)
+    lo, hi = _allowed(wT, blend, width)
+    seam_h = None
+    gen = iter_seam(_restrict(E_h, lo, hi), method=method, waypoints=wps.get("horizontal", ()),
+                    cancel=cancel, **seam_options)
+    while True:
+        try:
+            ev = next(gen)
+        except StopIteration as stop:
+            seam_h = stop.value
+            break
+        if isinstance(ev, SeamUpdate):
+            yield _update("horizontal", ev.seam, ev.final, (y, x))
+        else:
+            yield ev
+    check(cancel)
+    alpha_h = _alpha(seam_h, E_h, blend, width, rho)
+    strip = apply_cut(R_R, R_L, alpha_h)
+    I = {k: v[:, :a].copy() for k, v in F.items()}
+    for k in I:
+        I[k][:, :wT] = strip[k]
+    yield _update("horizontal", seam_h, True, (y, x))
+    yield Progress(1, 2, "seamless: vertical stitch")
+
+    # ---- vertical: R1 = R_B kept on top; canonical = transpose (rows = tile columns), cyclic
+    R_T = {k: v[:wT] for k, v in I.items()}
+    R_B = {k: v[b : b + wT] for k, v in I.items()}
+    E_v = seam_error(R_B, R_T, wts, metric)
+    Ec = np.ascontiguousarray(E_v.T)
+    wv = tuple((c, r) for r, c in wps.get("vertical", ()))
+    seam_v = None
+    gen = iter_seam(_restrict(Ec, lo, hi), method=method, cyclic=True, waypoints=wv,
+                    cancel=cancel, **seam_options)
+    while True:
+        try:
+            ev = next(gen)
+        except StopIteration as stop:
+            seam_v = stop.value
+            break
+        if isinstance(ev, SeamUpdate):
+            yield _update("vertical", ev.seam, ev.final, (y, x), transpose=True)
+        else:
+            yield ev
+    check(cancel)
+    alpha_v = np.ascontiguousarray(_alpha(seam_v, Ec, blend, width, rho, cyclic=True).T)
+    band = apply_cut(R_B, R_T, alpha_v)
+    tiles = {k: v[:b].copy() for k, v in I.items()}
+    for k in tiles:
+        tiles[k][:wT] = band[k]
+    up_v = _update("vertical", seam_v, True, (y, x), transpose=True)
+    yield up_v
+    yield Progress(2, 2, "seamless: done")
+
+    path_h = np.asarray(seam_h.path, dtype=np.intp)
+    path_v = np.asarray(up_v.path, dtype=np.intp)
+    errors = {"horizontal": E_h.astype(np.float32), "vertical": E_v.astype(np.float32)}
+    regions = {"R_L": R_L[MAIN], "R_R": R_R[MAIN], "R_T": R_T[MAIN], "R_B": R_B[MAIN]}
+    region_rects = {
+        "R_L": (x, y, wT, b + wT),
+        "R_R": (x + a, y, wT, b + wT),
+        "R_T": (x, y, a, wT),
+        "R_B": (x, y + b, a, wT),
+    }
+    fr = frozen_array
+    return SeamlessTile(
+        tile=fr(tiles[MAIN]),
+        rect=(x, y, a, b),
+        overlap=wT,
+        regions={k: fr(v) for k, v in regions.items()},
+        region_rects=region_rects,
+        errors={k: fr(v) for k, v in errors.items()},
+        seams={"horizontal": seam_h, "vertical": seam_v},
+        paths={"horizontal": fr(path_h), "vertical": fr(path_v)},
+        paths_tile={"horizontal": fr(path_h[path_h[:, 0] < b]), "vertical": fr(path_v)},
+        paths_source={"horizontal": fr(path_h + (y, x)), "vertical": fr(path_v + (y, x))},
+        alphas={"horizontal": fr(alpha_h), "vertical": fr(alpha_v)},
+        maps={k: fr(v) for k, v in tiles.items() if k != MAIN},
+        criterion={"horizontal": float(seam_h.criterion), "vertical": float(seam_v.criterion)},
+        peak={"horizontal": float(seam_h.peak), "vertical": float(seam_v.peak)},
+        parameters=params,
+        warnings=notes,
+    )
+
+
+def _alpha(seam: Seam, error: np.ndarray, blend: str, width: int, rho: int,
+           cyclic: bool = False) -> np.ndarray:
+    """Canonical weight of R1 with the outer column pinned to R1 and the inner one to R2."""
+    alpha = np.array(blend_weights(seam, error, mode=blend, width=width, rho=rho, cyclic=cyclic),
+                     dtype=np.float32)
+    alpha[:, 0] = 1.0
+    alpha[:, -1] = 0.0
+    return alpha
+
+
+def _update(which: str, seam: Seam, final: bool, origin, *, transpose: bool = False):
+    path = np.asarray(seam.path, dtype=np.intp)
+    if transpose:
+        path = path[:, ::-1]
+    return SeamlessUpdate(which=which, seam=seam, path=frozen_array(path),
+                          path_source=frozen_array(path + np.asarray(origin)), final=final)
+
+
+def make_seamless(source, rect, **options) -> SeamlessTile:
+    """Drain :func:`iter_make_seamless` and return the :class:`SeamlessTile`."""
+    return drain(iter_make_seamless(source, rect, **options))
