@@ -1,0 +1,270 @@
+"""Shortest paths on the pixel graph with node costs (ALGORITHMS §3): Dijkstra and minimax.
+
+Nodes are the pixels of ``domain``; a step to a 4- or 8-neighbour q adds ``cost[q]``; start
+nodes pay their own cost. Labels and their order, by metric:
+
+* ``sum``      — cumulative cost (plain Dijkstra, exact);
+* ``lm``       — Long & Mould's partial non-scalar label (max, sum) compared by max, ties by
+  sum; exact for the max, not always for the sum (the order is not kept by extension, §3);
+* ``minimax``  — exact two-phase version: the minimal peak m* (the ``lm`` run's max is exact),
+  then the minimal sum over the nodes with cost <= m*;
+* ``sorted``   — the full Pai–Reissell metric on costs quantised to ``levels`` levels: the
+  count vector of path nodes per level compared from the top level down, ties by sum. The
+  order is invariant under adding the same node to both paths, so Dijkstra is exact.
+
+One numba kernel with an indexed binary heap (decrease-key) serves every metric.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from engine._validate import as_error_map, choice, positive_int
+from engine.cancel import check
+
+GRAPH_METRICS = ("sum", "minimax", "lm", "sorted")
+_SUM, _LM, _SORTED = 0, 1, 2
+
+
+@njit(cache=True, nogil=True)
+def _less(u, v, mode, k1, k2, cnt, nlev):
+    """Label of node u strictly smaller than label of node v."""
+    if mode == _SORTED:
+        for lv in range(nlev - 1, -1, -1):
+            if cnt[u, lv] != cnt[v, lv]:
+                return cnt[u, lv] < cnt[v, lv]
+        return k2[u] < k2[v]
+    if k1[u] != k1[v]:
+        return k1[u] < k1[v]
+    return k2[u] < k2[v]
+
+
+@njit(cache=True, nogil=True)
+def _sift_up(heap, pos, t, mode, k1, k2, cnt, nlev):
+    node = heap[t]
+    while t > 0:
+        parent = (t - 1) >> 1
+        q = heap[parent]
+        if not _less(node, q, mode, k1, k2, cnt, nlev):
+            break
+        heap[t] = q
+        pos[q] = t
+        t = parent
+    heap[t] = node
+    pos[node] = t
+
+
+@njit(cache=True, nogil=True)
+def _sift_down(heap, pos, size, t, mode, k1, k2, cnt, nlev):
+    node = heap[t]
+    while True:
+        left = 2 * t + 1
+        if left >= size:
+            break
+        child = left
+        right = left + 1
+        if right < size and _less(heap[right], heap[left], mode, k1, k2, cnt, nlev):
+            child = right
+        q = heap[child]
+        if not _less(q, node, mode, k1, k2, cnt, nlev):
+            break
+        heap[t] = q
+        pos[q] = t
+        t = child
+    heap[t] = node
+    pos[node] = t
+
+
+@njit(cache=True, nogil=True)
+def _dijkstra(cost, domain, sources, targets, mode, lev, nlev, conn, pred):
+    """Search from every source pixel to the first target popped; returns its flat index
+    (-1 when no target is reachable). ``pred`` receives the predecessor of each settled node."""
+    h, w = cost.shape
+    n = h * w
+    inf = np.inf
+    k1 = np.full(n, inf)
+    k2 = np.zeros(n)
+    cnt = np.zeros((n if mode == _SORTED else 1, max(nlev, 1)), dtype=np.int32)
+    heap = np.empty(n, dtype=np.int64)
+    pos = np.full(n, -1, dtype=np.int64)  # -1: never queued, -2: settled
+    if conn == 8:
+        dr = np.array([-1, -1, -1, 0, 0, 1, 1, 1])
+        dc = np.array([-1, 0, 1, -1, 1, -1, 0, 1])
+    else:
+        dr = np.array([-1, 0, 0, 1])
+        dc = np.array([0, -1, 1, 0])
+    size = 0
+    for r in range(h):
+        for c in range(w):
+            if sources[r, c] and domain[r, c]:
+                u = r * w + c
+                e = cost[r, c]
+                k1[u] = e
+                k2[u] = e if mode != _SUM else 0.0
+                if mode == _SORTED:
+                    cnt[u, lev[r, c]] = 1
+                pred[u] = -1
+                heap[size] = u
+                pos[u] = size
+                size += 1
+                _sift_up(heap, pos, size - 1, mode, k1, k2, cnt, nlev)
+    while size > 0:
+        u = heap[0]
+        size -= 1
+        pos[u] = -2
+        if size > 0:
+            heap[0] = heap[size]
+            pos[heap[0]] = 0
+            _sift_down(heap, pos, size, 0, mode, k1, k2, cnt, nlev)
+        ur, uc = u // w, u % w
+        if targets[ur, uc]:
+            return u
+        for t in range(dr.shape[0]):
+            vr, vc = ur + dr[t], uc + dc[t]
+            if vr < 0 or vr >= h or vc < 0 or vc >= w or not domain[vr, vc]:
+                continue
+            v = vr * w + vc
+            if pos[v] == -2:
+                continue
+            e = cost[vr, vc]
+            if mode == _SUM:
+                n1, n2 = k1[u] + e, 0.0
+            else:
+                n1, n2 = max(k1[u], e), k2[u] + e
+            better = pos[v] == -1
+            if not better:
+                if mode == _SORTED:
+                    lv = lev[vr, vc]
+                    decided = False
+                    for m in range(nlev - 1, -1, -1):
+                        a = cnt[u, m] + (1 if m == lv else 0)
+                        if a != cnt[v, m]:
+                            better = a < cnt[v, m]
+                            decided = True
+                            break
+                    if not decided:
+                        better = n2 < k2[v]
+                else:
+                    better = n1 < k1[v] or (n1 == k1[v] and n2 < k2[v])
+            if better:
+                k1[v] = n1
+                k2[v] = n2
+                if mode == _SORTED:
+                    for m in range(nlev):
+                        cnt[v, m] = cnt[u, m]
+                    cnt[v, lev[vr, vc]] += 1
+                pred[v] = u
+                if pos[v] == -1:
+                    heap[size] = v
+                    pos[v] = size
+                    size += 1
+                _sift_up(heap, pos, pos[v], mode, k1, k2, cnt, nlev)
+    return -1
+
+
+def _run(cost, domain, sources, targets, mode, lev, nlev, conn):
+    pred = np.full(cost.size, -1, dtype=np.int64)
+    t = _dijkstra(cost, domain, sources, targets, mode, lev, nlev, conn, pred)
+    if t < 0:
+        return None
+    nodes = [t]
+    while pred[nodes[-1]] >= 0:
+        nodes.append(pred[nodes[-1]])
+    nodes = np.array(nodes[::-1], dtype=np.intp)
+    return np.column_stack(np.divmod(nodes, cost.shape[1]))
+
+
+_NO_LEVELS = np.zeros((1, 1), dtype=np.int64)
+
+
+def quantise(cost: np.ndarray, domain: np.ndarray, levels: int) -> np.ndarray:
+    """Level 0..levels-1 of every pixel, uniform between 0 and the largest cost in ``domain``."""
+    top = float(cost[domain].max()) if domain.any() else 0.0
+    if top <= 0:
+        return np.zeros(cost.shape, dtype=np.int64)
+    return np.minimum((cost * (levels / top)).astype(np.int64), levels - 1)
+
+
+def shortest_path(cost, sources, targets, domain, *, metric: str, levels: int = 32,
+                  connectivity: int = 8, cancel=None):
+    """Path ((N, 2) intp, source to target) on validated C-contiguous inputs, or None."""
+    check(cancel)
+    if metric == "sum":
+        path = _run(cost, domain, sources, targets, _SUM, _NO_LEVELS, 0, connectivity)
+    elif metric == "sorted":
+        lev = quantise(cost, domain, levels)
+        path = _run(cost, domain, sources, targets, _SORTED, lev, levels, connectivity)
+    else:
+        path = _run(cost, domain, sources, targets, _LM, _NO_LEVELS, 0, connectivity)
+        if metric == "minimax" and path is not None:
+            check(cancel)
+            peak = cost[path[:, 0], path[:, 1]].max()
+            low = domain & (cost <= peak)
+            path = _run(cost, low, sources, targets, _SUM, _NO_LEVELS, 0, connectivity)
+    check(cancel)
+    return path
+
+
+def _bool_mask(a, name: str, shape) -> np.ndarray:
+    m = np.asarray(a)
+    if m.dtype != bool:
+        raise TypeError(f"{name} must be a bool array, got dtype {m.dtype}")
+    if m.shape != shape:
+        raise ValueError(f"{name} must have the shape of cost {shape}, got {m.shape}")
+    return np.ascontiguousarray(m)
+
+
+def graph_path(cost, sources, targets, *, domain=None, metric: str = "sum", levels: int = 32,
+               connectivity: int = 8, cancel=None) -> np.ndarray:
+    """Best path on the pixel graph from any pixel of ``sources`` to the first reached target.
+
+    Parameters
+    ----------
+    cost : (h, w) array_like
+        Non-negative, finite node costs; every node on the path pays its own cost (the start
+        node included).
+    sources, targets : (h, w) bool ndarray
+        Start and goal pixels (only those inside ``domain`` count).
+    domain : (h, w) bool ndarray, optional
+        Pixels the path may use (default: all), e.g. the L-shaped quilting overlap.
+    metric : {'sum', 'minimax', 'lm', 'sorted'}
+        Path order (module docstring): cumulative cost, exact (peak, sum), Long & Mould's
+        comparator, or the quantised sorted-vector metric with ``levels`` levels.
+    connectivity : {8, 4}
+        Pixel neighbourhood.
+    cancel : CancelToken, optional
+        Raises :class:`engine.Cancelled` when set.
+
+    Returns
+    -------
+    (N, 2) intp ndarray
+        (row, col) pixels from the source to the target.
+
+    Raises
+    ------
+    ValueError
+        When no target can be reached from a source within the domain.
+    """
+    c = np.ascontiguousarray(as_error_map(cost, "cost"))
+    choice(metric, "metric", GRAPH_METRICS)
+    levels = positive_int(levels, "levels")
+    connectivity = check_connectivity(connectivity)
+    src = _bool_mask(sources, "sources", c.shape)
+    tgt = _bool_mask(targets, "targets", c.shape)
+    dom = np.ones(c.shape, bool) if domain is None else _bool_mask(domain, "domain", c.shape)
+    if not (src & dom).any():
+        raise ValueError("sources has no pixel inside domain")
+    if not (tgt & dom).any():
+        raise ValueError("targets has no pixel inside domain")
+    path = shortest_path(c, src, tgt, dom, metric=metric, levels=levels,
+                         connectivity=connectivity, cancel=cancel)
+    if path is None:
+        raise ValueError("no path from sources to targets within domain")
+    return path
+
+
+def check_connectivity(connectivity) -> int:
+    if isinstance(connectivity, bool) or connectivity not in (4, 8):
+        raise ValueError(f"connectivity must be 4 or 8, got {connectivity!r}")
+    return int(connectivity)
