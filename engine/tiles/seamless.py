@@ -14,6 +14,7 @@ Material maps (normal, roughness...) follow the same cuts: the seam is searched 
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
@@ -24,7 +25,7 @@ from engine.cancel import check
 from engine.events import Progress, Snapshot, drain, frozen_array
 from engine.materials import apply_cut, material_error
 from engine.blend import BLEND_MODES, blend_weights
-from engine.seams import CYCLIC_METHODS, Seam, SeamUpdate, iter_find_seam
+from engine.seams import CYCLIC_METHODS, METHODS, Seam, SeamUpdate, iter_find_seam
 from engine.tiles.template import Template, _check_rect, flat_warning
 
 __all__ = [
@@ -235,6 +236,7 @@ def iter_make_seamless(source, rect, *, overlap=None, method: str = "dp", metric
         raise TypeError("overlap is required when rect is a plain (x, y, w, h) rectangle")
     x, y, a, b = _check_rect(rect, overlap, (H, W))
     choice(blend, "blend", BLEND_MODES)
+    choice(method, "method", METHODS)
     positive_int(width, "width", minimum=0)
     positive_int(rho, "rho", minimum=0)
     extra = as_maps(maps, (H, W))
@@ -245,6 +247,7 @@ def iter_make_seamless(source, rect, *, overlap=None, method: str = "dp", metric
     flat = flat_warning(S)
     if flat:
         notes.append(flat)
+        warnings.warn(flat, stacklevel=2)
     params = dict(method=method, metric=metric, blend=blend, width=int(width), rho=int(rho),
                   **{k: v for k, v in seam_options.items() if isinstance(v, (int, float, str))})
     return _iter_make_seamless(S, extra, (x, y, a, b), int(overlap), method, metric, blend,
@@ -264,19 +267,10 @@ def _iter_make_seamless(S, extra, rect, wT, method, metric, blend, width, rho, w
     # ---- horizontal: R1 = R_R kept on the left (the tile's left edge), R2 = R_L; canonical
     E_h = seam_error(R_R, R_L, wts, metric)
     lo, hi = _allowed(wT, blend, width)
-    seam_h = None
-    gen = iter_seam(_restrict(E_h, lo, hi), method=method, waypoints=wps.get("horizontal", ()),
-                    cancel=cancel, **seam_options)
-    while True:
-        try:
-            ev = next(gen)
-        except StopIteration as stop:
-            seam_h = stop.value
-            break
-        if isinstance(ev, SeamUpdate):
-            yield _update("horizontal", ev.seam, ev.final, (y, x))
-        else:
-            yield ev
+    seam_h = yield from _stream(
+        iter_seam(_restrict(E_h, lo, hi), method=method, waypoints=wps.get("horizontal", ()),
+                  cancel=cancel, **seam_options),
+        "horizontal", (y, x))
     check(cancel)
     alpha_h = _alpha(seam_h, E_h, blend, width, rho)
     strip = apply_cut(R_R, R_L, alpha_h)
@@ -292,19 +286,10 @@ def _iter_make_seamless(S, extra, rect, wT, method, metric, blend, width, rho, w
     E_v = seam_error(R_B, R_T, wts, metric)
     Ec = np.ascontiguousarray(E_v.T)
     wv = tuple((c, r) for r, c in wps.get("vertical", ()))
-    seam_v = None
-    gen = iter_seam(_restrict(Ec, lo, hi), method=method, cyclic=True, waypoints=wv,
-                    cancel=cancel, **seam_options)
-    while True:
-        try:
-            ev = next(gen)
-        except StopIteration as stop:
-            seam_v = stop.value
-            break
-        if isinstance(ev, SeamUpdate):
-            yield _update("vertical", ev.seam, ev.final, (y, x), transpose=True)
-        else:
-            yield ev
+    seam_v = yield from _stream(
+        iter_seam(_restrict(Ec, lo, hi), method=method, cyclic=True, waypoints=wv,
+                  cancel=cancel, **seam_options),
+        "vertical", (y, x), transpose=True)
     check(cancel)
     alpha_v = np.ascontiguousarray(_alpha(seam_v, Ec, blend, width, rho, cyclic=True).T)
     band = apply_cut(R_B, R_T, alpha_v)
@@ -325,6 +310,7 @@ def _iter_make_seamless(S, extra, rect, wT, method, metric, blend, width, rho, w
         "R_T": (x, y, a, wT),
         "R_B": (x, y + b, a, wT),
     }
+    drawn = (("horizontal", E_h, path_h), ("vertical", E_v, path_v))
     fr = frozen_array
     return SeamlessTile(
         tile=fr(tiles[MAIN]),
@@ -339,8 +325,8 @@ def _iter_make_seamless(S, extra, rect, wT, method, metric, blend, width, rho, w
         paths_source={"horizontal": fr(path_h + (y, x)), "vertical": fr(path_v + (y, x))},
         alphas={"horizontal": fr(alpha_h), "vertical": fr(alpha_v)},
         maps={k: fr(v) for k, v in tiles.items() if k != MAIN},
-        criterion={"horizontal": float(seam_h.criterion), "vertical": float(seam_v.criterion)},
-        peak={"horizontal": float(seam_h.peak), "vertical": float(seam_v.peak)},
+        criterion={k: float(v[p[:, 0], p[:, 1]].sum()) for k, v, p in drawn},
+        peak={k: float(v[p[:, 0], p[:, 1]].max()) for k, v, p in drawn},
         parameters=params,
         warnings=notes,
     )
@@ -354,6 +340,23 @@ def _alpha(seam: Seam, error: np.ndarray, blend: str, width: int, rho: int,
     alpha[:, 0] = 1.0
     alpha[:, -1] = 0.0
     return alpha
+
+
+def _stream(gen, which: str, origin, *, transpose: bool = False):
+    """Re-yield a seam search's improvements as :class:`SeamlessUpdate`; return its seam.
+
+    The final update is sent by the caller once the cut is applied.
+    """
+    while True:
+        try:
+            ev = next(gen)
+        except StopIteration as stop:
+            return stop.value
+        if isinstance(ev, SeamUpdate):
+            if not ev.final:
+                yield _update(which, ev.seam, False, origin, transpose=transpose)
+        else:
+            yield ev
 
 
 def _update(which: str, seam: Seam, final: bool, origin, *, transpose: bool = False):
