@@ -241,6 +241,8 @@ def _iter_single(e, method, pins, cyclic, opts, cancel):
 
 
 def _iter_anytime(e, pins, cyclic, opts, cancel):
+    e = e.copy()  # streamed seams are built lazily from it: keep a private, frozen copy
+    e.setflags(write=False)
     best = None
     for seam in iter_oscillating(e, pins, o_max=opts["o_max"], variant=opts["variant"],
                                  cyclic=cyclic, cancel=cancel):

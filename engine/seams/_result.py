@@ -2,15 +2,12 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 from scipy import ndimage
 
 
-@dataclass(frozen=True, slots=True)
 class Seam:
-    """A cut through an overlap error map (rows run top to bottom).
+    """A cut through an overlap error map (rows run top to bottom); immutable.
 
     Attributes
     ----------
@@ -25,17 +22,72 @@ class Seam:
         Largest error on the path.
     method : str
         The method key that produced it.
+
+    Streamed seams (thousands per second from the oscillating search) may be built lazily:
+    ``path``, ``mask``, ``criterion`` and ``peak`` are then computed on first access from a
+    private copy of the control points (same values as an eager build).
     """
 
-    path: np.ndarray
-    mask: np.ndarray
-    criterion: float
-    peak: float
-    method: str = ""
+    __slots__ = ("_path", "_mask", "_criterion", "_peak", "method", "_build")
+
+    def __init__(self, path, mask, criterion, peak, method: str = ""):
+        for name, value in (("_path", path), ("_mask", mask), ("_criterion", float(criterion)),
+                            ("_peak", float(peak)), ("method", method), ("_build", None)):
+            object.__setattr__(self, name, value)
+
+    @classmethod
+    def lazy(cls, build, method: str) -> Seam:
+        """A seam whose fields come from ``build() -> (path, mask, criterion, peak)``."""
+        seam = cls.__new__(cls)
+        for name in ("_path", "_mask", "_criterion", "_peak"):
+            object.__setattr__(seam, name, None)
+        object.__setattr__(seam, "method", method)
+        object.__setattr__(seam, "_build", build)
+        return seam
+
+    def _fields(self):
+        build = self._build
+        if build is not None:
+            path, mask, crit, peak = build()
+            path.setflags(write=False)
+            mask.setflags(write=False)
+            for name, value in (("_path", path), ("_mask", mask), ("_criterion", float(crit)),
+                                ("_peak", float(peak)), ("_build", None)):
+                object.__setattr__(self, name, value)
+        return self
+
+    @property
+    def path(self) -> np.ndarray:
+        return self._fields()._path
+
+    @property
+    def mask(self) -> np.ndarray:
+        return self._fields()._mask
+
+    @property
+    def criterion(self) -> float:
+        return self._fields()._criterion
+
+    @property
+    def peak(self) -> float:
+        return self._fields()._peak
 
     @property
     def shape(self) -> tuple[int, int]:
         return self.mask.shape
+
+    def __setattr__(self, name, value):
+        raise AttributeError(f"Seam is immutable (cannot set {name!r})")
+
+    def __delattr__(self, name):
+        raise AttributeError(f"Seam is immutable (cannot delete {name!r})")
+
+    def __reduce__(self):
+        return (Seam, (self.path, self.mask, self.criterion, self.peak, self.method))
+
+    def __repr__(self) -> str:
+        return (f"Seam(method={self.method!r}, shape={self.shape}, pixels={len(self.path)}, "
+                f"criterion={self.criterion:.6g}, peak={self.peak:.6g})")
 
 
 def mask_from_columns(cols: np.ndarray, width: int) -> np.ndarray:

@@ -163,9 +163,114 @@ def _dijkstra(cost, domain, sources, targets, mode, lev, nlev, conn, pred):
     return -1
 
 
+@njit(cache=True, nogil=True)
+def _heap_push(hk1, hk2, hn, size, a, b, node):
+    t = size
+    while t > 0:
+        parent = (t - 1) >> 1
+        if hk1[parent] < a or (hk1[parent] == a and hk2[parent] <= b):
+            break
+        hk1[t] = hk1[parent]
+        hk2[t] = hk2[parent]
+        hn[t] = hn[parent]
+        t = parent
+    hk1[t] = a
+    hk2[t] = b
+    hn[t] = node
+    return size + 1
+
+
+@njit(cache=True, nogil=True)
+def _heap_pop(hk1, hk2, hn, size):
+    """Remove the root (the caller read it); returns the new size."""
+    size -= 1
+    if size == 0:
+        return 0
+    a, b, node = hk1[size], hk2[size], hn[size]
+    t = 0
+    while True:
+        child = 2 * t + 1
+        if child >= size:
+            break
+        r = child + 1
+        if r < size and (hk1[r] < hk1[child] or (hk1[r] == hk1[child] and hk2[r] < hk2[child])):
+            child = r
+        if a < hk1[child] or (a == hk1[child] and b <= hk2[child]):
+            break
+        hk1[t] = hk1[child]
+        hk2[t] = hk2[child]
+        hn[t] = hn[child]
+        t = child
+    hk1[t] = a
+    hk2[t] = b
+    hn[t] = node
+    return size
+
+
+@njit(cache=True, nogil=True)
+def _dijkstra_scalar(cost, domain, sources, targets, lm, conn, pred):
+    """:func:`_dijkstra` for the scalar labels (sum, or lm's (max, sum)) with the keys inline
+    in a lazy-deletion heap (faster than the indexed heap)."""
+    h, w = cost.shape
+    n = h * w
+    d1 = np.full(n, np.inf)
+    d2 = np.zeros(n)
+    done = np.zeros(n, dtype=np.bool_)
+    cap = n * (conn + 1) + 1  # every push is a strict improvement of some node
+    hk1 = np.empty(cap)
+    hk2 = np.empty(cap)
+    hn = np.empty(cap, dtype=np.int64)
+    if conn == 8:
+        dr = np.array([-1, -1, -1, 0, 0, 1, 1, 1])
+        dc = np.array([-1, 0, 1, -1, 1, -1, 0, 1])
+    else:
+        dr = np.array([-1, 0, 0, 1])
+        dc = np.array([0, -1, 1, 0])
+    size = 0
+    for r in range(h):
+        for c in range(w):
+            if sources[r, c] and domain[r, c]:
+                u = r * w + c
+                d1[u] = cost[r, c]
+                d2[u] = cost[r, c] if lm else 0.0
+                pred[u] = -1
+                size = _heap_push(hk1, hk2, hn, size, d1[u], d2[u], u)
+    while size > 0:
+        u = hn[0]
+        a, b = hk1[0], hk2[0]
+        size = _heap_pop(hk1, hk2, hn, size)
+        if done[u] or a != d1[u] or b != d2[u]:
+            continue
+        done[u] = True
+        ur, uc = u // w, u % w
+        if targets[ur, uc]:
+            return u
+        for t in range(dr.shape[0]):
+            vr, vc = ur + dr[t], uc + dc[t]
+            if vr < 0 or vr >= h or vc < 0 or vc >= w or not domain[vr, vc]:
+                continue
+            v = vr * w + vc
+            if done[v]:
+                continue
+            e = cost[vr, vc]
+            if lm:
+                n1, n2 = max(a, e), b + e
+            else:
+                n1, n2 = a + e, 0.0
+            if n1 < d1[v] or (n1 == d1[v] and n2 < d2[v]):
+                d1[v] = n1
+                d2[v] = n2
+                pred[v] = u
+                size = _heap_push(hk1, hk2, hn, size, n1, n2, v)
+    return -1
+
+
 def _run(cost, domain, sources, targets, mode, lev, nlev, conn):
     pred = np.full(cost.size, -1, dtype=np.int64)
-    t = _dijkstra(cost, domain, sources, targets, mode, lev, nlev, conn, pred)
+    if mode == _SORTED:
+        t = _dijkstra(cost, domain, sources, targets, mode, lev, nlev, conn, pred)
+    else:
+        t = _dijkstra_scalar(cost, domain, sources, targets, mode == _LM, conn, pred)
     if t < 0:
         return None
     nodes = [t]

@@ -100,11 +100,10 @@ def _seam_arrays(error, c, cyclic):
 
 
 def controls_seam(error: np.ndarray, c: np.ndarray, cyclic: bool, method: str) -> Seam:
-    """The :class:`Seam` of control points ``c`` (complementary points included)."""
-    path, mask, total, peak = _seam_arrays(error, c, cyclic)
-    path.setflags(write=False)
-    mask.setflags(write=False)
-    return Seam(path=path, mask=mask, criterion=float(total), peak=float(peak), method=method)
+    """The :class:`Seam` of control points ``c`` (complementary points included), built lazily
+    from a private copy of ``c`` (``error`` must stay unchanged, as engine inputs do)."""
+    c = np.array(c, dtype=np.int64)
+    return Seam.lazy(lambda: _seam_arrays(error, c, cyclic), method)
 
 
 def criterion(error: np.ndarray, c: np.ndarray, *, cyclic: bool = False) -> float:
@@ -141,17 +140,99 @@ def _affected_cost(p, c, rows, nrows, j, o, i, cyclic):
 
 
 @njit(cache=True, nogil=True)
-def _osc_run(p, c, seq_o, seq_j, skip, cyclic, resume, state, fstate, budget):
-    """Run the oscillating search from ``state`` until an improvement, ``budget`` trials or
-    convergence. ``c`` is updated in place.
+def _first_improving(p, q, c, j, o, cyclic, eps, limit):
+    """First column i (in loop order) for which moving the block j..j+o-1 to i gives a
+    criterion below ``limit``; returns (i, new criterion) or (-1, eps).
 
-    state = [position in the (o, j) sequence, trials since the last improvement];
-    fstate = [current criterion]. Returns 1 (improved), 0 (budget used up), 2 (converged).
+    O(1) per i: only rows j-1 .. j+o change; the block's inner rows cost E[k, i] (column
+    prefix sums ``q``), its end rows and the two outer rows get new complementary points.
     """
     h = c.shape[0]
     w = p.shape[1] - 1
+    big = w + 2  # a missing neighbour never lowers mu
+    if cyclic and o + 2 > h:
+        return _first_improving_generic(p, c, j, o, cyclic, eps, limit)
+    # outer rows a = j-1 and z = j+o, their outer neighbours aa = j-2 and zz = j+o+1
+    if cyclic:
+        a, z = (j - 1) % h, (j + o) % h
+        has_a = has_z = True
+        ca_prev = c[(j - 2) % h] + 1
+        cz_next = c[(j + o + 1) % h] + 1
+    else:
+        a, z = j - 1, j + o
+        has_a, has_z = a >= 0, z < h
+        ca_prev = c[j - 2] + 1 if j >= 2 else big
+        cz_next = c[j + o + 1] + 1 if j + o + 1 < h else big
+    ca = c[a] + 1 if has_a else big
+    cz = c[z] + 1 if has_z else big
+    old = 0.0
+    if has_a:
+        old += p[a, c[a] + 1] - p[a, min(c[a], ca_prev, c[j] + 1)]
+    if has_z:
+        old += p[z, c[z] + 1] - p[z, min(c[z], cz_next, c[(j + o - 1) % h] + 1)]
+    last = (j + o - 1) % h
+    for t in range(o):
+        k = (j + t) % h
+        prev = c[(k - 1) % h] + 1 if cyclic or k > 0 else big
+        nxt = c[(k + 1) % h] + 1 if cyclic or k + 1 < h else big
+        old += p[k, c[k] + 1] - p[k, min(c[k], prev, nxt)]
+    # a block already uniform at column v cannot improve by moving to v
+    v = c[j]
+    for t in range(1, o):
+        if c[(j + t) % h] != v:
+            v = -1
+            break
+    base = eps - old
+    s0 = (j + 1) % h  # first inner row
+    n_in = o - 2
+    for i in range(w):
+        if i == v:
+            continue
+        new = base
+        if has_a:
+            new += p[a, c[a] + 1] - p[a, min(c[a], ca_prev, i + 1)]
+        if has_z:
+            new += p[z, c[z] + 1] - p[z, min(c[z], cz_next, i + 1)]
+        if o == 1:
+            new += p[j, i + 1] - p[j, min(i, ca, cz)]
+        else:
+            new += p[j, i + 1] - p[j, min(i, ca)]
+            new += p[last, i + 1] - p[last, min(i, cz)]
+            if n_in > 0:
+                if s0 + n_in <= h:
+                    new += q[s0 + n_in, i] - q[s0, i]
+                else:
+                    new += q[h, i] - q[s0, i] + q[s0 + n_in - h, i]
+        if new < limit:
+            return i, new
+    return -1, eps
+
+
+@njit(cache=True, nogil=True)
+def _first_improving_generic(p, c, j, o, cyclic, eps, limit):
+    """Same as :func:`_first_improving` for tiny cyclic maps (o + 2 > h): O(h) per i."""
+    h = c.shape[0]
+    w = p.shape[1] - 1
+    rows = np.arange(h)
+    old = _affected_cost(p, c, rows, h, j, o, -1, cyclic)
+    for i in range(w):
+        new = eps - old + _affected_cost(p, c, rows, h, j, o, i, cyclic)
+        if new < limit:
+            return i, new
+    return -1, eps
+
+
+@njit(cache=True, nogil=True)
+def _osc_run(p, q, c, seq_o, seq_j, skip, cyclic, resume, state, fstate, budget):
+    """Run the oscillating search from ``state`` until an improvement, ``budget`` trials or
+    convergence. ``c`` is updated in place.
+
+    state = [position in the (o, j) sequence, trials since the last improvement,
+    improvements]; fstate = [current criterion]. Returns 1 (improved), 0 (budget used up),
+    2 (converged).
+    """
+    h = c.shape[0]
     n = seq_o.shape[0]
-    rows = np.empty(h + 2, dtype=np.int64)
     pos = state[0]
     idle = state[1]
     eps = fstate[0]
@@ -159,49 +240,22 @@ def _osc_run(p, c, seq_o, seq_j, skip, cyclic, resume, state, fstate, budget):
         if idle >= n:
             state[0] = pos
             state[1] = idle
+            fstate[0] = _criterion(p, c, cyclic)
             return _CONVERGED
         o = seq_o[pos]
         j = seq_j[pos]
-        improved = False
         if not skip[pos]:
-            # rows whose cost can change: j-1 .. j+o (mod h when cyclic)
-            nrows = 0
-            if cyclic:
-                if o + 2 >= h:
-                    for k in range(h):
-                        rows[nrows] = k
-                        nrows += 1
-                else:
-                    for k in range(j - 1, j + o + 1):
-                        rows[nrows] = k % h
-                        nrows += 1
-            else:
-                for k in range(max(j - 1, 0), min(j + o + 1, h)):
-                    rows[nrows] = k
-                    nrows += 1
-            old = _affected_cost(p, c, rows, nrows, j, o, -1, cyclic)
-            limit = eps - 1e-9 * eps
-            for i in range(w):
-                same = True
+            i, new = _first_improving(p, q, c, j, o, cyclic, eps, eps - 1e-9 * eps)
+            if i >= 0:
                 for t in range(o):
-                    if c[(j + t) % h] != i:
-                        same = False
-                        break
-                if same:
-                    continue
-                new = eps - old + _affected_cost(p, c, rows, nrows, j, o, i, cyclic)
-                if new < limit:
-                    for t in range(o):
-                        c[(j + t) % h] = i
-                    eps = _criterion(p, c, cyclic)
-                    improved = True
-                    break
-        if improved:
-            pos = j if resume else 0
-            state[0] = pos
-            state[1] = 0
-            fstate[0] = eps
-            return _IMPROVED
+                    c[(j + t) % h] = i
+                state[2] += 1
+                # incremental value; refreshed exactly now and then against drift
+                eps = _criterion(p, c, cyclic) if state[2] % 256 == 0 else new
+                state[0] = j if resume else 0
+                state[1] = 0
+                fstate[0] = eps
+                return _IMPROVED
         idle += 1
         pos += 1
         if pos == n:
@@ -247,13 +301,15 @@ def iter_oscillating(error, pins, *, o_max: int, variant: str, cyclic: bool, can
     p = prefix_sums(error)
     frozen = pins >= 0
     seq_o, seq_j, skip = _move_sequence(h, min(o_max, h), cyclic, frozen)
-    state = np.zeros(2, dtype=np.int64)
+    q = np.zeros((h + 1, w))
+    np.cumsum(error, axis=0, out=q[1:])
+    state = np.zeros(3, dtype=np.int64)
     fstate = np.array([_criterion(p, c, cyclic)])
     # about 1e5 row evaluations per kernel call: the cancel token is polled every ~0.1 ms
     budget = max(1, 100_000 // (w * (min(o_max, h) + 2)))
     resume = variant == "resume"
     while not is_cancelled(cancel):
-        status = _osc_run(p, c, seq_o, seq_j, skip, cyclic, resume, state, fstate, budget)
+        status = _osc_run(p, q, c, seq_o, seq_j, skip, cyclic, resume, state, fstate, budget)
         if status == _IMPROVED:
             yield controls_seam(error, c, cyclic, method)
         elif status == _CONVERGED:
