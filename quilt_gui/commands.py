@@ -72,14 +72,25 @@ class SetTemplateRect(_Mergeable):
     ID = 2
 
     def __init__(
-        self, doc: Document, rect, *, merge_id: int | None = None, text: str = "Move tile rectangle"
+        self,
+        doc: Document,
+        rect,
+        *,
+        merge_id: int | None = None,
+        text: str = "Move tile rectangle",
+        old=None,
+        already_applied: bool = False,
     ) -> None:
         super().__init__(text, merge_id)
         self.doc = doc
         self.new = rect
-        self.old = doc.template_rect
+        self.old = old if already_applied else doc.template_rect
+        self._skip = already_applied
 
     def redo(self) -> None:
+        if self._skip:  # streamed in already (the template search animates the rectangle)
+            self._skip = False
+            return
         self.doc.apply_template_rect(self.new)
 
     def undo(self) -> None:

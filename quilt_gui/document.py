@@ -176,6 +176,12 @@ class Document(QObject):
             return
         self.undo_stack.push(commands.SetTemplateRect(self, rect, merge_id=merge_id, text=text))
 
+    def commit_template_rect(self, old, *, text: str = "Find best tile") -> None:
+        """One undo step for a rectangle the template search already streamed in."""
+        if old != self.template_rect:
+            self.undo_stack.push(commands.SetTemplateRect(
+                self, self.template_rect, text=text, old=old, already_applied=True))
+
     def add_waypoint(self, key: str, point: tuple[int, int]) -> None:
         pt = (int(point[0]), int(point[1]))
         if pt in self.waypoints[key]:
@@ -293,13 +299,15 @@ class Document(QObject):
 
     # ------------------------------------------------------------------ whole-document changes
     def clamp_rect(self, rect) -> tuple[int, int, int, int]:
-        """``rect`` (x, y, w, h) moved and shrunk to lie inside the source."""
+        """``rect`` (x, y, w, h) moved and shrunk so its footprint (the rectangle plus the
+        overlap to the right and below) lies inside the source."""
         x, y, w, h = (int(round(v)) for v in rect)
         if self.source is None:
             return x, y, max(1, w), max(1, h)
         H, W = self.source.shape
-        w, h = max(1, min(w, W)), max(1, min(h, H))
-        x, y = min(max(0, x), W - w), min(max(0, y), H - h)
+        e = min(int(self.params["overlap"]), max(0, min(H, W) - 1))
+        w, h = max(1, min(w, W - e)), max(1, min(h, H - e))
+        x, y = min(max(0, x), W - e - w), min(max(0, y), H - e - h)
         return x, y, w, h
 
     def set_source(self, source: Source, *, name: str | None = None) -> None:
@@ -444,10 +452,10 @@ class Document(QObject):
 
 
 def _tile_maps(seamless, names: list[str]) -> dict[str, np.ndarray] | None:
-    """Per-map template tiles of an engine SeamlessTile (``maps`` when it has material maps)."""
-    maps = getattr(seamless, "maps", None)
-    if isinstance(maps, dict) and all(m in maps for m in names):
-        return {m: maps[m] for m in names}
-    if len(names) == 1:
-        return {names[0]: seamless.tile}
-    return None
+    """Per-map template tiles of an engine SeamlessTile: the main map is ``tile``, the
+    material maps are in ``maps``; None if a map is missing (a result from before it was
+    attached)."""
+    maps = {names[0]: seamless.tile, **dict(seamless.maps or {})}
+    if not all(m in maps for m in names):
+        return None
+    return {m: maps[m] for m in names}

@@ -311,6 +311,12 @@ class JobManager(QObject):
         if job is not None:
             job.abort()
 
+    def abort_matching(self, prefix: str) -> None:
+        """Abort every current job whose key starts with ``prefix``."""
+        for key, job in list(self._jobs.items()):
+            if key.startswith(prefix):
+                job.abort()
+
     def stop_all(self) -> None:
         for job in list(self._running):
             job.stop()

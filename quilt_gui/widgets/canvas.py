@@ -286,6 +286,11 @@ class ImageCanvas(QGraphicsView):
         """View coordinates of the centre of pixel (row, col) (for tests and tooltips)."""
         return QPointF(self.mapFromScene(QPointF(col + 0.5, row + 0.5)))
 
+    def hide_scrollbars(self) -> None:
+        """For small panels: pan by dragging only."""
+        self.setHorizontalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+        self.setVerticalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+
     def add_item(self, item: QGraphicsItem) -> QGraphicsItem:
         self.scene().addItem(item)
         if isinstance(item, QGraphicsPixmapItem):

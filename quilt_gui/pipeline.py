@@ -1,0 +1,374 @@
+"""The engine runs for the document: background jobs started on edits, results written back.
+
+:class:`Pipeline` listens to the document; when an input of a derived result changes
+(the template rectangle, a seam parameter, a waypoint) it restarts the matching job,
+which supersedes the running one, so results of stale inputs are never applied.
+Long user actions (find template, generate candidates, quilting) are methods here.
+Messages for the user go out through :attr:`Pipeline.message` (level, text).
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import replace
+
+import numpy as np
+from PySide6.QtCore import QObject, QTimer, Signal, Slot
+
+from engine.cancel import Cancelled
+from quilt_gui import jobs, params
+from quilt_gui.document import CandidateEntry, Document
+
+log = logging.getLogger(__name__)
+
+__all__ = ["Pipeline", "error_text"]
+
+
+def error_text(exc: BaseException) -> str:
+    """A one-line message for the user (no traceback)."""
+    cause = exc.__cause__ if isinstance(exc, jobs.JobError) and exc.__cause__ else exc
+    text = str(cause) or type(cause).__name__
+    return text.splitlines()[0] if text else type(cause).__name__
+
+
+class Pipeline(QObject):
+    """Runs the engine for ``doc`` in the background."""
+
+    message = Signal(str, str)  # level ("info" | "warning" | "error"), text
+    seam_updated = Signal(object)  # engine.tiles.seamless.SeamlessUpdate, live
+    template_searching = Signal(bool)
+
+    def __init__(self, doc: Document, manager: jobs.JobManager | None = None,
+                 parent=None) -> None:
+        super().__init__(parent)
+        self.doc = doc
+        self.jobs = manager or jobs.manager()
+        self.seamless_inputs = None  # the inputs doc.seamless was computed from
+        self._seamless_pending = None
+        self._template_old_rect = None
+        self._seamless_timer = QTimer(self)
+        self._seamless_timer.setSingleShot(True)
+        self._seamless_timer.setInterval(0)
+        self._seamless_timer.timeout.connect(self._start_seamless)
+        doc.source_changed.connect(self._on_source_changed)
+        doc.maps_changed.connect(self.schedule_seamless)
+        doc.template_changed.connect(self.schedule_seamless)
+        doc.waypoints_changed.connect(self.schedule_seamless)
+        doc.params_changed.connect(self._on_params_changed)
+        self._preview_timer = QTimer(self)
+        self._preview_timer.setSingleShot(True)
+        self._preview_timer.setInterval(0)
+        self._preview_timer.timeout.connect(self._start_preview)
+        doc.picks_changed.connect(self.schedule_preview)
+        doc.candidates_reset.connect(self.schedule_preview)
+        doc.candidate_changed.connect(self._on_candidate_changed)
+        self._gen_old = ([], [])
+        self._remake_text = ""
+
+    # ------------------------------------------------------------------ helpers
+    def _error(self, exc: BaseException) -> None:
+        self.message.emit("error", error_text(exc))
+
+    def _progress_only(self, _event) -> None:
+        pass
+
+    @Slot()
+    def _on_source_changed(self) -> None:
+        for key in ("template", "seamless", "candidates", "preview", "tile_metrics"):
+            self.jobs.abort(key)
+        self.jobs.abort_matching("candidate:")
+        self.seamless_inputs = None
+
+    @Slot(object)
+    def _on_params_changed(self, keys) -> None:
+        if keys & params.SEAMLESS_KEYS:
+            if "overlap" in keys and self.doc.template_rect is not None:
+                clamped = self.doc.clamp_rect(self.doc.template_rect)
+                if clamped != self.doc.template_rect:
+                    self.doc.apply_template_rect(clamped)
+                    return  # template_changed schedules the seamless job
+            self.schedule_seamless()
+        if keys & params.PREVIEW_KEYS:
+            self.schedule_preview()
+
+    @Slot(int)
+    def _on_candidate_changed(self, index: int) -> None:
+        if index in self.doc.picks:
+            self.schedule_preview()
+
+    def stop(self, key: str) -> None:
+        self.jobs.stop(key)
+
+    # ------------------------------------------------------------------ template search
+    def find_template(self) -> jobs.Job | None:
+        """Search the best tile rectangle; the rectangle animates as the search improves."""
+        from engine.tiles import iter_find_template
+
+        doc = self.doc
+        if doc.source is None:
+            self.message.emit("warning", "Open a source image first.")
+            return None
+        p = doc.params
+        self._template_old_rect = doc.template_rect
+        self.template_searching.emit(True)
+        return self.jobs.start(
+            "template", iter_find_template, doc.source.main, label="Finding the best tile",
+            tile_min=p["tile_min"], tile_max=max(p["tile_min"], p["tile_max"]),
+            overlap=p["overlap"], on_event=self._on_template_event,
+            on_done=self._on_template_done, on_error=self._on_template_error,
+            on_cancel=self._on_template_cancel,
+        )
+
+    def _on_template_event(self, event) -> None:
+        rect = getattr(event, "rect", None)
+        if rect is not None:
+            self.doc.apply_template_rect(rect)
+
+    def _on_template_done(self, template) -> None:
+        self.doc.apply_template_rect(template.rect)
+        self.doc.commit_template_rect(self._template_old_rect)
+        for note in template.warnings:
+            self.message.emit("warning", note)
+        x, y, w, h = template.rect
+        self.message.emit("info", f"Best tile: {w}x{h} at ({x}, {y}), border cost "
+                                  f"{template.cost:.4f}")
+        self.template_searching.emit(False)
+
+    def _on_template_error(self, exc) -> None:
+        self._restore_template_rect()
+        self._error(exc)
+
+    def _on_template_cancel(self) -> None:
+        self._restore_template_rect()
+        self.message.emit("info", "Template search cancelled.")
+
+    def _restore_template_rect(self) -> None:
+        if self.doc.template_rect != self._template_old_rect:
+            self.doc.apply_template_rect(self._template_old_rect)
+        self.template_searching.emit(False)
+
+    # ------------------------------------------------------------------ seamless tile
+    def seamless_request(self) -> tuple | None:
+        """(args, kwargs, inputs) of the seamless job for the current document, or None."""
+        doc = self.doc
+        if doc.source is None or doc.template_rect is None:
+            return None
+        p = doc.params
+        extra = {k: v for k, v in doc.source.maps.items() if k != doc.source.main_name}
+        wps = {k: list(v) for k, v in doc.waypoints.items() if v}
+        kwargs = dict(overlap=p["overlap"], method=p["method"], metric=p["metric"],
+                      blend=p["blend"], width=p["width"], rho=p["rho"],
+                      waypoints=wps or None, maps=extra or None, **params.seam_options(p))
+        inputs = (doc.template_rect, tuple(sorted((k, repr(v)) for k, v in kwargs.items()
+                                                  if k != "maps")), tuple(extra))
+        return (doc.source.main, doc.template_rect), kwargs, inputs
+
+    @Slot()
+    def schedule_seamless(self) -> None:
+        """Recompute the seamless tile soon (coalesces several edits in one event cycle)."""
+        self._seamless_timer.start()
+
+    @Slot()
+    def _start_seamless(self) -> None:
+        from engine.tiles import iter_make_seamless
+
+        req = self.seamless_request()
+        if req is None:
+            self.jobs.abort("seamless")
+            if self.doc.seamless is not None:
+                self.doc.apply_seamless(None)
+            self.seamless_inputs = None
+            return
+        args, kwargs, inputs = req
+        if inputs == self.seamless_inputs and self.jobs.get("seamless") is None:
+            return
+        self._seamless_pending = inputs
+        self.jobs.start("seamless", iter_make_seamless, *args, label="Stitching the tile",
+                        on_event=self._on_seamless_event, on_done=self._on_seamless_done,
+                        on_error=self._on_seamless_error, **kwargs)
+
+    def _on_seamless_event(self, event) -> None:
+        if hasattr(event, "which") and hasattr(event, "path_source"):
+            self.seam_updated.emit(event)
+
+    def _on_seamless_done(self, result) -> None:
+        self.seamless_inputs = self._seamless_pending
+        self.doc.apply_seamless(result)
+        for note in result.warnings:
+            self.message.emit("warning", note)
+
+    def _on_seamless_error(self, exc) -> None:
+        self.seamless_inputs = None
+        if self.doc.seamless is not None:
+            self.doc.apply_seamless(None)
+        if not isinstance(exc, Cancelled):
+            self._error(exc)
+
+    # ------------------------------------------------------------------ candidates
+    def _tile_options(self) -> dict:
+        """Seam and patch options of the candidate calls (from the parameters)."""
+        p = self.doc.params
+        extra = {k: v for k, v in self.doc.source.maps.items() if k != self.doc.source.main_name}
+        return dict(
+            patch_size=p["patch_size"] or None, patch_overlap=p["patch_overlap"] or None,
+            margin=p["margin"], method=p["method"], metric=p["metric"], blend=p["blend"],
+            width=p["width"], rho=p["rho"], maps=extra or None, **params.seam_options(p))
+
+    def _template_ready(self) -> bool:
+        doc = self.doc
+        if doc.source is None:
+            self.message.emit("warning", "Open a source image first.")
+            return False
+        if doc.seamless is None or self.seamless_inputs is None:
+            self.message.emit("warning", "Make the seamless tile first: draw the tile rectangle "
+                                         "or use Find best tile.")
+            return False
+        return True
+
+    def entry_from(self, c) -> CandidateEntry:
+        """A document entry from an engine CandidateTile (all material maps, scores)."""
+        maps = {self.doc.source.main_name: c.tile, **dict(c.maps)}
+        loop_len = max(1, len(c.loop))
+        return CandidateEntry(
+            maps=maps, patch_origin=tuple(int(v) for v in c.patch_origin),
+            patch_rect=tuple(int(v) for v in c.patch_rect), seed=c.seed,
+            score=float(c.scores["criterion"]) / loop_len, scores=dict(c.scores),
+            loop=np.asarray(c.loop))
+
+    def generate_candidates(self) -> jobs.Job | None:
+        """Stream ``n_candidates`` new variants into the document (locked ones are kept)."""
+        from engine.tiles import iter_candidates
+
+        if not self._template_ready():
+            return None
+        doc = self.doc
+        template = np.asarray(doc.seamless.tile)
+        m = max(1, int(doc.params["margin"]))
+        keep, keep_picks, dropped = [], [], 0
+        for i, e in enumerate(doc.candidates):
+            if not e.locked:
+                continue
+            if e.tile.shape != template.shape or not _same_border(e.tile, template, m):
+                dropped += 1
+                continue
+            if i in doc.picks:
+                keep_picks.append((doc.picks.index(i), len(keep)))
+            keep.append(e)
+        if dropped:
+            self.message.emit("warning", f"{dropped} locked candidate(s) were made from another "
+                                         "template and do not connect to this one; dropped.")
+        self.jobs.abort_matching("candidate:")
+        self._gen_old = (list(doc.candidates), list(doc.picks))
+        doc.apply_candidates(keep, [k for _, k in sorted(keep_picks)])
+        n = int(doc.params["n_candidates"]) - len(keep)
+        if n <= 0:
+            self._on_candidates_done([])
+            return None
+        return self.jobs.start(
+            "candidates", iter_candidates, doc.source.main, doc.seamless, n,
+            label=f"Generating {n} candidates", rng=int(doc.params["seed"]),
+            neighbourhood=doc.params["neighbourhood"], workers=2,
+            on_event=self._on_candidate_event, on_done=self._on_candidates_done,
+            on_error=self._on_candidates_error, **self._tile_options())
+
+    def _on_candidate_event(self, event) -> None:
+        if hasattr(event, "tile") and hasattr(event, "patch_rect"):
+            self.doc.append_candidate(self.entry_from(event))
+
+    def _on_candidates_done(self, _result) -> None:
+        doc = self.doc
+        doc.set_candidates(list(doc.candidates), list(doc.picks), text="Generate candidates",
+                           old=self._gen_old, already_applied=True)
+        self.message.emit("info", f"{len(doc.candidates)} candidates. Click to pick the tiles "
+                                  "to keep; double-click to open one.")
+
+    def _on_candidates_error(self, exc) -> None:
+        self._on_candidates_done(None)
+        self._error(exc)
+
+    def remake_candidate(self, index: int, *, origin=None) -> jobs.Job | None:
+        """Re-roll candidate ``index`` (new random patch) or rebuild it from ``origin``."""
+        from engine.tiles import make_candidate
+
+        if not self._template_ready() or not 0 <= index < len(self.doc.candidates):
+            return None
+        doc = self.doc
+        kw = self._tile_options()
+        if origin is None:
+            kw.update(rng=int(np.random.default_rng().integers(2**31)),
+                      neighbourhood=doc.params["neighbourhood"])
+            text = f"Re-roll candidate #{index + 1}"
+        else:
+            kw.update(patch_origin=(int(origin[0]), int(origin[1])))
+            text = f"Move patch of candidate #{index + 1}"
+        self._remake_text = text
+        return self.jobs.start(
+            f"candidate:{index}", make_candidate, doc.source.main, doc.seamless, index=index,
+            label=text, on_done=self._on_remade, on_error=self._on_remake_error, **kw)
+
+    def _on_remade(self, c) -> None:
+        index = int(c.index)
+        if index >= len(self.doc.candidates):
+            return
+        entry = replace(self.entry_from(c), weight=self.doc.candidates[index].weight)
+        self.doc.replace_candidate(index, entry, text=self._remake_text)
+
+    def _on_remake_error(self, exc) -> None:
+        self._error(exc)
+        self.doc.candidate_changed.emit(-1)  # views put the patch rectangle back
+
+    # ------------------------------------------------------------------ preview
+    @Slot()
+    def schedule_preview(self) -> None:
+        self._preview_timer.start()
+
+    @Slot()
+    def _start_preview(self) -> None:
+        doc = self.doc
+        tiles = [e.tile for e in doc.picked_entries()]
+        if not tiles or doc.source is None:
+            self.jobs.abort("preview")
+            if doc.preview is not None or doc.layout is not None:
+                doc.apply_layout(None)
+                doc.apply_preview(None, None)
+            return
+        p = doc.params
+        weights = [e.weight for e in doc.picked_entries()]
+        self.jobs.start("preview", make_preview, tiles, doc.source.main, label="Preview",
+                        rows=p["preview_rows"], cols=p["preview_cols"], seed=p["layout_seed"],
+                        no_equal_neighbours=p["no_equal_neighbours"], weights=weights,
+                        on_done=self._on_preview_done, on_error=self._error)
+
+    def _on_preview_done(self, result) -> None:
+        layout, image, score = result
+        self.doc.apply_layout(layout)
+        self.doc.apply_preview(image, score)
+
+    def reroll_layout(self) -> None:
+        """A new random layout for the preview (one undo step: the layout seed changes)."""
+        seed = int(np.random.default_rng().integers(2**31 - 1))
+        self.doc.set_param("layout_seed", seed)
+
+
+def make_preview(tiles, source, *, rows, cols, seed, no_equal_neighbours, weights, cancel=None):
+    """(layout, image, grid score) of the picked tiles (runs in a worker)."""
+    from engine.metrics import grid_score
+    from engine.tiles import assemble, random_layout
+
+    n = len(tiles)
+    if n < 2 or sum(w > 0 for w in weights) < 2:
+        no_equal_neighbours = False
+    layout = random_layout(n, rows, cols, rng=seed, no_equal_neighbours=no_equal_neighbours,
+                           weights=weights)
+    image = assemble(tiles, layout)
+    th, tw = tiles[0].shape[:2]
+    score = None
+    if rows * cols > 1:
+        score = float(grid_score(image, (th, tw), source=source))
+    return layout, image, score
+
+
+def _same_border(a: np.ndarray, b: np.ndarray, m: int) -> bool:
+    """True when the outer ``m`` pixels of two tiles are equal (they connect)."""
+    return bool(np.array_equal(a[:m], b[:m]) and np.array_equal(a[-m:], b[-m:])
+                and np.array_equal(a[:, :m], b[:, :m]) and np.array_equal(a[:, -m:], b[:, -m:]))

@@ -1,0 +1,186 @@
+"""Export dialog: the bundle options of :func:`engine.project.export_project`, run in the
+background. Non-modal; errors are shown in the dialog and as a message, never a popup."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from PySide6.QtCore import Signal, Slot
+from PySide6.QtWidgets import (
+    QCheckBox,
+    QComboBox,
+    QDialog,
+    QDialogButtonBox,
+    QFileDialog,
+    QFormLayout,
+    QHBoxLayout,
+    QLabel,
+    QLineEdit,
+    QPushButton,
+    QSpinBox,
+    QVBoxLayout,
+    QWidget,
+)
+
+from engine.project import export_project
+from quilt_gui import jobs, settings
+from quilt_gui.document import Document, safe_name
+from quilt_gui.pipeline import error_text
+
+
+def _spin(lo: int, hi: int, value: int, tip: str, special: str | None = None) -> QSpinBox:
+    s = QSpinBox()
+    s.setRange(lo, hi)
+    s.setValue(value)
+    s.setToolTip(tip)
+    if special:
+        s.setSpecialValueText(special)
+    return s
+
+
+class ExportDialog(QDialog):
+    """Folder, name, atlas layout, bit depth and formats of the export bundle."""
+
+    message = Signal(str, str)  # level, text
+    exported = Signal(object)  # the manifest
+
+    def __init__(self, doc: Document, manager: jobs.JobManager, parent=None) -> None:
+        super().__init__(parent)
+        self.setWindowTitle("Export tile set")
+        self.setModal(False)
+        self.doc = doc
+        self.jobs = manager
+        self.manifest: dict | None = None
+        self.folder = QLineEdit()
+        self.folder.setToolTip("The bundle is written into this folder (created; it must be "
+                               "empty unless Overwrite is on)")
+        browse = QPushButton("Browse…")
+        browse.clicked.connect(self._browse)
+        row = QHBoxLayout()
+        row.setContentsMargins(0, 0, 0, 0)
+        row.addWidget(self.folder, 1)
+        row.addWidget(browse)
+        folder_row = QWidget()
+        folder_row.setLayout(row)
+        self.name = QLineEdit()
+        self.name.setToolTip("File-name prefix: {name}_{index:03}_{map}.png")
+        self.columns = _spin(0, 256, 0, "Tiles per atlas row (0 = about square)", "auto")
+        self.spacing = _spin(0, 64, 0, "Pixels between atlas tiles")
+        self.margin = _spin(0, 64, 0, "Pixels around the atlas")
+        self.extrude = _spin(0, 16, 0, "Repeat each tile's edge pixels this many times around "
+                                       "it (stops bleeding between atlas tiles)")
+        self.bit_depth = QComboBox()
+        self.bit_depth.addItems(["Same as the source", "8 bit", "16 bit"])
+        self.bit_depth.setToolTip("Bits per channel of the written images")
+        self.dither = QCheckBox("Dither when reducing 16 → 8 bit")
+        self.dither.setChecked(True)
+        self.tile_format = QComboBox()
+        self.tile_format.addItems(["png", "tif"])
+        self.tile_format.setToolTip("Format of the per-tile and preview images (atlases are PNG)")
+        self.normal = QComboBox()
+        self.normal.addItems(["opengl", "directx"])
+        self.normal.setToolTip("Normal-map convention recorded in the manifest")
+        self.overwrite = QCheckBox("Overwrite an existing bundle in that folder")
+        self.summary = QLabel()
+        self.summary.setWordWrap(True)
+        self.status = QLabel()
+        self.status.setWordWrap(True)
+        form = QFormLayout()
+        form.addRow("Folder", folder_row)
+        form.addRow("Name", self.name)
+        form.addRow("Atlas columns", self.columns)
+        form.addRow("Spacing", self.spacing)
+        form.addRow("Margin", self.margin)
+        form.addRow("Edge extrusion", self.extrude)
+        form.addRow("Bit depth", self.bit_depth)
+        form.addRow("", self.dither)
+        form.addRow("Tile format", self.tile_format)
+        form.addRow("Normal maps", self.normal)
+        form.addRow("", self.overwrite)
+        self.buttons = QDialogButtonBox()
+        self.export_button = self.buttons.addButton("Export",
+                                                    QDialogButtonBox.ButtonRole.AcceptRole)
+        self.buttons.addButton(QDialogButtonBox.StandardButton.Close)
+        self.buttons.accepted.connect(self.export)
+        self.buttons.rejected.connect(self.close)
+        lay = QVBoxLayout(self)
+        lay.addWidget(self.summary)
+        lay.addLayout(form)
+        lay.addWidget(self.status)
+        lay.addWidget(self.buttons)
+        self.resize(560, 0)
+
+    def refresh(self) -> None:
+        """Defaults from the document and the last export folder."""
+        doc = self.doc
+        self.name.setText(doc.name)
+        base = settings.get("last_export_dir") or str(Path.home())
+        self.folder.setText(str(Path(base) / f"{doc.name}_export"))
+        n = len(doc.picks) or len(doc.candidates)
+        what = "picked" if doc.picks else "(none picked: all)"
+        maps = list(doc.source.maps) if doc.source else []
+        size = ""
+        if doc.candidates:
+            h, w = doc.candidates[0].tile.shape[:2]
+            size = f", {w}×{h} px"
+        lay = "" if doc.layout is None else f", preview layout {doc.layout.shape[0]}×" \
+                                            f"{doc.layout.shape[1]}"
+        depth = doc.source.bit_depth if doc.source else 8
+        self.summary.setText(f"<b>{n}</b> tiles {what}{size}; maps: {', '.join(maps)}; "
+                             f"source {depth}-bit{lay}.")
+        self.normal.setEnabled("normal" in (doc.source.kinds.values() if doc.source else ()))
+        self.status.setText("")
+
+    def options(self) -> dict:
+        """Keyword options of :func:`engine.project.export_project` from the widgets."""
+        depth = {0: None, 1: 8, 2: 16}[self.bit_depth.currentIndex()]
+        return dict(
+            columns=self.columns.value() or None, spacing=self.spacing.value(),
+            margin=self.margin.value(), extrude=self.extrude.value(), bit_depth=depth,
+            dither=self.dither.isChecked() if depth == 8 else None,
+            tile_format=self.tile_format.currentText(), overwrite=self.overwrite.isChecked(),
+            normal_convention=self.normal.currentText())
+
+    @Slot()
+    def _browse(self) -> None:
+        path = QFileDialog.getExistingDirectory(self, "Export into folder", self.folder.text())
+        if path:
+            self.folder.setText(path)
+
+    @Slot()
+    def export(self) -> jobs.Job | None:
+        """Start the export in the background."""
+        folder = self.folder.text().strip()
+        if not folder:
+            self._fail("Choose a folder to export into.")
+            return None
+        try:
+            project = self.doc.to_project()
+        except ValueError as exc:
+            self._fail(str(exc))
+            return None
+        project.name = safe_name(self.name.text() or self.doc.name)
+        self.export_button.setEnabled(False)
+        self.status.setText("Exporting…")
+        self._folder = folder
+        return self.jobs.start("export", export_project, project, folder, label="Exporting",
+                               pass_cancel=False, on_done=self._on_done,
+                               on_error=self._on_error, **self.options())
+
+    def _on_done(self, manifest: dict) -> None:
+        self.manifest = manifest
+        self.export_button.setEnabled(True)
+        settings.set("last_export_dir", str(Path(self._folder).parent))
+        n = len(manifest.get("tiles", []))
+        text = f"Exported {n} tiles to {self._folder}."
+        self.status.setText(text)
+        self.message.emit("info", text)
+        self.exported.emit(manifest)
+
+    def _on_error(self, exc) -> None:
+        self.export_button.setEnabled(True)
+        self._fail(f"Export failed: {error_text(exc)}")
+
+    def _fail(self, text: str) -> None:
+        self.status.setText(f"<span style='color:#ff7070'>{text}</span>")
+        self.message.emit("error", text)

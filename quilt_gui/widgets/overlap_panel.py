@@ -1,0 +1,255 @@
+"""Side panel: each overlap's two regions and its error map, with the seam and waypoints.
+
+Click on any of the three panels to add a waypoint the seam must pass through;
+right-click near a waypoint to remove it. The same view shows a quilting block's
+overlap in quilting mode (:meth:`OverlapView.show_overlap`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from PySide6.QtCore import Qt, Signal, Slot
+from PySide6.QtGui import QColor, QFont
+from PySide6.QtWidgets import (
+    QGraphicsItem,
+    QGraphicsSimpleTextItem,
+    QHBoxLayout,
+    QLabel,
+    QPushButton,
+    QSplitter,
+    QVBoxLayout,
+    QWidget,
+)
+
+from quilt_gui.document import Document
+from quilt_gui.imaging import heat_rgba, to_uint8
+from quilt_gui.pipeline import Pipeline
+from quilt_gui.widgets.canvas import ImageCanvas, PixelSetItem
+from quilt_gui.widgets.source_view import SEAM_COLORS, WaypointItem, nearest_waypoint
+
+GAP = 3  # pixels between the three panels
+
+
+def _rgba(a: np.ndarray) -> np.ndarray:
+    u = to_uint8(a)
+    if u.shape[2] == 1:
+        u = np.repeat(u, 3, axis=2)
+    if u.shape[2] == 3:
+        u = np.concatenate([u, np.full(u.shape[:2] + (1,), 255, np.uint8)], axis=2)
+    return u
+
+
+class OverlapView(ImageCanvas):
+    """R1, R2 and the error map of one overlap side by side (or stacked), seam on each."""
+
+    waypoint_added = Signal(object)  # (row, col) in the overlap frame
+    waypoint_removed = Signal(object)
+
+    def __init__(self, color="#7dff5f", parent=None) -> None:
+        super().__init__(parent)
+        self.setDragMode(ImageCanvas.DragMode.NoDrag)
+        self.hide_scrollbars()
+        self.frame_shape: tuple[int, int] | None = None
+        self.offsets: list[tuple[int, int]] = []  # (x, y) of each panel
+        self.paths = [PixelSetItem(color) for _ in range(3)]
+        for p in self.paths:
+            self.add_item(p)
+        self.labels: list[QGraphicsSimpleTextItem] = []
+        self.waypoints: list[tuple[int, int]] = []
+        self._wp_items: list[WaypointItem] = []
+        self.setToolTip("Click: add a waypoint the seam must pass through\n"
+                        "Right-click: remove the nearest waypoint")
+
+    def show_overlap(self, r1, r2, error, *, stacked: bool, names=("R1", "R2", "error")) -> None:
+        """Show the regions and the error map; ``stacked`` puts them one above the other."""
+        error = np.asarray(error)
+        h, w = error.shape
+        panels = [_rgba(r1), _rgba(r2), heat_rgba(error)]
+        if stacked:
+            canvas = np.zeros((3 * h + 2 * GAP, w, 4), np.uint8)
+            self.offsets = [(0, i * (h + GAP)) for i in range(3)]
+        else:
+            canvas = np.zeros((h, 3 * w + 2 * GAP, 4), np.uint8)
+            self.offsets = [(i * (w + GAP), 0) for i in range(3)]
+        for (ox, oy), p in zip(self.offsets, panels, strict=True):
+            canvas[oy:oy + h, ox:ox + w] = p
+        refit = self.frame_shape != (h, w)
+        self.frame_shape = (h, w)
+        self.set_image(canvas, fit=refit)
+        for item in self.labels:
+            self.scene().removeItem(item)
+        self.labels = []
+        font = QFont()
+        font.setPointSize(8)
+        for (ox, oy), name in zip(self.offsets, names, strict=True):
+            t = QGraphicsSimpleTextItem(name)
+            t.setFont(font)
+            t.setBrush(QColor(230, 230, 230))
+            t.setFlag(QGraphicsItem.GraphicsItemFlag.ItemIgnoresTransformations)
+            t.setPos(ox, oy - 0.5)
+            t.setZValue(50)
+            self.scene().addItem(t)
+            self.labels.append(t)
+        self._layout_labels()
+
+    def _layout_labels(self) -> None:
+        # labels sit above each panel, in screen pixels
+        for t, (ox, oy) in zip(self.labels, self.offsets, strict=False):
+            t.setPos(ox, oy - 14.0 / max(self.zoom, 1e-6))
+
+    def set_zoom(self, zoom, anchor=None) -> None:
+        super().set_zoom(zoom, anchor)
+        self._layout_labels()
+
+    def fit(self) -> None:
+        super().fit()
+        self._layout_labels()
+
+    def clear(self) -> None:
+        self.frame_shape = None
+        self.set_image(None)
+        for p in self.paths:
+            p.hide()
+        for item in self.labels:
+            self.scene().removeItem(item)
+        self.labels = []
+        self.set_waypoints([])
+
+    def set_path(self, path) -> None:
+        if self.frame_shape is None or path is None:
+            for p in self.paths:
+                p.hide()
+            return
+        for item, (ox, oy) in zip(self.paths, self.offsets, strict=True):
+            item.set_points(path, (ox, oy))
+            item.show()
+
+    def set_waypoints(self, points) -> None:
+        for it in self._wp_items:
+            self.scene().removeItem(it)
+        self._wp_items = []
+        self.waypoints = [tuple(p) for p in points]
+        if self.frame_shape is None:
+            return
+        for r, c in self.waypoints:
+            for ox, oy in self.offsets:
+                it = WaypointItem(r + oy, c + ox)
+                self.scene().addItem(it)
+                self._wp_items.append(it)
+
+    def frame_point(self, view_pos) -> tuple[int, int] | None:
+        """(row, col) in the overlap frame under a view position (any of the panels)."""
+        px = self.pixel_at(view_pos)
+        if px is None or self.frame_shape is None:
+            return None
+        r, c = px
+        h, w = self.frame_shape
+        for ox, oy in self.offsets:
+            if ox <= c < ox + w and oy <= r < oy + h:
+                return r - oy, c - ox
+        return None
+
+    def mousePressEvent(self, event) -> None:  # noqa: N802 - Qt API
+        pt = self.frame_point(event.position())
+        if pt is None:
+            super().mousePressEvent(event)
+            return
+        if event.button() == Qt.MouseButton.RightButton:
+            near = nearest_waypoint(self.waypoints, pt)
+            if near is not None:
+                self.waypoint_removed.emit(near)
+        elif event.button() == Qt.MouseButton.LeftButton:
+            self.waypoint_added.emit(pt)
+        event.accept()
+
+
+class OverlapPanel(QWidget):
+    """The two overlaps of the template (horizontal: R_R | R_L, vertical: R_B / R_T)."""
+
+    def __init__(self, doc: Document, pipeline: Pipeline, parent=None) -> None:
+        super().__init__(parent)
+        self.doc = doc
+        self.views = {"horizontal": OverlapView(SEAM_COLORS["horizontal"]),
+                      "vertical": OverlapView(SEAM_COLORS["vertical"])}
+        self.labels = {k: QLabel() for k in self.views}
+        lay = QVBoxLayout(self)
+        lay.setContentsMargins(4, 4, 4, 4)
+        split = QSplitter(Qt.Orientation.Vertical)
+        for which, title in (("horizontal", "Left / right overlap (R_R over R_L)"),
+                             ("vertical", "Top / bottom overlap (R_B over R_T)")):
+            box = QWidget()
+            bl = QVBoxLayout(box)
+            bl.setContentsMargins(0, 0, 0, 0)
+            head = QLabel(f"<b>{title}</b>")
+            bl.addWidget(head)
+            bl.addWidget(self.views[which], 1)
+            bl.addWidget(self.labels[which])
+            split.addWidget(box)
+            self.views[which].waypoint_added.connect(getattr(self, f"_add_{which}"))
+            self.views[which].waypoint_removed.connect(getattr(self, f"_remove_{which}"))
+        lay.addWidget(split, 1)
+        row = QHBoxLayout()
+        self.clear_button = QPushButton("Clear waypoints")
+        self.clear_button.setToolTip("Remove every waypoint of both seams")
+        self.clear_button.clicked.connect(doc.clear_waypoints)
+        row.addStretch(1)
+        row.addWidget(self.clear_button)
+        lay.addLayout(row)
+        doc.seamless_changed.connect(self._on_seamless_changed)
+        doc.waypoints_changed.connect(self._on_waypoints_changed)
+        pipeline.seam_updated.connect(self._on_seam_updated)
+        self._on_seamless_changed()
+
+    @Slot(object)
+    def _add_horizontal(self, pt) -> None:
+        self.doc.add_waypoint("horizontal", pt)
+
+    @Slot(object)
+    def _add_vertical(self, pt) -> None:
+        self.doc.add_waypoint("vertical", pt)
+
+    @Slot(object)
+    def _remove_horizontal(self, pt) -> None:
+        self.doc.remove_waypoint("horizontal", pt)
+
+    @Slot(object)
+    def _remove_vertical(self, pt) -> None:
+        self.doc.remove_waypoint("vertical", pt)
+
+    @Slot()
+    def _on_seamless_changed(self) -> None:
+        s = self.doc.seamless
+        if s is None:
+            for which, v in self.views.items():
+                v.clear()
+                self.labels[which].setText("No tile yet: draw a rectangle or Find best tile.")
+            return
+        reg = s.regions
+        self.views["horizontal"].show_overlap(reg["R_R"], reg["R_L"], s.errors["horizontal"],
+                                              stacked=False, names=("R_R", "R_L", "E"))
+        self.views["vertical"].show_overlap(reg["R_B"], reg["R_T"], s.errors["vertical"],
+                                            stacked=True, names=("R_B", "R_T", "E"))
+        for which, v in self.views.items():
+            v.set_path(s.paths[which])
+            self.labels[which].setText(
+                f"seam criterion {s.criterion[which]:.3f}   peak {s.peak[which]:.3f}   "
+                f"({s.seams[which].method})")
+        self._on_waypoints_changed()
+
+    @Slot(object)
+    def _on_seam_updated(self, update) -> None:
+        v = self.views.get(update.which)
+        if v is None or v.frame_shape is None:
+            return
+        path = np.asarray(update.path)
+        h, w = v.frame_shape
+        if path.size and (path[:, 0].max() >= h or path[:, 1].max() >= w):
+            return  # a different rectangle: wait for its result
+        v.set_path(path)
+        self.labels[update.which].setText(
+            f"searching... criterion {update.seam.criterion:.3f}   peak {update.seam.peak:.3f}")
+
+    @Slot()
+    def _on_waypoints_changed(self) -> None:
+        for which, v in self.views.items():
+            v.set_waypoints(self.doc.waypoints[which])

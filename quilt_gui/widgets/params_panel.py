@@ -1,0 +1,156 @@
+"""The parameters panel, built from :data:`quilt_gui.params.PARAMS`.
+
+Every widget edits the document through :meth:`Document.set_param`; a slider drag shares
+one merge id, so it is one undo step. Document changes (undo, project load) update the
+widgets with their signals blocked.
+"""
+
+from __future__ import annotations
+
+from functools import partial
+
+from PySide6.QtCore import Qt, Slot
+from PySide6.QtWidgets import (
+    QCheckBox,
+    QComboBox,
+    QFormLayout,
+    QGroupBox,
+    QHBoxLayout,
+    QLabel,
+    QScrollArea,
+    QSizePolicy,
+    QSpinBox,
+    QToolButton,
+    QVBoxLayout,
+    QWidget,
+)
+from superqt import QLabeledDoubleSlider, QLabeledSlider
+from superqt.utils import signals_blocked
+
+from quilt_gui import params
+from quilt_gui.commands import new_merge_id
+from quilt_gui.document import Document
+
+#: Integer parameters edited with a slider (the rest use spin boxes).
+SLIDERS = frozenset({"overlap", "o_max", "max_run", "width", "rho", "margin", "neighbourhood",
+                     "iterations"})
+TILESET_GROUPS = ("Template", "Seam", "Candidates", "Preview")
+QUILT_GROUPS = ("Quilting", "Transfer")
+
+
+class ParamsPanel(QScrollArea):
+    """Group boxes of parameter widgets plus the actions of each step."""
+
+    def __init__(self, doc: Document, actions: dict[str, list] | None = None,
+                 parent=None) -> None:
+        super().__init__(parent)
+        self.doc = doc
+        self.widgets: dict[str, QWidget] = {}
+        self.groups: dict[str, QGroupBox] = {}
+        self._merge: dict[str, int] = {}
+        body = QWidget()
+        lay = QVBoxLayout(body)
+        lay.setContentsMargins(6, 6, 6, 6)
+        for group in params.GROUPS:
+            box = QGroupBox(group)
+            form = QFormLayout(box)
+            form.setFieldGrowthPolicy(QFormLayout.FieldGrowthPolicy.AllNonFixedFieldsGrow)
+            form.setLabelAlignment(Qt.AlignmentFlag.AlignRight)
+            for p in params.PARAMS:
+                if p.group != group:
+                    continue
+                w = self._make_widget(p)
+                w.setToolTip(p.tip)
+                label = QLabel(p.label)
+                label.setToolTip(p.tip)
+                form.addRow(label, w)
+                self.widgets[p.key] = w
+            buttons = (actions or {}).get(group, [])
+            if buttons:
+                row = QHBoxLayout()
+                for action in buttons:
+                    b = QToolButton()
+                    b.setDefaultAction(action)
+                    b.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextOnly)
+                    b.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Fixed)
+                    row.addWidget(b)
+                form.addRow(row)
+            lay.addWidget(box)
+            self.groups[group] = box
+        lay.addStretch(1)
+        self.setWidget(body)
+        self.setMinimumWidth(body.sizeHint().width() + 24)
+        self.setWidgetResizable(True)
+        self.setHorizontalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+        doc.params_changed.connect(self._on_params_changed)
+        self._on_params_changed(frozenset(params.DEFAULTS))
+
+    def show_groups(self, groups) -> None:
+        """Show only these groups (the tile-set or the quilting mode)."""
+        for name, box in self.groups.items():
+            box.setVisible(name in groups)
+
+    # ------------------------------------------------------------------ widgets
+    def _make_widget(self, p: params.Param) -> QWidget:
+        key = p.key
+        if p.choices:
+            w = QComboBox()
+            w.addItems([str(c) for c in p.choices])
+            w.currentTextChanged.connect(partial(self._edit, key))
+            return w
+        if isinstance(p.default, bool):
+            w = QCheckBox()
+            w.toggled.connect(partial(self._edit, key))
+            return w
+        if isinstance(p.default, float):
+            w = QLabeledDoubleSlider(Qt.Orientation.Horizontal)
+            w.setRange(p.minimum, p.maximum)
+            w.setSingleStep(p.step)
+            w.setDecimals(p.decimals)
+        elif key in SLIDERS:
+            w = QLabeledSlider(Qt.Orientation.Horizontal)
+            w.setRange(int(p.minimum), int(p.maximum))
+        else:
+            w = QSpinBox()
+            w.setRange(int(p.minimum), int(p.maximum))
+            w.setKeyboardTracking(False)
+            w.setAccelerated(True)
+            w.valueChanged.connect(partial(self._edit, key))
+            return w
+        w.sliderPressed.connect(partial(self._drag_started, key))
+        w.sliderReleased.connect(partial(self._drag_ended, key))
+        w.valueChanged.connect(partial(self._edit, key))
+        return w
+
+    def _drag_started(self, key: str) -> None:
+        self._merge[key] = new_merge_id()
+
+    def _drag_ended(self, key: str) -> None:
+        self._merge.pop(key, None)
+
+    def _edit(self, key: str, value) -> None:
+        self.doc.set_param(key, value, merge_id=self._merge.get(key))
+
+    def value(self, key: str):
+        """What the widget of ``key`` shows (for tests)."""
+        w = self.widgets[key]
+        if isinstance(w, QComboBox):
+            return w.currentText()
+        if isinstance(w, QCheckBox):
+            return w.isChecked()
+        return w.value()
+
+    @Slot(object)
+    def _on_params_changed(self, keys) -> None:
+        for key in keys:
+            w = self.widgets.get(key)
+            if w is None:
+                continue
+            v = self.doc.params[key]
+            with signals_blocked(w):
+                if isinstance(w, QComboBox):
+                    w.setCurrentText(str(v))
+                elif isinstance(w, QCheckBox):
+                    w.setChecked(bool(v))
+                else:
+                    w.setValue(v)
