@@ -1,0 +1,449 @@
+"""``quilt-studio tileset SOURCE --out DIR``: template, seamless tile, candidates, preview.
+
+Writes into DIR (created if needed):
+
+- ``template.png``: the seamless template tile;
+- ``tile_000.png`` ...: every candidate (``tile_000_<map>.png`` for material maps);
+- ``manifest.json``: parameters, seed, template rectangle and costs, per-tile source
+  rectangle, seed and scores, picks, layout, warnings;
+- ``layout.csv`` / ``layout.json``: the preview's index matrix (cells are tile indices,
+  i.e. the NNN of ``tile_NNN.png``);
+- ``preview.png``: the picked tiles assembled by that matrix.
+
+Images keep the source's bit depth (16-bit in, 16-bit out) and channels. Progress goes to
+stderr, one line per step.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import io
+import json
+import re
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from engine.cli.export import add_project_option, save_project_option
+
+FORMAT = "quilt-studio-tileset"
+VERSION = 1
+MAIN_MAP = "albedo"  # the source's map name in a project file
+
+
+# ---------------------------------------------------------------- argument types
+def _size(text: str):
+    """``N`` or ``HxW`` -> int or (h, w)."""
+    m = re.fullmatch(r"\s*(\d+)\s*(?:[xX]\s*(\d+)\s*)?", text)
+    if not m:
+        raise argparse.ArgumentTypeError(f"expected N or HxW (e.g. 256 or 200x300), got {text!r}")
+    h = int(m.group(1))
+    w = int(m.group(2)) if m.group(2) else None
+    if h < 1 or (w is not None and w < 1):
+        raise argparse.ArgumentTypeError(f"sizes must be >= 1, got {text!r}")
+    return h if w is None else (h, w)
+
+
+def _int_at_least(minimum: int):
+    def parse(text: str) -> int:
+        try:
+            v = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
+        if v < minimum:
+            raise argparse.ArgumentTypeError(f"must be >= {minimum}, got {v}")
+        return v
+
+    return parse
+
+
+def _picks(text: str) -> list[int]:
+    try:
+        out = [int(t) for t in text.replace(" ", "").split(",") if t != ""]
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected comma-separated tile indices like 0,3,7, got {text!r}") from None
+    if not out or min(out) < 0 or len(set(out)) != len(out):
+        raise argparse.ArgumentTypeError(f"picks must be distinct indices >= 0, got {text!r}")
+    return out
+
+
+def _grid(text: str) -> tuple[int, int]:
+    v = _size(text)
+    return (v, v) if isinstance(v, int) else v
+
+
+def _named(kind: str):
+    def parse(text: str):
+        name, sep, value = text.partition("=")
+        if not sep or not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9._-]*", name):
+            raise argparse.ArgumentTypeError(f"expected NAME={kind.upper()}, got {text!r}")
+        if kind == "weight":
+            try:
+                return name, float(value)
+            except ValueError:
+                raise argparse.ArgumentTypeError(f"expected NAME=NUMBER, got {text!r}") from None
+        return name, value
+
+    return parse
+
+
+def _colour_range(text: str):
+    """``LO:HI`` with LO/HI one number or comma-separated per-channel numbers in [0, 1]."""
+    try:
+        lo, hi = text.split(":")
+        lo_v = [float(v) for v in lo.split(",")]
+        hi_v = [float(v) for v in hi.split(",")]
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected LO:HI like 0,0,0:0.2,0.2,0.25 or 0:0.1, got {text!r}") from None
+    return (lo_v[0] if len(lo_v) == 1 else lo_v, hi_v[0] if len(hi_v) == 1 else hi_v)
+
+
+def add_parser(subparsers) -> argparse.ArgumentParser:
+    from engine.blend import BLEND_MODES
+    from engine.errormap import METRICS
+    from engine.seams import METHODS
+
+    p = subparsers.add_parser(
+        "tileset",
+        help="make a seamless template tile and N mutually connectable candidate tiles",
+        description="Search the template tile in SOURCE, make it seamless, derive N candidate "
+        "tiles that all connect to each other (Somol & Haindl), and write them with a "
+        "manifest, an index matrix and a synthesized preview into DIR.",
+    )
+    p.add_argument("source", metavar="SOURCE", help="source texture (PNG, JPEG, TIFF, BMP, WebP)")
+    p.add_argument("--out", required=True, metavar="DIR", help="output folder (created)")
+    p.add_argument("--candidates", type=_int_at_least(1), default=30, metavar="N",
+                   help="number of candidate tiles (default 30)")
+    p.add_argument("--tile-min", type=_size, default=None, metavar="N|HxW",
+                   help="smallest tile (default: a quarter of the source's shorter side)")
+    p.add_argument("--tile-max", type=_size, default=None, metavar="N|HxW",
+                   help="largest tile (default: half the source's shorter side)")
+    p.add_argument("--rect", default=None, metavar="X,Y,W,H",
+                   help="use this tile rectangle instead of searching one")
+    p.add_argument("--overlap", type=_int_at_least(2), default=None, metavar="N",
+                   help="w_T, width of the template's border regions (default: tile/10)")
+    p.add_argument("--patch-overlap", type=_int_at_least(2), default=None, metavar="N",
+                   help="w_P, the ring the patch cut runs in (default: --overlap)")
+    p.add_argument("--patch-size", type=_size, default=None, metavar="N|HxW",
+                   help="patch window (default: the tile size)")
+    p.add_argument("--margin", type=_int_at_least(0), default=2, metavar="N",
+                   help="outer pixels every candidate keeps from the template (default 2)")
+    p.add_argument("--neighbourhood", type=_int_at_least(0), default=5, metavar="N",
+                   help="refine each random patch position within +-N px (default 5)")
+    p.add_argument("--seam", choices=METHODS, default="dp", help="seam method (default dp)")
+    p.add_argument("--metric", choices=METRICS, default="euclid", help="error metric")
+    p.add_argument("--blend", choices=BLEND_MODES, default=None,
+                   help="blending of every cut (default: none for the template, adaptive "
+                   "for the patches)")
+    p.add_argument("--rho", type=_int_at_least(0), default=3, help="adaptive blending ρ")
+    p.add_argument("--width", type=_int_at_least(0), default=4, help="feather width in px")
+    p.add_argument("--seed", type=_int_at_least(0), default=0, help="random seed (default 0)")
+    p.add_argument("--pick", type=_picks, default=None, metavar="I,J,...",
+                   help="tile indices for the preview and the project (default: all)")
+    p.add_argument("--preview", type=_grid, default=(8, 8), metavar="RxC",
+                   help="preview grid in tiles (default 8x8)")
+    p.add_argument("--equal-neighbours", action="store_true",
+                   help="allow equal neighbouring tiles in the preview's index matrix")
+    p.add_argument("--workers", type=_int_at_least(1), default=2, help="threads (default 2)")
+    p.add_argument("--map", type=_named("file"), action="append", default=[],
+                   metavar="NAME=FILE", help="a co-registered material map (repeatable)")
+    p.add_argument("--weight", type=_named("weight"), action="append", default=[],
+                   metavar="NAME=W", help="seam error weight of a map ('main' = SOURCE)")
+    p.add_argument("--exclude-mask", default=None, metavar="FILE",
+                   help="image whose non-black pixels mark source pixels not to use")
+    p.add_argument("--exclude-color", type=_colour_range, default=None, metavar="LO:HI",
+                   help="exclude source colours in [LO, HI] per channel, e.g. 0,0,0:0.2,0.2,0.3")
+    add_project_option(p)
+    p.set_defaults(func=run)
+    return p
+
+
+# ---------------------------------------------------------------- running
+class _Reporter:
+    """Progress lines on stderr."""
+
+    def __init__(self):
+        self.t0 = time.perf_counter()
+
+    def __call__(self, text: str) -> None:
+        print(f"[{time.perf_counter() - self.t0:7.2f}s] {text}", file=sys.stderr, flush=True)
+
+
+def _run_events(gen, on_event):
+    while True:
+        try:
+            ev = next(gen)
+        except StopIteration as stop:
+            return stop.value
+        on_event(ev)
+
+
+def _parse_rect(text: str):
+    try:
+        v = [int(t) for t in text.split(",")]
+    except ValueError:
+        v = []
+    if len(v) != 4:
+        raise ValueError(f"--rect must be X,Y,W,H integers, got {text!r}")
+    return tuple(v)
+
+
+def load_source(path):
+    """:func:`engine.io.load_image`, but exact for 16-bit colour PNGs.
+
+    Pillow reads 16-bit RGB(A) PNGs as 8-bit; those are decoded with the exact PNG codec of
+    :mod:`engine.export` instead so that 16-bit in gives 16-bit out. Returns (pixels, depth).
+    """
+    from engine.io import load_image
+
+    loaded = load_image(path)
+    try:
+        with open(path, "rb") as f:
+            head = f.read(33)
+    except OSError:
+        head = b""
+    if (loaded.bit_depth == 8 and head.startswith(b"\x89PNG\r\n\x1a\n") and head[12:16] == b"IHDR"
+            and head[24] == 16 and head[25] in (2, 6)):
+        from engine.export._png import decode_png
+
+        q = decode_png(Path(path).read_bytes())
+        return (q.astype(np.float32) / 65535.0), 16
+    return loaded.pixels, loaded.bit_depth
+
+
+def run(args) -> int:
+    """Run the command; engine warnings become ``warning:`` lines on stderr (and the manifest)."""
+    import warnings
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        code = _run(args)
+    for w in caught:
+        print(f"quilt-studio tileset: warning: {w.message}", file=sys.stderr)
+    return code
+
+
+def _run(args) -> int:
+    from engine.events import Progress
+    from engine.exclusion import exclusion_mask
+    from engine.export import quantize
+    from engine.export._png import encode_png
+    from engine.io import load_image
+    from engine.tiles import (
+        CandidateTile,
+        TemplateUpdate,
+        iter_candidates,
+        iter_find_template,
+        iter_make_seamless,
+        random_layout,
+    )
+
+    say = _Reporter()
+    S, depth = load_source(args.source)
+    H, W = S.shape[:2]
+    say(f"source {args.source}: {W}x{H}, {S.shape[2]} channel(s), {depth}-bit")
+    maps = {}
+    for name, path in args.map:
+        if name in maps or name == "main":
+            raise ValueError(f"--map {name}: duplicate or reserved map name")
+        maps[name] = load_image(path).pixels
+    weights = dict(args.weight) or None
+    excluded = None
+    if args.exclude_mask or args.exclude_color is not None:
+        painted = None
+        if args.exclude_mask:
+            m = load_image(args.exclude_mask).pixels
+            if m.shape[:2] != (H, W):
+                raise ValueError(
+                    f"{args.exclude_mask}: the mask is {m.shape[1]}x{m.shape[0]}, the source "
+                    f"{W}x{H}")
+            painted = m[:, :, : max(1, m.shape[2] - (m.shape[2] in (2, 4)))].max(axis=2) > 0
+        excluded = exclusion_mask(S, color_range=args.exclude_color, painted=painted)
+        say(f"excluded: {int(excluded.sum())} of {H * W} source pixels")
+
+    tmpl_blend = args.blend or "none"
+    cand_blend = args.blend or "adaptive"
+    short = min(H, W)
+    tile_min = args.tile_min if args.tile_min is not None else max(8, short // 4)
+    tile_max = args.tile_max if args.tile_max is not None else max(8, short // 2)
+    if args.tile_min is not None and args.tile_max is None:
+        tile_max = tile_min
+    warn_list: list[str] = []
+
+    # 1. template rectangle
+    if args.rect:
+        rect = _parse_rect(args.rect)
+        from engine.tiles import default_overlap
+
+        overlap = args.overlap or default_overlap((rect[3], rect[2]))
+        cost = None
+        say(f"template: fixed rectangle {rect}, overlap {overlap}")
+    else:
+        def on_template(ev):
+            if isinstance(ev, TemplateUpdate):
+                say(f"template: {ev.phase} rect {ev.rect} cost {ev.cost:.4f}")
+
+        tmpl = _run_events(
+            iter_find_template(S, tile_min=tile_min, tile_max=tile_max, overlap=args.overlap,
+                               excluded=excluded), on_template)
+        rect, overlap, cost = tmpl.rect, tmpl.overlap, tmpl.cost
+        warn_list += list(tmpl.warnings)
+
+    # 2. seamless tile
+    st = _run_events(
+        iter_make_seamless(S, rect, overlap=overlap, method=args.seam, metric=args.metric,
+                           blend=tmpl_blend, width=args.width, rho=args.rho, maps=maps or None,
+                           weights=weights), lambda ev: None)
+    warn_list += [w for w in st.warnings if w not in warn_list]
+    say(f"seamless tile {rect[2]}x{rect[3]}: seam criterion h {st.criterion['horizontal']:.2f}"
+        f" v {st.criterion['vertical']:.2f}")
+
+    # 3. candidates
+    n = args.candidates
+
+    def on_candidate(ev):
+        if isinstance(ev, CandidateTile):
+            say(f"candidate {ev.index:3d} ({done[0] + 1}/{n}): patch {ev.patch_rect}, criterion "
+                f"{ev.scores['criterion']:.2f}, changed {ev.scores['changed']:.0%}")
+            done[0] += 1
+        elif isinstance(ev, Progress) and ev.message.endswith("cancelled"):
+            say(ev.message)
+
+    done = [0]
+    cands = _run_events(
+        iter_candidates(S, st, n, patch_size=args.patch_size, patch_overlap=args.patch_overlap,
+                        margin=args.margin, neighbourhood=args.neighbourhood, method=args.seam,
+                        metric=args.metric, blend=cand_blend, width=args.width, rho=args.rho,
+                        excluded=excluded, maps=maps or None, weights=weights, rng=args.seed,
+                        workers=args.workers), on_candidate)
+
+    # 4. picks and preview layout
+    picks = args.pick if args.pick is not None else list(range(len(cands)))
+    bad = [k for k in picks if k >= len(cands)]
+    if bad:
+        raise ValueError(f"--pick {bad} out of range: there are {len(cands)} candidates")
+    rows, cols = args.preview
+    ids = random_layout(len(picks), rows, cols, rng=args.seed,
+                        no_equal_neighbours=not args.equal_neighbours and len(picks) > 1)
+    cells = np.asarray(picks, dtype=np.int64)[ids]  # candidate indices
+    from engine.tiles import assemble
+
+    preview = {m: assemble([cands[k] for k in picks], ids, map_name=None if m == "main" else m)
+               for m in ["main", *maps]}
+
+    # 5. files
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+
+    def write(stem: str, images: dict) -> dict:
+        files = {}
+        for m, img in images.items():
+            fname = f"{stem}.png" if m == "main" else f"{stem}_{m}.png"
+            _write_bytes(out / fname, encode_png(quantize(img, depth, dither=False)))
+            files[m] = fname
+        return files
+
+    template_files = write("template", {"main": st.tile, **st.maps})
+    tile_entries = []
+    for c in cands:
+        files = write(f"tile_{c.index:03d}", {"main": c.tile, **c.maps})
+        x, y, w, h = c.patch_rect
+        tile_entries.append({
+            "index": c.index, "file": files["main"], "maps": files, "seed": c.seed,
+            "source_rect": [x, y, w, h], "patch_origin": list(c.patch_origin),
+            "target_rect": list(c.target_rect),
+            "scores": {k: float(v) for k, v in c.scores.items()},
+        })
+    preview_files = write("preview", preview)
+    _write_text(out / "layout.csv", _csv(cells))
+    layout_doc = {"tile_w": int(rect[2]), "tile_h": int(rect[3]), "rows": rows, "cols": cols,
+                  "cells": cells.tolist(), "cells_are": "tile indices (tile_NNN.png)"}
+    _write_text(out / "layout.json", json.dumps(layout_doc, indent=1) + "\n")
+    parameters = {
+        "tile_min": tile_min, "tile_max": tile_max, "overlap": overlap,
+        "patch_overlap": args.patch_overlap or overlap,
+        "patch_size": args.patch_size or [int(rect[3]), int(rect[2])], "margin": args.margin,
+        "neighbourhood": args.neighbourhood, "seam": args.seam, "metric": args.metric,
+        "template_blend": tmpl_blend, "candidate_blend": cand_blend, "rho": args.rho,
+        "width": args.width, "candidates": n, "workers": args.workers,
+        "weights": weights, "preview": [rows, cols],
+        "no_equal_neighbours": not args.equal_neighbours,
+    }
+    manifest = {
+        "format": FORMAT, "version": VERSION,
+        "source": {"path": str(args.source), "width": W, "height": H,
+                   "channels": int(S.shape[2]), "bit_depth": depth,
+                   "maps": {k: p for k, p in args.map}},
+        "seed": args.seed,
+        "parameters": parameters,
+        "template": {"file": template_files["main"], "maps": template_files,
+                     "rect": list(rect), "overlap": overlap,
+                     "footprint": [rect[0], rect[1], rect[2] + overlap, rect[3] + overlap],
+                     "cost": cost, "seam_criterion": st.criterion, "seam_peak": st.peak},
+        "tiles": tile_entries,
+        "picks": picks,
+        "layout": {"csv": "layout.csv", "json": "layout.json"},
+        "preview": {"file": preview_files["main"], "maps": preview_files},
+        "warnings": warn_list,
+    }
+    _write_text(out / "manifest.json", json.dumps(manifest, indent=1) + "\n")
+    say(f"wrote template, {len(cands)} tiles, manifest, layout and preview to {out}")
+
+    # 6. project
+    src_maps = {MAIN_MAP: S, **maps}
+
+    def as_project_maps(main, extra):
+        return {MAIN_MAP: np.asarray(main), **{k: np.asarray(v) for k, v in extra.items()}}
+
+    save_project_option(
+        args,
+        sources=src_maps,
+        tiles=[as_project_maps(c.tile, c.maps) for c in cands],
+        name="tileset",
+        template=as_project_maps(st.tile, st.maps),
+        template_rect=rect,
+        patch_origins=[c.patch_origin for c in cands],
+        seeds=[c.seed for c in cands],
+        scores=[c.scores["criterion"] for c in cands],
+        picks=picks,
+        layout=ids,
+        parameters=parameters,
+        project_seeds={"candidates": args.seed, "layout": args.seed},
+        bit_depth=depth,
+        source_paths={MAIN_MAP: str(args.source), **{k: p for k, p in args.map}},
+        map_weights={(MAIN_MAP if k == "main" else k): v for k, v in (weights or {}).items()},
+        preview=as_project_maps(preview["main"], {m: preview[m] for m in maps}),
+    )
+    return 0
+
+
+def _csv(cells: np.ndarray) -> str:
+    buf = io.StringIO()
+    csv.writer(buf, lineterminator="\n").writerows(cells.tolist())
+    return buf.getvalue()
+
+
+def _write_text(path: Path, text: str) -> None:
+    _write_bytes(path, text.encode("utf-8"))
+
+
+def _write_bytes(path: Path, data: bytes) -> None:
+    """Write atomically (temporary sibling, then rename) with the usual umask permissions."""
+    import os
+
+    from engine.export import _umask
+
+    tmp = path.with_name(f".{path.name}.tmp")
+    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o666 & ~_umask())
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+        os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise

@@ -1,0 +1,156 @@
+"""End to end: ``quilt-studio tileset SOURCE --out DIR`` on small sources."""
+
+import csv
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import resources
+from engine.cli import main
+from engine.export._png import decode_png, encode_png
+from engine.io import load_image
+from engine.project import load_project
+from engine.tiles import assemble, candidates, make_seamless
+
+
+@pytest.fixture(scope="module")
+def src(tmp_path_factory):
+    d = tmp_path_factory.mktemp("src")
+    S = load_image(resources.sample_path("cobblestones")).pixels[:150, :160]
+    q8 = np.round(S * 255).astype(np.uint8)
+    gray = np.round(S[:, :, :1] * 65535).astype(np.uint16)
+    rgb16 = np.round(S * 65535).astype(np.uint16)
+    rgb16[::3, ::5] += 1  # values that 8 bits cannot hold
+    paths = {"rgb8": d / "rgb8.png", "gray16": d / "gray16.png", "rgb16": d / "rgb16.png",
+             "height": d / "height.png", "mask": d / "mask.png"}
+    paths["rgb8"].write_bytes(encode_png(q8))
+    paths["gray16"].write_bytes(encode_png(gray))
+    paths["rgb16"].write_bytes(encode_png(rgb16))
+    paths["height"].write_bytes(encode_png(q8[:, :, 1]))
+    mask = np.zeros((150, 160), np.uint8)
+    mask[:, 140:] = 255
+    paths["mask"].write_bytes(encode_png(mask))
+    return paths
+
+
+ARGS = ["--candidates", "5", "--tile-min", "48", "--tile-max", "56", "--seed", "3",
+        "--preview", "3x4"]
+
+
+def png(path):
+    return decode_png(path.read_bytes())
+
+
+def test_end_to_end_files_manifest_layout_and_determinism(src, tmp_path, capsys):
+    out = tmp_path / "set"
+    proj = tmp_path / "set.quiltproj"
+    assert main(["tileset", str(src["rgb8"]), "--out", str(out), *ARGS, "--project",
+                 str(proj)]) == 0
+    err = capsys.readouterr().err
+    assert "template:" in err and err.count("candidate") >= 5 and "wrote" in err
+    names = {p.name for p in out.iterdir()}
+    assert {"template.png", "manifest.json", "layout.csv", "layout.json", "preview.png"} <= names
+    assert {f"tile_{i:03d}.png" for i in range(5)} <= names
+    man = json.loads((out / "manifest.json").read_text())
+    assert man["seed"] == 3 and man["source"]["bit_depth"] == 8
+    p = man["parameters"]
+    assert p["tile_min"] == 48 and p["tile_max"] == 56 and p["seam"] == "dp"
+    assert p["candidates"] == 5 and p["overlap"] == man["template"]["overlap"]
+    assert len(man["tiles"]) == 5
+    for t in man["tiles"]:
+        assert set(t["scores"]) >= {"criterion", "peak", "changed"}
+        x, y, w, h = t["source_rect"]
+        assert (w, h) == tuple(man["template"]["rect"][2:]) and x >= 0 and y >= 0
+    # the files hold exactly what the engine makes with the same parameters
+    S = png(src["rgb8"]).astype(np.float32) / 255
+    rect = tuple(man["template"]["rect"])
+    st = make_seamless(S, rect, overlap=man["template"]["overlap"])
+    np.testing.assert_array_equal(png(out / "template.png"), np.round(st.tile * 255))
+    cands = candidates(S, st, 5, rng=3, workers=1)
+    for c in cands:
+        np.testing.assert_array_equal(png(out / f"tile_{c.index:03d}.png"),
+                                      np.round(c.tile * 255))
+        assert man["tiles"][c.index]["source_rect"] == list(c.patch_rect)
+    # layout CSV == JSON, no equal neighbours, preview assembled from it
+    rows = [[int(v) for v in r] for r in csv.reader((out / "layout.csv").open())]
+    lay = json.loads((out / "layout.json").read_text())
+    assert rows == lay["cells"] and (lay["rows"], lay["cols"]) == (3, 4)
+    cells = np.array(rows)
+    assert (cells[:, 1:] != cells[:, :-1]).all() and (cells[1:] != cells[:-1]).all()
+    tiles = [png(out / f"tile_{i:03d}.png") for i in range(5)]
+    np.testing.assert_array_equal(png(out / "preview.png"), assemble(tiles, cells))
+    # the project opens with the same tiles, picks and layout
+    project = load_project(proj)
+    assert len(project.candidates) == 5 and project.picks == list(range(5))
+    assert project.template_rect == rect
+    np.testing.assert_array_equal(project.layout, cells)
+    np.testing.assert_allclose(project.candidates[2].maps["albedo"], cands[2].tile, atol=1e-6)
+
+
+def test_sixteen_bit_and_gray_keep_their_depth(src, tmp_path):
+    for key, channels in (("rgb16", 3), ("gray16", 1)):
+        out = tmp_path / key
+        assert main(["tileset", str(src[key]), "--out", str(out), *ARGS]) == 0
+        for name in ("template.png", "tile_000.png", "preview.png"):
+            q = png(out / name)
+            assert q.dtype == np.uint16 and q.shape[2] == channels, (key, name)
+        man = json.loads((out / "manifest.json").read_text())
+        assert man["source"]["bit_depth"] == 16
+        # away from the cuts the tile holds exact 16-bit source values
+        x, y, w, h = man["template"]["rect"]
+        wt = man["template"]["overlap"]
+        s = png(src[key])
+        np.testing.assert_array_equal(png(out / "template.png")[wt:, wt:],
+                                      s[y + wt : y + h, x + wt : x + w])
+
+
+def test_picks_maps_exclusion_and_options(src, tmp_path):
+    out = tmp_path / "opts"
+    assert main(["tileset", str(src["rgb8"]), "--out", str(out), *ARGS, "--pick", "1,3",
+                 "--map", f"height={src['height']}", "--weight", "main=1",
+                 "--weight", "height=0.5", "--exclude-mask", str(src["mask"]),
+                 "--seam", "oscillating", "--blend", "feather", "--workers", "1"]) == 0
+    man = json.loads((out / "manifest.json").read_text())
+    assert man["picks"] == [1, 3]
+    cells = np.array(json.loads((out / "layout.json").read_text())["cells"])
+    assert set(np.unique(cells)) <= {1, 3}
+    assert (out / "tile_000_height.png").exists() and (out / "preview_height.png").exists()
+    assert png(out / "tile_000_height.png").shape[2] == 1
+    x, y, w, h = man["template"]["footprint"]
+    assert x + w <= 140
+    for t in man["tiles"]:
+        tx, ty, tw, th = t["source_rect"]
+        assert tx + tw <= 140
+    assert man["parameters"]["seam"] == "oscillating"
+    assert man["parameters"]["template_blend"] == "feather"
+
+
+def test_bad_input_gives_clear_errors(src, tmp_path, capsys):
+    out = str(tmp_path / "bad")
+    assert main(["tileset", str(src["rgb8"]), "--out", out, "--tile-min", "200"]) == 1
+    assert "smaller than the minimum tile" in capsys.readouterr().err
+    assert main(["tileset", str(tmp_path / "missing.png"), "--out", out]) == 1
+    assert "no such file" in capsys.readouterr().err
+    assert main(["tileset", str(src["rgb8"]), "--out", out, *ARGS, "--pick", "9"]) == 1
+    assert "out of range" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main(["tileset", str(src["rgb8"]), "--out", out, "--tile-min", "big"])
+    flat = tmp_path / "flat.png"
+    flat.write_bytes(encode_png(np.full((90, 90, 3), 120, np.uint8)))
+    assert main(["tileset", str(flat), "--out", out, "--candidates", "2", "--tile-min",
+                 "32"]) == 0
+    assert "warning: the source is a single flat colour" in capsys.readouterr().err
+    man = json.loads((tmp_path / "bad" / "manifest.json").read_text())
+    assert any("flat" in w for w in man["warnings"])
+
+
+def test_installed_command_runs(src, tmp_path):
+    out = tmp_path / "cmd"
+    r = subprocess.run([sys.executable, "-m", "quilt_gui", "tileset", str(src["rgb8"]), "--out",
+                        str(out), "--candidates", "2", "--tile-min", "48"],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert "candidate" in r.stderr and (out / "tile_001.png").exists()
