@@ -38,9 +38,7 @@ class Seam:
     @classmethod
     def lazy(cls, build, method: str) -> Seam:
         """A seam whose fields come from ``build() -> (path, mask, criterion, peak)``."""
-        seam = cls.__new__(cls)
-        for name in ("_path", "_mask", "_criterion", "_peak"):
-            object.__setattr__(seam, name, None)
+        seam = cls.__new__(cls)  # the value slots stay unset until _fields() fills them
         object.__setattr__(seam, "method", method)
         object.__setattr__(seam, "_build", build)
         return seam

@@ -106,6 +106,20 @@ def controls_seam(error: np.ndarray, c: np.ndarray, cyclic: bool, method: str) -
     return Seam.lazy(lambda: _seam_arrays(error, c, cyclic), method)
 
 
+def _replayed_seam(error, base, moves, k, cyclic, method) -> Seam:
+    """Lazy seam of ``base`` after the block moves ``moves[:k + 1]`` (rows j, block size o,
+    column i); ``base`` and ``moves`` are private and never changed afterwards."""
+
+    def build():
+        c = base.copy()
+        h = c.shape[0]
+        for j, o, i in moves[: k + 1]:
+            c[(j + np.arange(o)) % h] = i
+        return _seam_arrays(error, c, cyclic)
+
+    return Seam.lazy(build, method)
+
+
 def criterion(error: np.ndarray, c: np.ndarray, *, cyclic: bool = False) -> float:
     """eps(c) of the control-point model (prefix sums; used by tests and benchmarks)."""
     return float(_criterion(prefix_sums(error), np.asarray(c, dtype=np.int64), bool(cyclic)))
@@ -113,64 +127,88 @@ def criterion(error: np.ndarray, c: np.ndarray, *, cyclic: bool = False) -> floa
 
 # ----------------------------------------------------------------------------- search
 @njit(cache=True, nogil=True)
-def _affected_cost(p, c, rows, nrows, j, o, i, cyclic):
-    """Sum of the row costs of ``rows[:nrows]`` with the block j..j+o-1 set to column i.
-
-    ``i < 0`` keeps the current columns.
-    """
+def _affected_cost(p, c, j, o, i, cyclic):
+    """Criterion of ``c`` with the block j..j+o-1 set to column i (``i < 0``: unchanged).
+    O(h); used only for tiny cyclic maps where the O(1) update does not apply."""
     h = c.shape[0]
     total = 0.0
-    for t in range(nrows):
-        k = rows[t]
-        if cyclic:
-            kp, kn = (k - 1) % h, (k + 1) % h
-            ck = i if i >= 0 and (k - j) % h < o else c[k]
-            prev = i if i >= 0 and (kp - j) % h < o else c[kp]
-            nxt = i if i >= 0 and (kn - j) % h < o else c[kn]
-        else:
-            ck = i if i >= 0 and j <= k < j + o else c[k]
-            prev = -1
-            nxt = -1
-            if k > 0:
-                prev = i if i >= 0 and j <= k - 1 < j + o else c[k - 1]
-            if k + 1 < h:
-                nxt = i if i >= 0 and j <= k + 1 < j + o else c[k + 1]
+    for k in range(h):
+        kp, kn = (k - 1) % h, (k + 1) % h
+        ck = i if i >= 0 and (k - j) % h < o else c[k]
+        prev = i if i >= 0 and (kp - j) % h < o else c[kp]
+        nxt = i if i >= 0 and (kn - j) % h < o else c[kn]
+        if not cyclic:
+            prev = prev if k > 0 else -1
+            nxt = nxt if k + 1 < h else -1
         total += p[k, ck + 1] - p[k, _mu(ck, prev, nxt)]
     return total
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _add_outer(acc, prow, cval, m):
+    """acc[i] += cost of an outer row (control point cval, mu without the block = m) when its
+    block-side neighbour moves to column i: P[cval+1] - P[min(m, i+1)]."""
+    w = acc.shape[0]
+    top = prow[cval + 1]
+    k = min(max(m - 1, 0), w)
+    for i in range(k):
+        acc[i] += top - prow[i + 1]
+    const = top - prow[m]
+    for i in range(k, w):
+        acc[i] += const
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _set_block_row(acc, prow, m):
+    """acc[i] = cost of a block row at column i whose other neighbours give mu bound m:
+    P[i+1] - P[min(i, m)]."""
+    w = acc.shape[0]
+    k = min(max(m, 0), w - 1)
+    for i in range(k + 1):
+        acc[i] = prow[i + 1] - prow[i]
+    for i in range(k + 1, w):
+        acc[i] = prow[i + 1] - prow[m]
+
+
 @njit(cache=True, nogil=True)
-def _first_improving(p, q, c, j, o, cyclic, eps, limit):
+def _first_improving(p, q, c, j, o, cyclic, eps, limit, acc, tmp):
     """First column i (in loop order) for which moving the block j..j+o-1 to i gives a
     criterion below ``limit``; returns (i, new criterion) or (-1, eps).
 
-    O(1) per i: only rows j-1 .. j+o change; the block's inner rows cost E[k, i] (column
-    prefix sums ``q``), its end rows and the two outer rows get new complementary points.
+    Only rows j-1 .. j+o change: the block's inner rows cost E[k, i] (column prefix sums
+    ``q``), its end rows and the two outer rows get new complementary points. Each term is a
+    contiguous slice of a prefix-sum row or a constant over a range of i, so the whole vector
+    of candidate criteria costs a few simple passes over w values (``acc``, ``tmp`` scratch).
     """
     h = c.shape[0]
     w = p.shape[1] - 1
     big = w + 2  # a missing neighbour never lowers mu
     if cyclic and o + 2 > h:
-        return _first_improving_generic(p, c, j, o, cyclic, eps, limit)
-    # outer rows a = j-1 and z = j+o, their outer neighbours aa = j-2 and zz = j+o+1
+        old = _affected_cost(p, c, j, o, -1, cyclic)
+        for i in range(w):
+            new = eps - old + _affected_cost(p, c, j, o, i, cyclic)
+            if new < limit:
+                return i, new
+        return -1, eps
+    last = (j + o - 1) % h
+    # outer rows a = j-1 and z = j+o with their own outer neighbours' bounds
     if cyclic:
         a, z = (j - 1) % h, (j + o) % h
         has_a = has_z = True
-        ca_prev = c[(j - 2) % h] + 1
-        cz_next = c[(j + o + 1) % h] + 1
+        ma = min(c[a], c[(j - 2) % h] + 1)
+        mz = min(c[z], c[(j + o + 1) % h] + 1)
     else:
         a, z = j - 1, j + o
         has_a, has_z = a >= 0, z < h
-        ca_prev = c[j - 2] + 1 if j >= 2 else big
-        cz_next = c[j + o + 1] + 1 if j + o + 1 < h else big
+        ma = min(c[a], c[j - 2] + 1 if j >= 2 else big) if has_a else big
+        mz = min(c[z], c[z + 1] + 1 if z + 1 < h else big) if has_z else big
     ca = c[a] + 1 if has_a else big
     cz = c[z] + 1 if has_z else big
     old = 0.0
     if has_a:
-        old += p[a, c[a] + 1] - p[a, min(c[a], ca_prev, c[j] + 1)]
+        old += p[a, c[a] + 1] - p[a, min(ma, c[j] + 1)]
     if has_z:
-        old += p[z, c[z] + 1] - p[z, min(c[z], cz_next, c[(j + o - 1) % h] + 1)]
-    last = (j + o - 1) % h
+        old += p[z, c[z] + 1] - p[z, min(mz, c[last] + 1)]
     for t in range(o):
         k = (j + t) % h
         prev = c[(k - 1) % h] + 1 if cyclic or k > 0 else big
@@ -182,91 +220,97 @@ def _first_improving(p, q, c, j, o, cyclic, eps, limit):
         if c[(j + t) % h] != v:
             v = -1
             break
+    if o == 1:
+        _set_block_row(acc, p[j], min(ca, cz))
+    else:
+        _set_block_row(acc, p[j], ca)
+        _set_block_row(tmp, p[last], cz)
+        for i in range(w):
+            acc[i] += tmp[i]
+        n_in = o - 2
+        if n_in > 0:
+            s0 = (j + 1) % h
+            if s0 + n_in <= h:
+                for i in range(w):
+                    acc[i] += q[s0 + n_in, i] - q[s0, i]
+            else:
+                for i in range(w):
+                    acc[i] += q[h, i] - q[s0, i] + q[s0 + n_in - h, i]
+    if has_a:
+        _add_outer(acc, p[a], c[a], ma)
+    if has_z:
+        _add_outer(acc, p[z], c[z], mz)
     base = eps - old
-    s0 = (j + 1) % h  # first inner row
-    n_in = o - 2
+    bound = limit - base
     for i in range(w):
-        if i == v:
-            continue
-        new = base
-        if has_a:
-            new += p[a, c[a] + 1] - p[a, min(c[a], ca_prev, i + 1)]
-        if has_z:
-            new += p[z, c[z] + 1] - p[z, min(c[z], cz_next, i + 1)]
-        if o == 1:
-            new += p[j, i + 1] - p[j, min(i, ca, cz)]
-        else:
-            new += p[j, i + 1] - p[j, min(i, ca)]
-            new += p[last, i + 1] - p[last, min(i, cz)]
-            if n_in > 0:
-                if s0 + n_in <= h:
-                    new += q[s0 + n_in, i] - q[s0, i]
-                else:
-                    new += q[h, i] - q[s0, i] + q[s0 + n_in - h, i]
-        if new < limit:
-            return i, new
+        if acc[i] < bound and i != v:
+            return i, base + acc[i]
     return -1, eps
 
 
-@njit(cache=True, nogil=True)
-def _first_improving_generic(p, c, j, o, cyclic, eps, limit):
-    """Same as :func:`_first_improving` for tiny cyclic maps (o + 2 > h): O(h) per i."""
-    h = c.shape[0]
-    w = p.shape[1] - 1
-    rows = np.arange(h)
-    old = _affected_cost(p, c, rows, h, j, o, -1, cyclic)
-    for i in range(w):
-        new = eps - old + _affected_cost(p, c, rows, h, j, o, i, cyclic)
-        if new < limit:
-            return i, new
-    return -1, eps
+# state slots of _osc_run
+_POS, _IDLE, _COUNT, _CYCLIC, _RESUME, _BUDGET_SLOT, _NMOVES = range(7)
 
 
 @njit(cache=True, nogil=True)
-def _osc_run(p, q, c, seq_o, seq_j, skip, cyclic, resume, state, fstate, budget):
-    """Run the oscillating search from ``state`` until an improvement, ``budget`` trials or
-    convergence. ``c`` is updated in place.
+def _osc_run(p, q, c, seq, state, fstate, moves):
+    """Run the oscillating search from ``state`` for at most ``state[_BUDGET_SLOT]`` trials,
+    until ``moves`` is full or the search converges; ``c`` is updated in place.
 
-    state = [position in the (o, j) sequence, trials since the last improvement,
-    improvements]; fstate = [current criterion]. Returns 1 (improved), 0 (budget used up),
-    2 (converged).
+    ``seq`` rows: block size o, first row j, skip (block holds a frozen point) of every move
+    in loop order. Each accepted move (j, o, i) is appended to ``moves``; its count goes to
+    ``state[_NMOVES]``. ``fstate[0]`` is the current criterion. Returns 2 when converged.
     """
     h = c.shape[0]
-    n = seq_o.shape[0]
-    pos = state[0]
-    idle = state[1]
+    w = p.shape[1] - 1
+    n = seq.shape[1]
+    cyclic = state[_CYCLIC] != 0
+    resume = state[_RESUME] != 0
+    acc = np.empty(w)
+    tmp = np.empty(w)
+    pos = state[_POS]
+    idle = state[_IDLE]
     eps = fstate[0]
-    for _ in range(budget):
+    nm = 0
+    status = _BUDGET
+    for _ in range(state[_BUDGET_SLOT]):
         if idle >= n:
-            state[0] = pos
-            state[1] = idle
-            fstate[0] = _criterion(p, c, cyclic)
-            return _CONVERGED
-        o = seq_o[pos]
-        j = seq_j[pos]
-        if not skip[pos]:
-            i, new = _first_improving(p, q, c, j, o, cyclic, eps, eps - 1e-9 * eps)
+            eps = _criterion(p, c, cyclic)
+            status = _CONVERGED
+            break
+        o = seq[0, pos]
+        j = seq[1, pos]
+        if seq[2, pos] == 0:
+            i, new = _first_improving(p, q, c, j, o, cyclic, eps, eps - 1e-9 * eps, acc, tmp)
             if i >= 0:
                 for t in range(o):
                     c[(j + t) % h] = i
-                state[2] += 1
+                moves[nm, 0] = j
+                moves[nm, 1] = o
+                moves[nm, 2] = i
+                nm += 1
+                state[_COUNT] += 1
                 # incremental value; refreshed exactly now and then against drift
-                eps = _criterion(p, c, cyclic) if state[2] % 256 == 0 else new
-                state[0] = j if resume else 0
-                state[1] = 0
-                fstate[0] = eps
-                return _IMPROVED
+                eps = _criterion(p, c, cyclic) if state[_COUNT] % 256 == 0 else new
+                pos = j if resume else 0
+                idle = 0
+                if nm == moves.shape[0]:
+                    break
+                continue
         idle += 1
         pos += 1
         if pos == n:
             pos = 0
-    state[0] = pos
-    state[1] = idle
-    return _BUDGET
+    state[_POS] = pos
+    state[_IDLE] = idle
+    state[_NMOVES] = nm
+    fstate[0] = eps
+    return status
 
 
-def _move_sequence(h: int, o_max: int, cyclic: bool, frozen: np.ndarray):
-    """All block moves (o, j) in loop order, and which of them touch a frozen control point."""
+def _move_sequence(h: int, o_max: int, cyclic: bool, frozen: np.ndarray) -> np.ndarray:
+    """All block moves in loop order as rows (o, j, skip); skip marks blocks holding a frozen
+    control point."""
     seq_o, seq_j = [], []
     for o in range(1, o_max + 1):
         nj = (h if o < h else 1) if cyclic else h - o + 1
@@ -274,14 +318,11 @@ def _move_sequence(h: int, o_max: int, cyclic: bool, frozen: np.ndarray):
         seq_j.append(np.arange(nj, dtype=np.int64))
     seq_o = np.concatenate(seq_o)
     seq_j = np.concatenate(seq_j)
-    if frozen.any():
-        # block rows (j + t) % h for t < o contain a frozen index?
-        fz = np.concatenate([frozen, frozen]) if cyclic else np.concatenate([frozen, [False]])
-        csum = np.concatenate([[0], np.cumsum(fz)])
-        skip = csum[seq_j + seq_o] - csum[seq_j] > 0
-    else:
-        skip = np.zeros(seq_o.shape, dtype=bool)
-    return seq_o, seq_j, skip
+    # block rows (j + t) % h for t < o contain a frozen index?
+    fz = np.concatenate([frozen, frozen]) if cyclic else np.concatenate([frozen, [False]])
+    csum = np.concatenate([[0], np.cumsum(fz)])
+    skip = (csum[seq_j + seq_o] - csum[seq_j] > 0).astype(np.int64)
+    return np.stack([seq_o, seq_j, skip])
 
 
 def initial_controls(error: np.ndarray, pins: np.ndarray) -> np.ndarray:
@@ -292,29 +333,34 @@ def initial_controls(error: np.ndarray, pins: np.ndarray) -> np.ndarray:
 
 def iter_oscillating(error, pins, *, o_max: int, variant: str, cyclic: bool, cancel,
                      method: str = "oscillating"):
-    """Generator: yields a Seam for the initial path and for every improvement; returns the
-    final control points (the last Seam yielded is the best). Stops early, keeping the best
-    path so far, when ``cancel`` is set."""
+    """Generator: yields a Seam for the initial path and for every improvement (in order, each
+    strictly better than the one before). Stops early, keeping the best path so far, when
+    ``cancel`` is set. ``error`` must stay unchanged while the seams are in use."""
     h, w = error.shape
     c = initial_controls(error, pins)
     yield controls_seam(error, c, cyclic, method)
+    o_max = min(o_max, h)
     p = prefix_sums(error)
-    frozen = pins >= 0
-    seq_o, seq_j, skip = _move_sequence(h, min(o_max, h), cyclic, frozen)
     q = np.zeros((h + 1, w))
     np.cumsum(error, axis=0, out=q[1:])
-    state = np.zeros(3, dtype=np.int64)
+    seq = _move_sequence(h, o_max, cyclic, pins >= 0)
+    state = np.zeros(7, dtype=np.int64)
+    state[_CYCLIC] = cyclic
+    state[_RESUME] = variant == "resume"
+    # ~1e5 column evaluations per kernel call: the cancel token is polled every ~0.1 ms
+    state[_BUDGET_SLOT] = max(1, 100_000 // w)
     fstate = np.array([_criterion(p, c, cyclic)])
-    # about 1e5 row evaluations per kernel call: the cancel token is polled every ~0.1 ms
-    budget = max(1, 100_000 // (w * (min(o_max, h) + 2)))
-    resume = variant == "resume"
+    moves = np.empty((64, 3), dtype=np.int64)
     while not is_cancelled(cancel):
-        status = _osc_run(p, q, c, seq_o, seq_j, skip, cyclic, resume, state, fstate, budget)
-        if status == _IMPROVED:
-            yield controls_seam(error, c, cyclic, method)
-        elif status == _CONVERGED:
+        base = c.copy()
+        status = _osc_run(p, q, c, seq, state, fstate, moves)
+        n = int(state[_NMOVES])
+        if n:
+            log = moves[:n].copy()
+            for k in range(n):
+                yield _replayed_seam(error, base, log, k, cyclic, method)
+        if status == _CONVERGED:
             break
-    return c
 
 
 # ----------------------------------------------------------------------------- optimum

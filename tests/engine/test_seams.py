@@ -542,3 +542,37 @@ def test_input_untouched_float32_accepted(method):
 
 def test_warmup_runs():
     warmup()
+
+
+# ----------------------------------------------------------------------------- result type
+def test_seam_is_immutable_picklable_and_lazy_seams_match_eager():
+    import pickle
+
+    e = smooth_map((40, 9), 3)
+    work = e.copy()
+    updates = list(iter_find_seam(work, method="oscillating"))
+    work[:] = 99.0  # the caller reuses its buffer: streamed seams must not change
+    for u in updates[:: max(1, len(updates) // 7)] + [updates[-1]]:
+        s = u.seam
+        c = controls_of(s)
+        assert s.criterion == pytest.approx(osc_eps(e, c))
+        assert s.peak == pytest.approx(e[s.path[:, 0], s.path[:, 1]].max())
+        assert np.array_equal(s.mask, np.arange(9)[None, :] <= c[:, None])
+    s = updates[-1].seam
+    with pytest.raises(AttributeError):
+        s.criterion = 0.0
+    with pytest.raises(ValueError):
+        s.path[0, 0] = 1
+    t = pickle.loads(pickle.dumps(s))
+    assert np.array_equal(t.path, s.path) and t.criterion == s.criterion and t.method == s.method
+    assert "oscillating" in repr(s) and s.shape == (40, 9)
+
+
+def test_benchmark_runs_and_baseline_matches_dp(capsys):
+    from benchmarks.seams import main, numpy_dp
+
+    e = smooth_map((50, 7), 0)
+    assert np.array_equal(numpy_dp(e), find_seam(e).path[:, 1])
+    assert main(["--sizes", "32x6", "--min-time", "0"]) == 0
+    out = capsys.readouterr().out
+    assert "numpy row DP" in out and "oscillating o_max=3" in out

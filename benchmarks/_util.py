@@ -1,0 +1,40 @@
+"""Shared helpers for the benchmarks: robust timing and plain-text tables."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+
+
+def median_time(fn: Callable[[], object], *, min_time: float = 0.2, min_repeats: int = 3,
+                max_repeats: int = 50) -> tuple[float, object]:
+    """Median wall time of ``fn()`` in seconds over repeats, and the last result.
+
+    Repeats until ``min_time`` seconds were spent and at least ``min_repeats`` runs were made
+    (at most ``max_repeats``); a call slower than ``min_time`` runs ``min_repeats`` times.
+    """
+    times = []
+    result = None
+    spent = 0.0
+    while len(times) < max_repeats and (len(times) < min_repeats or spent < min_time):
+        t0 = time.perf_counter()
+        result = fn()
+        dt = time.perf_counter() - t0
+        times.append(dt)
+        spent += dt
+    times.sort()
+    n = len(times)
+    median = times[n // 2] if n % 2 else 0.5 * (times[n // 2 - 1] + times[n // 2])
+    return median, result
+
+
+def format_table(headers: Sequence[str], rows: Sequence[Sequence[object]]) -> str:
+    """Rows as a Markdown-compatible table with right-aligned columns."""
+    cells = [[str(h) for h in headers]] + [[str(c) for c in r] for r in rows]
+    widths = [max(len(r[i]) for r in cells) for i in range(len(headers))]
+    lines = []
+    for k, r in enumerate(cells):
+        lines.append("| " + " | ".join(c.rjust(wd) for c, wd in zip(r, widths, strict=True)) + " |")
+        if k == 0:
+            lines.append("|" + "|".join("-" * (wd + 1) + ":" for wd in widths) + "|")
+    return "\n".join(lines)
