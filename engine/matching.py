@@ -1,0 +1,411 @@
+"""Candidate search for patch-based synthesis: masked SSD against every sample position.
+
+ALGORITHMS.md §0 and §2.2. For a block of existing content ``T`` (bh, bw, C) and non-negative
+per-pixel weights ``W`` (the overlap mask, or any weighting), the error of the sample window
+anchored at ``p`` is
+
+    e(p) = Σ_u Σ_c W(u) (S_c(p + u) − T_c(u))²
+         = Σ W·T²  −  2 Σ_c corr(S_c, W·T_c)(p)  +  corr(Σ_c S_c², W)(p).
+
+Both correlations are computed for all positions at once by FFT. Because only *valid* positions
+are wanted (the window inside the sample), a circular correlation of the sample's own size is
+exact: no index wraps. The sample's spectra are computed once (:class:`SampleSpectrum`, float32,
+real FFT, a fixed padded shape); each query costs one forward transform per channel of the kernel
+and one inverse, the channels being summed in the frequency domain.
+
+:class:`PCAMatcher` is the *fast* mode: the overlap is split into fixed parts (corner, left arm,
+top arm), every sample position is described by its projections on a few principal components of
+each part (computed for all positions at once by the same FFT correlation), the squared error is
+estimated as ``‖f‖² − 2·proj(f)·proj(T) + ‖T‖²`` (``‖f‖²`` exact, from a summed-area table) and the
+best few estimates are re-ranked by the exact SSD (:func:`ssd_at`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.fft as sfft
+from numba import njit
+
+from engine._validate import as_image, as_rng, positive_int
+
+__all__ = [
+    "ZERO_ERROR_FRACTION",
+    "PCAMatcher",
+    "SampleSpectrum",
+    "box_sums_float",
+    "check_block",
+    "error_floor",
+    "masked_ssd",
+    "select_within_tolerance",
+    "ssd_at",
+]
+
+
+def _workers(threads: int | None) -> int:
+    return 1 if threads is None else max(1, int(threads))
+
+
+class SampleSpectrum:
+    """Spectra of a sample for masked-SSD queries of any block size up to the sample's.
+
+    Parameters
+    ----------
+    sample : (H, W, C) float32 ndarray
+        The sample (already validated, [0, 1]).
+    groups : sequence of sequences of int, optional
+        Channel groups that share one weight map in :meth:`ssd` (default: one group with every
+        channel). Texture transfer uses two groups: the colour channels and the correspondence
+        channel.
+    workers : int
+        ``workers=`` passed to :mod:`scipy.fft`.
+    """
+
+    def __init__(self, sample: np.ndarray, *, groups=None, workers: int = 1):
+        s = np.ascontiguousarray(np.asarray(sample, dtype=np.float32))
+        if s.ndim != 3:
+            raise ValueError(f"sample must be (H, W, C), got shape {s.shape}")
+        self.sample = s
+        h, w, c = s.shape
+        self.shape = (h, w)
+        self.channels = c
+        self.groups = tuple(tuple(int(i) for i in g) for g in (groups or (tuple(range(c)),)))
+        if sorted(i for g in self.groups for i in g) != list(range(c)):
+            raise ValueError(f"groups must partition the {c} channels, got {groups!r}")
+        self.group_of = np.empty(c, dtype=np.intp)
+        for gi, g in enumerate(self.groups):
+            self.group_of[list(g)] = gi
+        self.workers = int(workers)
+        self.padded = (sfft.next_fast_len(h, real=True), sfft.next_fast_len(w, real=True))
+        chans = np.moveaxis(s, 2, 0)
+        sq = np.stack([np.sum(chans[list(g)] ** 2, axis=0) for g in self.groups])
+        self._fs = self._forward(chans)
+        self._fsq = self._forward(sq)
+
+    def _forward(self, k: np.ndarray, workers: int | None = None) -> np.ndarray:
+        """2-D real FFT of kernels (..., kh, kw) zero-padded to ``padded``; pruned row pass."""
+        hp, wp = self.padded
+        wk = self.workers if workers is None else workers
+        r = sfft.rfft(k, n=wp, axis=-1, workers=wk)
+        return sfft.fft(r, n=hp, axis=-2, workers=wk)
+
+    def _inverse(
+        self, x: np.ndarray, rows: int, cols: int, workers: int | None = None
+    ) -> np.ndarray:
+        hp, wp = self.padded
+        wk = self.workers if workers is None else workers
+        y = sfft.ifft(x, axis=-2, workers=wk)[..., :rows, :]
+        return sfft.irfft(y, n=wp, axis=-1, workers=wk)[..., :cols]
+
+    def correlate(self, kernels: np.ndarray) -> np.ndarray:
+        """``Σ_c corr(S_c, K_c)`` at every valid position for a batch of kernels (n, C, kh, kw)."""
+        k = np.asarray(kernels, dtype=np.float32)
+        n, c, kh, kw = k.shape
+        x = _channel_sum(self._forward(k), self._fs)
+        h, w = self.shape
+        return self._inverse(x, h - kh + 1, w - kw + 1)
+
+    def ssd(self, targets: np.ndarray, weights: np.ndarray, *, workers: int | None = None):
+        """Weighted SSD maps for a batch of blocks of one shape.
+
+        Parameters
+        ----------
+        targets : (n, bh, bw, C) float32
+            Existing content (only read where its weight is > 0).
+        weights : (n, bh, bw) or (n, G, bh, bw) float32
+            Non-negative weight of every block pixel, per channel group.
+
+        Returns
+        -------
+        (n, H - bh + 1, W - bw + 1) float32
+            ``e(p)`` for every anchor ``p`` (clipped at 0 against float round-off).
+        ``workers`` overrides the spectrum's FFT workers for this call.
+        """
+        t = np.asarray(targets, dtype=np.float32)
+        wts = np.asarray(weights, dtype=np.float32)
+        if wts.ndim == 3:
+            wts = wts[:, None]
+        n, bh, bw, c = t.shape
+        h, w = self.shape
+        if c != self.channels:
+            raise ValueError(f"targets must have {self.channels} channels, got {c}")
+        if bh > h or bw > w:
+            raise ValueError(f"block {bw}x{bh} is larger than the sample {w}x{h}")
+        tt = np.moveaxis(t, 3, 1)  # (n, C, bh, bw)
+        wc = wts[:, self.group_of]  # weight of each channel
+        k = wc * tt
+        const = np.einsum("nchw,nchw->n", k, tt, dtype=np.float64)
+        fk = self._forward(k, workers)
+        fw = self._forward(wts, workers)
+        x = _channel_sum(fw, self._fsq)
+        x -= 2 * _channel_sum(fk, self._fs)
+        e = self._inverse(x, h - bh + 1, w - bw + 1, workers)
+        e += const.astype(np.float32)[:, None, None]
+        np.maximum(e, 0, out=e)
+        return e
+
+
+def _channel_sum(fk: np.ndarray, fs: np.ndarray) -> np.ndarray:
+    """``Σ_c conj(fk[:, c]) · fs[c]`` — correlations summed over channels in the frequency
+    domain (a channel loop beats einsum and a fused numba loop here)."""
+    x = fk[:, 0].conj() * fs[0]
+    for c in range(1, fk.shape[1]):
+        x += fk[:, c].conj() * fs[c]
+    return x
+
+
+def masked_ssd(sample, target, mask, *, threads: int | None = None) -> np.ndarray:
+    """Masked SSD of ``target`` against every window of ``sample`` (ALGORITHMS.md §0).
+
+    Parameters
+    ----------
+    sample : (H, W[, C]) array_like
+    target : (bh, bw[, C]) array_like
+        Existing content; only its pixels where ``mask`` is set count.
+    mask : (bh, bw) array_like of bool or float
+        The overlap (or any non-negative weights).
+    threads : int, optional
+        FFT workers.
+
+    Returns
+    -------
+    (H - bh + 1, W - bw + 1) float32 ndarray
+        ``Σ_mask Σ_c (sample[y+u, x+v, c] − target[u, v, c])²`` at every anchor (y, x).
+    """
+    s = as_image(sample, "sample")
+    t = as_image(target, "target")
+    m = np.asarray(mask, dtype=np.float32)
+    if m.shape != t.shape[:2]:
+        raise ValueError(f"mask must be shaped like target {t.shape[:2]}, got {m.shape}")
+    if t.shape[2] != s.shape[2]:
+        raise ValueError(f"target has {t.shape[2]} channels, sample has {s.shape[2]}")
+    if np.any(m < 0):
+        raise ValueError("mask weights must be non-negative")
+    spec = SampleSpectrum(s, workers=_workers(threads))
+    return spec.ssd(t[None], m[None])[0]
+
+
+@njit(cache=True, nogil=True)
+def _gather_ssd(sample, anchors, ys, xs, values, out):  # pragma: no cover - compiled
+    c = sample.shape[2]
+    for k in range(anchors.shape[0]):
+        ay, ax = anchors[k, 0], anchors[k, 1]
+        acc = 0.0
+        for m in range(ys.shape[0]):
+            for ch in range(c):
+                d = np.float64(sample[ay + ys[m], ax + xs[m], ch]) - values[m, ch]
+                acc += d * d
+        out[k] = acc
+
+
+def ssd_at(sample: np.ndarray, anchors: np.ndarray, target: np.ndarray, mask: np.ndarray):
+    """Exact masked SSD at a few anchors ((k, 2) rows of (y, x)); float64 (k,).
+
+    ``Σ_mask Σ_c (sample[y+u, x+v, c] − target[u, v, c])²`` accumulated in float64."""
+    ys, xs = np.nonzero(mask)
+    a = np.ascontiguousarray(np.asarray(anchors, dtype=np.int64).reshape(-1, 2))
+    out = np.empty(len(a), np.float64)
+    vals = np.ascontiguousarray(target[ys, xs], dtype=np.float64)
+    _gather_ssd(
+        np.ascontiguousarray(sample), a, ys.astype(np.int64), xs.astype(np.int64), vals, out
+    )
+    return out
+
+
+def error_floor(sample: np.ndarray) -> float:
+    """Mean squared difference of adjacent sample pixels per channel (the texture's own
+    pixel-to-pixel variation), used to decide when an overlap error counts as zero."""
+    s = np.asarray(sample, dtype=np.float32)
+    dx = np.mean((s[:, 1:] - s[:, :-1]) ** 2) if s.shape[1] > 1 else 0.0
+    dy = np.mean((s[1:] - s[:-1]) ** 2) if s.shape[0] > 1 else 0.0
+    return float(max((dx + dy) / 2, 1e-12))
+
+
+ZERO_ERROR_FRACTION = 0.01
+"""An overlap error below this fraction of ``error_floor · |M| · C`` counts as an exact copy."""
+
+
+def select_within_tolerance(errors: np.ndarray, *, tolerance: float, zero_level: float, rng):
+    """Choose uniformly among the entries with ``e ≤ (1 + tolerance) · max(e_min, zero_level)``.
+
+    ``errors`` is any array (``inf`` = forbidden). ``zero_level`` implements ALGORITHMS §2.2's
+    "if e_min ≈ 0 use e_min + δ": without it only exact copies would ever qualify after a copy
+    whose error is 0. Returns ``(flat index, e_min, number of qualifying entries)``.
+    """
+    flat = errors.ravel()
+    i_min = int(np.argmin(flat))
+    e_min = float(flat[i_min])
+    if not np.isfinite(e_min):
+        raise ValueError("no valid candidate position (every position is excluded)")
+    limit = (1.0 + tolerance) * max(e_min, zero_level)
+    ok = np.flatnonzero(flat <= limit)
+    if ok.size == 0:  # float round-off
+        return i_min, e_min, 1
+    return int(ok[rng.integers(ok.size)]), e_min, int(ok.size)
+
+
+# ---------------------------------------------------------------------------- fast mode
+@njit(cache=True, nogil=True)
+def _estimates(q, features, base, invalid, out):  # pragma: no cover - compiled
+    """out[i, j] = base[i, j] - 2 Σ_k q[i, k] features[k, j]; inf where invalid[j].
+
+    A plain loop: single-threaded and bit-identical whatever the batch (a threaded BLAS
+    product is both slower at this size on small machines and batch dependent)."""
+    n, kk = q.shape
+    nn = features.shape[1]
+    for i in range(n):
+        for j in range(nn):
+            out[i, j] = base[i, j]
+        for k in range(kk):
+            c = -2.0 * q[i, k]
+            if c == 0.0:
+                continue
+            for j in range(nn):
+                out[i, j] += c * features[k, j]
+        for j in range(nn):
+            if invalid[j]:
+                out[i, j] = np.inf
+
+
+def _orthonormal(y: np.ndarray) -> np.ndarray:
+    """Orthonormal basis of the columns of ``y`` (n, r) via the tiny r×r Gram matrix."""
+    lam, v = np.linalg.eigh(y.T @ y)
+    keep = lam > lam.max() * 1e-10
+    return y @ (v[:, keep] / np.sqrt(lam[keep]))
+
+
+def _randomized_pca(x: np.ndarray, k: int, rng, *, power: int = 1) -> np.ndarray:
+    """Top ``k`` principal directions (k, d) of the rows of ``x`` (Halko et al. range finder).
+
+    Only products with ``x`` and eigen-decompositions of r×r matrices (r = k + 8): LAPACK's QR
+    and SVD of the tall matrices are needlessly slow when threaded on a small machine.
+    """
+    x = (x - x.mean(axis=0)).astype(np.float64)
+    r = min(k + 8, min(x.shape))
+    y = x @ rng.standard_normal((x.shape[1], r))
+    for _ in range(power):
+        y = x @ (x.T @ _orthonormal(y))
+    b = _orthonormal(y).T @ x  # (r', d)
+    lam, u = np.linalg.eigh(b @ b.T)
+    order = np.argsort(lam)[::-1][:k]
+    comps = (u[:, order].T @ b) / np.sqrt(np.maximum(lam[order], 1e-30))[:, None]
+    return np.ascontiguousarray(comps, dtype=np.float32)
+
+
+class PCAMatcher:
+    """Approximate nearest candidates for an L-shaped overlap, then exact re-ranking.
+
+    The overlap of a ``block`` = (bh, bw) block with arms ``top`` rows and ``left`` columns is cut
+    into three disjoint parts: the corner (top × left), the rest of the left arm and the rest of
+    the top arm. Each part gets ``components`` principal components (randomized PCA of ≤ 256
+    random sample windows); the projections of every sample window on them are computed by FFT
+    correlation. A query with the parts it has (left arm only, top arm only, or both) ranks all
+    windows by ``‖f‖² − 2·proj(f)·proj(T)`` (``‖f‖²`` exact, from a summed-area table; the
+    constant ``‖T‖²`` dropped) and re-ranks the ``rerank`` best by the exact SSD.
+    """
+
+    def __init__(
+        self, spectrum: SampleSpectrum, block, *, top: int, left: int, components: int = 8, rng=None
+    ):
+        self.spec = spectrum
+        s = spectrum.sample
+        bh, bw = int(block[0]), int(block[1])
+        self.block = (bh, bw)
+        self.top, self.left = int(top), int(left)
+        h, w, c = s.shape
+        self.anchor_shape = (h - bh + 1, w - bw + 1)
+        rng = as_rng(rng)
+        rects = {
+            "corner": (0, 0, self.top, self.left),
+            "left": (self.top, 0, bh - self.top, self.left),
+            "top": (0, self.left, self.top, bw - self.left),
+        }
+        self.rects = {k: r for k, r in rects.items() if r[2] > 0 and r[3] > 0}
+        na = self.anchor_shape[0] * self.anchor_shape[1]
+        picks = rng.choice(na, size=min(na, 256), replace=False)
+        py, px = np.divmod(picks, self.anchor_shape[1])
+        sq = np.sum(s.astype(np.float64) ** 2, axis=2)
+        self.bases: dict[str, np.ndarray] = {}
+        self.norms: dict[str, np.ndarray] = {}
+        self.offsets: dict[str, tuple[int, int]] = {}
+        kernels = []
+        i = 0
+        for name, (y0, x0, rh, rw) in self.rects.items():
+            win = s[
+                py[:, None, None] + y0 + np.arange(rh)[None, :, None],
+                px[:, None, None] + x0 + np.arange(rw)[None, None, :],
+            ]
+            x = win.reshape(len(picks), -1)
+            k = min(int(components), x.shape[1], max(len(picks) - 1, 1))
+            basis = _randomized_pca(x, k, rng)
+            self.bases[name] = basis
+            self.offsets[name] = (i, i + k)
+            i += k
+            kern = np.zeros((k, c, bh, bw), np.float32)
+            kern[:, :, y0 : y0 + rh, x0 : x0 + rw] = np.moveaxis(basis.reshape(k, rh, rw, c), 3, 1)
+            kernels.append(kern)
+            self.norms[name] = box_sums_float(sq, (rh, rw))[
+                y0 : y0 + self.anchor_shape[0], x0 : x0 + self.anchor_shape[1]
+            ].astype(np.float32)
+        proj = spectrum.correlate(np.concatenate(kernels))
+        self.features = np.ascontiguousarray(proj.reshape(i, -1))  # (K, N)
+
+    def parts_for(self, top: int, left: int) -> tuple[str, ...]:
+        """Parts covered by an overlap with ``top`` rows and ``left`` columns, or () if the
+        overlap is not one this index describes."""
+        if (top, left) == (self.top, self.left):
+            return tuple(self.rects)
+        if top == 0 and left == self.left:
+            return tuple(n for n in ("corner", "left") if n in self.rects)
+        if left == 0 and top == self.top:
+            return tuple(n for n in ("corner", "top") if n in self.rects)
+        return ()
+
+    def query(self, targets, parts_list, valid, *, rerank: int, mask_list):
+        """Best ``rerank`` anchors by the exact SSD for each target.
+
+        ``targets`` (n, bh, bw, C); ``parts_list`` the parts of each; ``valid`` the allowed
+        anchors (bool, anchor_shape) or None; ``mask_list`` each target's overlap mask.
+        Returns a list of ``(anchors (k, 2), exact errors (k,))`` sorted by error.
+        """
+        n = len(targets)
+        nn = self.features.shape[1]
+        q = np.zeros((n, self.features.shape[0]), np.float32)
+        base = np.zeros((n, nn), np.float32)
+        for i, (t, parts) in enumerate(zip(targets, parts_list, strict=True)):
+            for name in parts:
+                y0, x0, rh, rw = self.rects[name]
+                a, b = self.offsets[name]
+                q[i, a:b] = self.bases[name] @ t[y0 : y0 + rh, x0 : x0 + rw].ravel()
+                base[i] += self.norms[name].ravel()
+        invalid = np.zeros(nn, bool) if valid is None else ~valid.ravel()
+        est = np.empty((n, nn), np.float32)
+        _estimates(q, self.features, base, invalid, est)
+        m = min(int(rerank), nn)
+        out = []
+        for i in range(n):
+            idx = np.argpartition(est[i], m - 1)[:m] if m < nn else np.arange(m)
+            idx = idx[np.isfinite(est[i, idx])]
+            anchors = np.column_stack(np.divmod(idx, self.anchor_shape[1]))
+            exact = ssd_at(self.spec.sample, anchors, targets[i], mask_list[i])
+            order = np.argsort(exact, kind="stable")
+            out.append((anchors[order], exact[order]))
+        return out
+
+
+def box_sums_float(values: np.ndarray, box) -> np.ndarray:
+    """Sum of ``values`` over every ``box`` window (float64 summed-area table)."""
+    bh, bw = box
+    h, w = values.shape
+    sat = np.zeros((h + 1, w + 1), np.float64)
+    np.cumsum(np.cumsum(values, axis=0), axis=1, out=sat[1:, 1:])
+    return sat[bh:, bw:] - sat[:-bh, bw:] - sat[bh:, :-bw] + sat[:-bh, :-bw]
+
+
+def check_block(block, name: str = "block") -> tuple[int, int]:
+    """``block`` as (bh, bw) from an int or a pair of ints."""
+    if isinstance(block, tuple | list):
+        if len(block) != 2:
+            raise ValueError(f"{name} must be an int or (height, width), got {block!r}")
+        return positive_int(block[0], name), positive_int(block[1], name)
+    b = positive_int(block, name)
+    return b, b

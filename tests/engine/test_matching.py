@@ -1,0 +1,145 @@
+import numpy as np
+import pytest
+
+from engine.matching import (
+    PCAMatcher,
+    SampleSpectrum,
+    masked_ssd,
+    select_within_tolerance,
+    ssd_at,
+)
+
+
+def brute_ssd(sample, target, weights):
+    s = np.asarray(sample, np.float64)
+    t = np.asarray(target, np.float64)
+    if s.ndim == 2:
+        s, t = s[:, :, None], t[:, :, None]
+    bh, bw = t.shape[:2]
+    out = np.empty((s.shape[0] - bh + 1, s.shape[1] - bw + 1))
+    for y in range(out.shape[0]):
+        for x in range(out.shape[1]):
+            out[y, x] = (weights[:, :, None] * (s[y : y + bh, x : x + bw] - t) ** 2).sum()
+    return out
+
+
+def l_mask(bh, bw, top, left):
+    m = np.zeros((bh, bw), bool)
+    m[:top] = True
+    m[:, :left] = True
+    return m
+
+
+@pytest.mark.parametrize(
+    "shape, block, channels",
+    [((23, 29), (7, 9), 3), ((31, 17), (5, 5), 1), ((16, 16), (16, 16), 3), ((19, 40), (8, 3), 4)],
+)
+def test_exact_masked_ssd_equals_brute_force(shape, block, channels):
+    rng = np.random.default_rng(sum(shape))
+    sample = rng.random((*shape, channels)).astype(np.float32)
+    target = rng.random((*block, channels)).astype(np.float32)
+    mask = l_mask(*block, top=2, left=3)
+    got = masked_ssd(sample, target, mask)
+    want = brute_ssd(sample, target, mask)
+    assert got.dtype == np.float32 and got.shape == want.shape
+    # float32 FFT: absolute error far below one grey level squared over the overlap
+    np.testing.assert_allclose(got, want, rtol=1e-4, atol=1e-4 * mask.sum() * channels)
+    assert np.argmin(got) == np.argmin(want) or np.isclose(got.min(), want.min(), rtol=1e-4)
+
+
+def test_union_mask_does_not_double_count_the_corner():
+    rng = np.random.default_rng(1)
+    sample = rng.random((20, 20, 3)).astype(np.float32)
+    target = rng.random((6, 6, 3)).astype(np.float32)
+    union = l_mask(6, 6, 2, 2)
+    got = masked_ssd(sample, target, union)
+    sum_of_strips = masked_ssd(sample, target, l_mask(6, 6, 2, 0)) + masked_ssd(
+        sample, target, l_mask(6, 6, 0, 2)
+    )
+    np.testing.assert_allclose(got, brute_ssd(sample, target, union), rtol=1e-4, atol=1e-3)
+    assert (sum_of_strips > got + 1e-3).all()  # the strips' sum counts the corner twice
+
+
+def test_weighted_groups_and_batches():
+    rng = np.random.default_rng(2)
+    sample = rng.random((25, 30, 4)).astype(np.float32)
+    spec = SampleSpectrum(sample, groups=((0, 1, 2), (3,)))
+    targets = rng.random((3, 6, 7, 4)).astype(np.float32)
+    weights = rng.random((3, 2, 6, 7)).astype(np.float32)
+    got = spec.ssd(targets, weights)
+    for i in range(3):
+        want = brute_ssd(sample[..., :3], targets[i, ..., :3], weights[i, 0]) + brute_ssd(
+            sample[..., 3], targets[i, ..., 3], weights[i, 1]
+        )
+        np.testing.assert_allclose(got[i], want, rtol=1e-4, atol=1e-3)
+
+
+def test_exact_copy_scores_zero_and_is_found():
+    rng = np.random.default_rng(3)
+    sample = rng.random((40, 40, 3)).astype(np.float32)
+    target = sample[11:19, 23:31].copy()
+    e = masked_ssd(sample, target, l_mask(8, 8, 2, 2))
+    assert e.min() >= 0
+    assert np.unravel_index(np.argmin(e), e.shape) == (11, 23)
+    assert e[11, 23] < 1e-3
+
+
+def test_ssd_at_matches_brute_force():
+    rng = np.random.default_rng(4)
+    sample = rng.random((20, 22, 3)).astype(np.float32)
+    target = rng.random((5, 6, 3)).astype(np.float32)
+    mask = l_mask(5, 6, 1, 2)
+    anchors = np.array([[0, 0], [15, 16], [7, 3]])
+    want = brute_ssd(sample, target, mask)[anchors[:, 0], anchors[:, 1]]
+    np.testing.assert_allclose(ssd_at(sample, anchors, target, mask), want, rtol=1e-10)
+
+
+def test_select_within_tolerance():
+    rng = np.random.default_rng(0)
+    e = np.array([5.0, 1.0, 1.05, 1.2, np.inf, 1.09])
+    picks = {
+        select_within_tolerance(e, tolerance=0.1, zero_level=0, rng=rng)[0] for _ in range(200)
+    }
+    assert picks == {1, 2, 5}
+    # e_min ≈ 0: the zero level widens the set beyond the exact copy
+    e0 = np.array([0.0, 0.5, 0.9, 3.0])
+    picks0 = {
+        select_within_tolerance(e0, tolerance=0.1, zero_level=1.0, rng=rng)[0] for _ in range(200)
+    }
+    assert picks0 == {0, 1, 2}
+    with pytest.raises(ValueError, match="no valid candidate"):
+        select_within_tolerance(np.full(3, np.inf), tolerance=0.1, zero_level=0, rng=rng)
+
+
+def test_pca_fast_mode_finds_the_best_candidates():
+    """The fast ranking with exact re-ranking recovers the exact best window on a real texture
+    (its errors are exact SSDs of real windows: never below the exhaustive minimum)."""
+    from engine.io import load_image
+    from resources import sample_path
+
+    s = load_image(sample_path("cobblestones")).pixels[:96, :96]
+    spec = SampleSpectrum(s)
+    pca = PCAMatcher(spec, (24, 24), top=4, left=4, rng=0)
+    rng = np.random.default_rng(5)
+    hits = 0
+    for _ in range(10):
+        y, x = rng.integers(0, 60, 2)
+        target = s[y : y + 24, x : x + 24] + rng.normal(0, 0.05, (24, 24, 3)).astype(np.float32)
+        mask = l_mask(24, 24, 4, 4)
+        exact = spec.ssd(target[None], mask[None])[0]
+        ((anchors, errs),) = pca.query(
+            [target], [pca.parts_for(4, 4)], None, rerank=16, mask_list=[mask]
+        )
+        assert errs[0] >= exact.min() - 1e-2
+        np.testing.assert_allclose(errs, exact[anchors[:, 0], anchors[:, 1]], rtol=1e-4, atol=1e-3)
+        hits += np.isclose(errs[0], exact.min(), rtol=1e-4, atol=1e-3)
+    assert hits >= 8
+
+
+def test_masked_ssd_errors():
+    with pytest.raises(ValueError, match="mask"):
+        masked_ssd(np.zeros((9, 9, 3)), np.zeros((3, 3, 3)), np.ones((2, 3)))
+    with pytest.raises(ValueError, match="channels"):
+        masked_ssd(np.zeros((9, 9, 3)), np.zeros((3, 3)), np.ones((3, 3)))
+    with pytest.raises(ValueError, match="larger than the sample"):
+        masked_ssd(np.zeros((4, 4, 3)), np.zeros((5, 3, 3)), np.ones((5, 3)))
