@@ -65,7 +65,8 @@ def _picks(text: str) -> list[int]:
         out = [int(t) for t in text.replace(" ", "").split(",") if t != ""]
     except ValueError:
         raise argparse.ArgumentTypeError(
-            f"expected comma-separated tile indices like 0,3,7, got {text!r}") from None
+            f"expected comma-separated tile indices like 0,3,7, got {text!r}"
+        ) from None
     if not out or min(out) < 0 or len(set(out)) != len(out):
         raise argparse.ArgumentTypeError(f"picks must be distinct indices >= 0, got {text!r}")
     return out
@@ -99,7 +100,8 @@ def _colour_range(text: str):
         hi_v = [float(v) for v in hi.split(",")]
     except ValueError:
         raise argparse.ArgumentTypeError(
-            f"expected LO:HI like 0,0,0:0.2,0.2,0.25 or 0:0.1, got {text!r}") from None
+            f"expected LO:HI like 0,0,0:0.2,0.2,0.25 or 0:0.1, got {text!r}"
+        ) from None
     return (lo_v[0] if len(lo_v) == 1 else lo_v, hi_v[0] if len(hi_v) == 1 else hi_v)
 
 
@@ -117,47 +119,128 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     )
     p.add_argument("source", metavar="SOURCE", help="source texture (PNG, JPEG, TIFF, BMP, WebP)")
     p.add_argument("--out", required=True, metavar="DIR", help="output folder (created)")
-    p.add_argument("--candidates", type=_int_at_least(1), default=30, metavar="N",
-                   help="number of candidate tiles (default 30)")
-    p.add_argument("--tile-min", type=_size, default=None, metavar="N|HxW",
-                   help="smallest tile (default: a quarter of the source's shorter side)")
-    p.add_argument("--tile-max", type=_size, default=None, metavar="N|HxW",
-                   help="largest tile (default: half the source's shorter side)")
-    p.add_argument("--rect", default=None, metavar="X,Y,W,H",
-                   help="use this tile rectangle instead of searching one")
-    p.add_argument("--overlap", type=_int_at_least(2), default=None, metavar="N",
-                   help="w_T, width of the template's border regions (default: tile/10)")
-    p.add_argument("--patch-overlap", type=_int_at_least(2), default=None, metavar="N",
-                   help="w_P, the ring the patch cut runs in (default: --overlap)")
-    p.add_argument("--patch-size", type=_size, default=None, metavar="N|HxW",
-                   help="patch window (default: the tile size)")
-    p.add_argument("--margin", type=_int_at_least(0), default=2, metavar="N",
-                   help="outer pixels every candidate keeps from the template (default 2)")
-    p.add_argument("--neighbourhood", type=_int_at_least(0), default=5, metavar="N",
-                   help="refine each random patch position within +-N px (default 5)")
+    p.add_argument(
+        "--candidates",
+        type=_int_at_least(1),
+        default=30,
+        metavar="N",
+        help="number of candidate tiles (default 30)",
+    )
+    p.add_argument(
+        "--tile-min",
+        type=_size,
+        default=None,
+        metavar="N|HxW",
+        help="smallest tile (default: a quarter of the source's shorter side)",
+    )
+    p.add_argument(
+        "--tile-max",
+        type=_size,
+        default=None,
+        metavar="N|HxW",
+        help="largest tile (default: half the source's shorter side)",
+    )
+    p.add_argument(
+        "--rect",
+        default=None,
+        metavar="X,Y,W,H",
+        help="use this tile rectangle instead of searching one",
+    )
+    p.add_argument(
+        "--overlap",
+        type=_int_at_least(2),
+        default=None,
+        metavar="N",
+        help="w_T, width of the template's border regions (default: tile/10)",
+    )
+    p.add_argument(
+        "--patch-overlap",
+        type=_int_at_least(2),
+        default=None,
+        metavar="N",
+        help="w_P, the ring the patch cut runs in (default: --overlap)",
+    )
+    p.add_argument(
+        "--patch-size",
+        type=_size,
+        default=None,
+        metavar="N|HxW",
+        help="patch window (default: the tile size)",
+    )
+    p.add_argument(
+        "--margin",
+        type=_int_at_least(0),
+        default=2,
+        metavar="N",
+        help="outer pixels every candidate keeps from the template (default 2)",
+    )
+    p.add_argument(
+        "--neighbourhood",
+        type=_int_at_least(0),
+        default=5,
+        metavar="N",
+        help="refine each random patch position within +-N px (default 5)",
+    )
     p.add_argument("--seam", choices=METHODS, default="dp", help="seam method (default dp)")
     p.add_argument("--metric", choices=METRICS, default="euclid", help="error metric")
-    p.add_argument("--blend", choices=BLEND_MODES, default=None,
-                   help="blending of every cut (default: none for the template, adaptive "
-                   "for the patches)")
+    p.add_argument(
+        "--blend",
+        choices=BLEND_MODES,
+        default=None,
+        help="blending of every cut (default: none for the template, adaptive for the patches)",
+    )
     p.add_argument("--rho", type=_int_at_least(0), default=3, help="adaptive blending ρ")
     p.add_argument("--width", type=_int_at_least(0), default=4, help="feather width in px")
     p.add_argument("--seed", type=_int_at_least(0), default=0, help="random seed (default 0)")
-    p.add_argument("--pick", type=_picks, default=None, metavar="I,J,...",
-                   help="tile indices for the preview and the project (default: all)")
-    p.add_argument("--preview", type=_grid, default=(8, 8), metavar="RxC",
-                   help="preview grid in tiles (default 8x8)")
-    p.add_argument("--equal-neighbours", action="store_true",
-                   help="allow equal neighbouring tiles in the preview's index matrix")
+    p.add_argument(
+        "--pick",
+        type=_picks,
+        default=None,
+        metavar="I,J,...",
+        help="tile indices for the preview and the project (default: all)",
+    )
+    p.add_argument(
+        "--preview",
+        type=_grid,
+        default=(8, 8),
+        metavar="RxC",
+        help="preview grid in tiles (default 8x8)",
+    )
+    p.add_argument(
+        "--equal-neighbours",
+        action="store_true",
+        help="allow equal neighbouring tiles in the preview's index matrix",
+    )
     p.add_argument("--workers", type=_int_at_least(1), default=2, help="threads (default 2)")
-    p.add_argument("--map", type=_named("file"), action="append", default=[],
-                   metavar="NAME=FILE", help="a co-registered material map (repeatable)")
-    p.add_argument("--weight", type=_named("weight"), action="append", default=[],
-                   metavar="NAME=W", help="seam error weight of a map ('main' = SOURCE)")
-    p.add_argument("--exclude-mask", default=None, metavar="FILE",
-                   help="image whose non-black pixels mark source pixels not to use")
-    p.add_argument("--exclude-color", type=_colour_range, default=None, metavar="LO:HI",
-                   help="exclude source colours in [LO, HI] per channel, e.g. 0,0,0:0.2,0.2,0.3")
+    p.add_argument(
+        "--map",
+        type=_named("file"),
+        action="append",
+        default=[],
+        metavar="NAME=FILE",
+        help="a co-registered material map (repeatable)",
+    )
+    p.add_argument(
+        "--weight",
+        type=_named("weight"),
+        action="append",
+        default=[],
+        metavar="NAME=W",
+        help="seam error weight of a map ('main' = SOURCE)",
+    )
+    p.add_argument(
+        "--exclude-mask",
+        default=None,
+        metavar="FILE",
+        help="image whose non-black pixels mark source pixels not to use",
+    )
+    p.add_argument(
+        "--exclude-color",
+        type=_colour_range,
+        default=None,
+        metavar="LO:HI",
+        help="exclude source colours in [LO, HI] per channel, e.g. 0,0,0:0.2,0.2,0.3",
+    )
     add_project_option(p)
     p.set_defaults(func=run)
     return p
@@ -207,8 +290,13 @@ def load_source(path):
             head = f.read(33)
     except OSError:
         head = b""
-    if (loaded.bit_depth == 8 and head.startswith(b"\x89PNG\r\n\x1a\n") and head[12:16] == b"IHDR"
-            and head[24] == 16 and head[25] in (2, 6)):
+    if (
+        loaded.bit_depth == 8
+        and head.startswith(b"\x89PNG\r\n\x1a\n")
+        and head[12:16] == b"IHDR"
+        and head[24] == 16
+        and head[25] in (2, 6)
+    ):
         from engine.export._png import decode_png
 
         q = decode_png(Path(path).read_bytes())
@@ -261,7 +349,8 @@ def _run(args) -> int:
             if m.shape[:2] != (H, W):
                 raise ValueError(
                     f"{args.exclude_mask}: the mask is {m.shape[1]}x{m.shape[0]}, the source "
-                    f"{W}x{H}")
+                    f"{W}x{H}"
+                )
             painted = m[:, :, : max(1, m.shape[2] - (m.shape[2] in (2, 4)))].max(axis=2) > 0
         excluded = exclusion_mask(S, color_range=args.exclude_color, painted=painted)
         say(f"excluded: {int(excluded.sum())} of {H * W} source pixels")
@@ -284,43 +373,78 @@ def _run(args) -> int:
         cost = None
         say(f"template: fixed rectangle {rect}, overlap {overlap}")
     else:
+
         def on_template(ev):
             if isinstance(ev, TemplateUpdate):
                 say(f"template: {ev.phase} rect {ev.rect} cost {ev.cost:.4f}")
 
         tmpl = _run_events(
-            iter_find_template(S, tile_min=tile_min, tile_max=tile_max, overlap=args.overlap,
-                               excluded=excluded), on_template)
+            iter_find_template(
+                S, tile_min=tile_min, tile_max=tile_max, overlap=args.overlap, excluded=excluded
+            ),
+            on_template,
+        )
         rect, overlap, cost = tmpl.rect, tmpl.overlap, tmpl.cost
         warn_list += list(tmpl.warnings)
 
     # 2. seamless tile
     st = _run_events(
-        iter_make_seamless(S, rect, overlap=overlap, method=args.seam, metric=args.metric,
-                           blend=tmpl_blend, width=args.width, rho=args.rho, maps=maps or None,
-                           weights=weights), lambda ev: None)
+        iter_make_seamless(
+            S,
+            rect,
+            overlap=overlap,
+            method=args.seam,
+            metric=args.metric,
+            blend=tmpl_blend,
+            width=args.width,
+            rho=args.rho,
+            maps=maps or None,
+            weights=weights,
+        ),
+        lambda ev: None,
+    )
     warn_list += [w for w in st.warnings if w not in warn_list]
-    say(f"seamless tile {rect[2]}x{rect[3]}: seam criterion h {st.criterion['horizontal']:.2f}"
-        f" v {st.criterion['vertical']:.2f}")
+    say(
+        f"seamless tile {rect[2]}x{rect[3]}: seam criterion h {st.criterion['horizontal']:.2f}"
+        f" v {st.criterion['vertical']:.2f}"
+    )
 
     # 3. candidates
     n = args.candidates
 
     def on_candidate(ev):
         if isinstance(ev, CandidateTile):
-            say(f"candidate {ev.index:3d} ({done[0] + 1}/{n}): patch {ev.patch_rect}, criterion "
-                f"{ev.scores['criterion']:.2f}, changed {ev.scores['changed']:.0%}")
+            say(
+                f"candidate {ev.index:3d} ({done[0] + 1}/{n}): patch {ev.patch_rect}, criterion "
+                f"{ev.scores['criterion']:.2f}, changed {ev.scores['changed']:.0%}"
+            )
             done[0] += 1
         elif isinstance(ev, Progress) and ev.message.endswith("cancelled"):
             say(ev.message)
 
     done = [0]
     cands = _run_events(
-        iter_candidates(S, st, n, patch_size=args.patch_size, patch_overlap=args.patch_overlap,
-                        margin=args.margin, neighbourhood=args.neighbourhood, method=args.seam,
-                        metric=args.metric, blend=cand_blend, width=args.width, rho=args.rho,
-                        excluded=excluded, maps=maps or None, weights=weights, rng=args.seed,
-                        workers=args.workers), on_candidate)
+        iter_candidates(
+            S,
+            st,
+            n,
+            patch_size=args.patch_size,
+            patch_overlap=args.patch_overlap,
+            margin=args.margin,
+            neighbourhood=args.neighbourhood,
+            method=args.seam,
+            metric=args.metric,
+            blend=cand_blend,
+            width=args.width,
+            rho=args.rho,
+            excluded=excluded,
+            maps=maps or None,
+            weights=weights,
+            rng=args.seed,
+            workers=args.workers,
+        ),
+        on_candidate,
+    )
 
     # 4. picks and preview layout
     picks = args.pick if args.pick is not None else list(range(len(cands)))
@@ -328,13 +452,20 @@ def _run(args) -> int:
     if bad:
         raise ValueError(f"--pick {bad} out of range: there are {len(cands)} candidates")
     rows, cols = args.preview
-    ids = random_layout(len(picks), rows, cols, rng=args.seed,
-                        no_equal_neighbours=not args.equal_neighbours and len(picks) > 1)
+    ids = random_layout(
+        len(picks),
+        rows,
+        cols,
+        rng=args.seed,
+        no_equal_neighbours=not args.equal_neighbours and len(picks) > 1,
+    )
     cells = np.asarray(picks, dtype=np.int64)[ids]  # candidate indices
     from engine.tiles import assemble
 
-    preview = {m: assemble([cands[k] for k in picks], ids, map_name=None if m == "main" else m)
-               for m in ["main", *maps]}
+    preview = {
+        m: assemble([cands[k] for k in picks], ids, map_name=None if m == "main" else m)
+        for m in ["main", *maps]
+    }
 
     # 5. files
     out = Path(args.out)
@@ -353,38 +484,72 @@ def _run(args) -> int:
     for c in cands:
         files = write(f"tile_{c.index:03d}", {"main": c.tile, **c.maps})
         x, y, w, h = c.patch_rect
-        tile_entries.append({
-            "index": c.index, "file": files["main"], "maps": files, "seed": c.seed,
-            "source_rect": [x, y, w, h], "patch_origin": list(c.patch_origin),
-            "target_rect": list(c.target_rect),
-            "scores": {k: float(v) for k, v in c.scores.items()},
-        })
+        tile_entries.append(
+            {
+                "index": c.index,
+                "file": files["main"],
+                "maps": files,
+                "seed": c.seed,
+                "source_rect": [x, y, w, h],
+                "patch_origin": list(c.patch_origin),
+                "target_rect": list(c.target_rect),
+                "scores": {k: float(v) for k, v in c.scores.items()},
+            }
+        )
     preview_files = write("preview", preview)
     _write_text(out / "layout.csv", _csv(cells))
-    layout_doc = {"tile_w": int(rect[2]), "tile_h": int(rect[3]), "rows": rows, "cols": cols,
-                  "cells": cells.tolist(), "cells_are": "tile indices (tile_NNN.png)"}
+    layout_doc = {
+        "tile_w": int(rect[2]),
+        "tile_h": int(rect[3]),
+        "rows": rows,
+        "cols": cols,
+        "cells": cells.tolist(),
+        "cells_are": "tile indices (tile_NNN.png)",
+    }
     _write_text(out / "layout.json", json.dumps(layout_doc, indent=1) + "\n")
     parameters = {
-        "tile_min": tile_min, "tile_max": tile_max, "overlap": overlap,
+        "tile_min": tile_min,
+        "tile_max": tile_max,
+        "overlap": overlap,
         "patch_overlap": args.patch_overlap or overlap,
-        "patch_size": args.patch_size or [int(rect[3]), int(rect[2])], "margin": args.margin,
-        "neighbourhood": args.neighbourhood, "seam": args.seam, "metric": args.metric,
-        "template_blend": tmpl_blend, "candidate_blend": cand_blend, "rho": args.rho,
-        "width": args.width, "candidates": n, "workers": args.workers,
-        "weights": weights, "preview": [rows, cols],
+        "patch_size": args.patch_size or [int(rect[3]), int(rect[2])],
+        "margin": args.margin,
+        "neighbourhood": args.neighbourhood,
+        "seam": args.seam,
+        "metric": args.metric,
+        "template_blend": tmpl_blend,
+        "candidate_blend": cand_blend,
+        "rho": args.rho,
+        "width": args.width,
+        "candidates": n,
+        "workers": args.workers,
+        "weights": weights,
+        "preview": [rows, cols],
         "no_equal_neighbours": not args.equal_neighbours,
     }
     manifest = {
-        "format": FORMAT, "version": VERSION,
-        "source": {"path": str(args.source), "width": W, "height": H,
-                   "channels": int(S.shape[2]), "bit_depth": depth,
-                   "maps": {k: p for k, p in args.map}},
+        "format": FORMAT,
+        "version": VERSION,
+        "source": {
+            "path": str(args.source),
+            "width": W,
+            "height": H,
+            "channels": int(S.shape[2]),
+            "bit_depth": depth,
+            "maps": {k: p for k, p in args.map},
+        },
         "seed": args.seed,
         "parameters": parameters,
-        "template": {"file": template_files["main"], "maps": template_files,
-                     "rect": list(rect), "overlap": overlap,
-                     "footprint": [rect[0], rect[1], rect[2] + overlap, rect[3] + overlap],
-                     "cost": cost, "seam_criterion": st.criterion, "seam_peak": st.peak},
+        "template": {
+            "file": template_files["main"],
+            "maps": template_files,
+            "rect": list(rect),
+            "overlap": overlap,
+            "footprint": [rect[0], rect[1], rect[2] + overlap, rect[3] + overlap],
+            "cost": cost,
+            "seam_criterion": st.criterion,
+            "seam_peak": st.peak,
+        },
         "tiles": tile_entries,
         "picks": picks,
         "layout": {"csv": "layout.csv", "json": "layout.json"},

@@ -145,11 +145,29 @@ class _AnyCancel:
 class _Setup:
     """Validated inputs shared by every candidate of one run."""
 
-    def __init__(self, source, template, *, patch_size, patch_overlap, margin, neighbourhood,
-                 method, metric, blend, width, rho, excluded, maps, weights, seam_options):
+    def __init__(
+        self,
+        source,
+        template,
+        *,
+        patch_size,
+        patch_overlap,
+        margin,
+        neighbourhood,
+        method,
+        metric,
+        blend,
+        width,
+        rho,
+        excluded,
+        maps,
+        weights,
+        seam_options,
+    ):
         if not isinstance(template, SeamlessTile):
             raise TypeError(
-                f"template must be a SeamlessTile (from make_seamless), got {type(template).__name__}"
+                "template must be a SeamlessTile (from make_seamless), got "
+                f"{type(template).__name__}"
             )
         self.S = as_image(source, "source")
         H, W = self.S.shape[:2]
@@ -161,8 +179,8 @@ class _Setup:
                 f"{template.tile.shape[2]}: use the source the template was made from"
             )
         self.ring = positive_int(
-            template.overlap if patch_overlap is None else patch_overlap, "patch_overlap",
-            minimum=2)
+            template.overlap if patch_overlap is None else patch_overlap, "patch_overlap", minimum=2
+        )
         self.margin = positive_int(margin, "margin", minimum=0)
         if self.margin >= self.ring:
             raise ValueError(
@@ -185,8 +203,14 @@ class _Setup:
         choice(blend, "blend", BLEND_MODES)
         choice(method, "method", METHODS)
         choice(metric, "metric", METRICS)
-        self.opts = dict(method=method, metric=metric, blend=blend, width=positive_int(
-            width, "width", minimum=0), rho=positive_int(rho, "rho", minimum=0), **seam_options)
+        self.opts = dict(
+            method=method,
+            metric=metric,
+            blend=blend,
+            width=positive_int(width, "width", minimum=0),
+            rho=positive_int(rho, "rho", minimum=0),
+            **seam_options,
+        )
         self.metric = metric
         extra = as_maps(maps, (H, W))
         if set(extra) != set(template.maps):
@@ -196,8 +220,10 @@ class _Setup:
             )
         self.weights = check_weights(weights, extra)
         self.stack = {MAIN: self.S, **extra}
-        tmaps = {MAIN: np.asarray(template.tile), **{k: np.asarray(v) for k, v in
-                                                      template.maps.items()}}
+        tmaps = {
+            MAIN: np.asarray(template.tile),
+            **{k: np.asarray(v) for k, v in template.maps.items()},
+        }
         self.tmaps = tmaps
         win = (slice(self.ty, self.ty + ph), slice(self.tx, self.tx + pw))
         self.U = {k: v[win] for k, v in tmaps.items()}
@@ -223,8 +249,12 @@ class _Setup:
 
     def parameters(self) -> dict:
         p = {k: v for k, v in self.opts.items() if isinstance(v, (int, float, str, bool))}
-        p.update(patch_size=[self.ph, self.pw], patch_overlap=self.ring, margin=self.margin,
-                 neighbourhood=self.n)
+        p.update(
+            patch_size=[self.ph, self.pw],
+            patch_overlap=self.ring,
+            margin=self.margin,
+            neighbourhood=self.n,
+        )
         return p
 
     # ---- positions
@@ -264,8 +294,15 @@ class _Setup:
         win = (slice(sy, sy + self.ph), slice(sx, sx + self.pw))
         Q = {k: v[win] for k, v in self.stack.items()}
         err = seam_error(Q, self.U, self.weights, self.metric)
-        cut = patch_cut(Q[MAIN], self.U[MAIN], ring=self.ring, margin=self.margin, error=err,
-                        cancel=cancel, **self.opts)
+        cut = patch_cut(
+            Q[MAIN],
+            self.U[MAIN],
+            ring=self.ring,
+            margin=self.margin,
+            error=err,
+            cancel=cancel,
+            **self.opts,
+        )
         check(cancel)
         out = apply_cut(Q, self.U, cut.alpha)
         ty, tx, ph, pw = self.ty, self.tx, self.ph, self.pw
@@ -317,11 +354,28 @@ def _ring_equal(a: np.ndarray, b: np.ndarray, m: int) -> bool:
 
 
 # --------------------------------------------------------------------------- API
-def iter_candidates(source, template: SeamlessTile, n: int = 30, *, patch_size=None,
-                    patch_overlap=None, margin: int = 2, neighbourhood: int = 5,
-                    method: str = "dp", metric: str = "euclid", blend: str = "adaptive",
-                    width: int = 4, rho: int = 3, excluded=None, maps=None, weights=None,
-                    rng=None, workers: int = 2, cancel=None, **seam_options):
+def iter_candidates(
+    source,
+    template: SeamlessTile,
+    n: int = 30,
+    *,
+    patch_size=None,
+    patch_overlap=None,
+    margin: int = 2,
+    neighbourhood: int = 5,
+    method: str = "dp",
+    metric: str = "euclid",
+    blend: str = "adaptive",
+    width: int = 4,
+    rho: int = 3,
+    excluded=None,
+    maps=None,
+    weights=None,
+    rng=None,
+    workers: int = 2,
+    cancel=None,
+    **seam_options,
+):
     """Stream ``n`` connectable variants of ``template``; the generator's value is their list.
 
     Parameters
@@ -355,10 +409,23 @@ def iter_candidates(source, template: SeamlessTile, n: int = 30, *, patch_size=N
     Yields :class:`CandidateTile` items as they finish (any order; each has its ``index``)
     and :class:`Progress`.
     """
-    setup = _Setup(source, template, patch_size=patch_size, patch_overlap=patch_overlap,
-                   margin=margin, neighbourhood=neighbourhood, method=method, metric=metric,
-                   blend=blend, width=width, rho=rho, excluded=excluded, maps=maps,
-                   weights=weights, seam_options=seam_options)
+    setup = _Setup(
+        source,
+        template,
+        patch_size=patch_size,
+        patch_overlap=patch_overlap,
+        margin=margin,
+        neighbourhood=neighbourhood,
+        method=method,
+        metric=metric,
+        blend=blend,
+        width=width,
+        rho=rho,
+        excluded=excluded,
+        maps=maps,
+        weights=weights,
+        seam_options=seam_options,
+    )
     n = positive_int(n, "n")
     workers = positive_int(workers, "workers")
     base = _base_seed(rng)
@@ -387,8 +454,9 @@ def _iter_candidates(setup: _Setup, n: int, base: int, workers: int, cancel):
         token = _AnyCancel(cancel, stop)
         pool = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="candidates")
         try:
-            pending = {pool.submit(setup.make, k, seeds[k], None, setup.n, token): k
-                       for k in range(n)}
+            pending = {
+                pool.submit(setup.make, k, seeds[k], None, setup.n, token): k for k in range(n)
+            }
             while pending:
                 finished, _ = wait(pending, return_when=FIRST_COMPLETED)
                 for fut in sorted(finished, key=pending.get):
@@ -418,12 +486,29 @@ def candidates(source, template: SeamlessTile, n: int = 30, **options) -> list[C
     return drain(iter_candidates(source, template, n, **options))
 
 
-def make_candidate(source, template: SeamlessTile, *, patch_origin=None, index: int = 0,
-                   seed: int | None = None, rng=None, neighbourhood: int | None = None,
-                   patch_size=None, patch_overlap=None, margin: int = 2, method: str = "dp",
-                   metric: str = "euclid", blend: str = "adaptive", width: int = 4,
-                   rho: int = 3, excluded=None, maps=None, weights=None, cancel=None,
-                   **seam_options) -> CandidateTile:
+def make_candidate(
+    source,
+    template: SeamlessTile,
+    *,
+    patch_origin=None,
+    index: int = 0,
+    seed: int | None = None,
+    rng=None,
+    neighbourhood: int | None = None,
+    patch_size=None,
+    patch_overlap=None,
+    margin: int = 2,
+    method: str = "dp",
+    metric: str = "euclid",
+    blend: str = "adaptive",
+    width: int = 4,
+    rho: int = 3,
+    excluded=None,
+    maps=None,
+    weights=None,
+    cancel=None,
+    **seam_options,
+) -> CandidateTile:
     """Make one candidate: from a user-given ``patch_origin`` (row, col) or from a seed.
 
     With ``patch_origin`` the patch is taken exactly there (``neighbourhood`` defaults to 0;
@@ -431,10 +516,23 @@ def make_candidate(source, template: SeamlessTile, *, patch_origin=None, index: 
     ``seed`` (a candidate's own seed, to rebuild it) or, if that is None too, from ``rng``
     (a re-roll). Raises :class:`engine.cancel.Cancelled` when cancelled.
     """
-    setup = _Setup(source, template, patch_size=patch_size, patch_overlap=patch_overlap,
-                   margin=margin, neighbourhood=0 if neighbourhood is None else neighbourhood,
-                   method=method, metric=metric, blend=blend, width=width, rho=rho,
-                   excluded=excluded, maps=maps, weights=weights, seam_options=seam_options)
+    setup = _Setup(
+        source,
+        template,
+        patch_size=patch_size,
+        patch_overlap=patch_overlap,
+        margin=margin,
+        neighbourhood=0 if neighbourhood is None else neighbourhood,
+        method=method,
+        metric=metric,
+        blend=blend,
+        width=width,
+        rho=rho,
+        excluded=excluded,
+        maps=maps,
+        weights=weights,
+        seam_options=seam_options,
+    )
     if isinstance(index, bool) or not isinstance(index, numbers.Integral) or index < 0:
         raise ValueError(f"index must be a non-negative integer, got {index!r}")
     origin = None

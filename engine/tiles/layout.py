@@ -32,8 +32,9 @@ def _weights(weights, n_tiles: int) -> np.ndarray:
     return w
 
 
-def random_layout(n_tiles: int, rows: int, cols: int, *, rng=None,
-                  no_equal_neighbours: bool = False, weights=None) -> np.ndarray:
+def random_layout(
+    n_tiles: int, rows: int, cols: int, *, rng=None, no_equal_neighbours: bool = False, weights=None
+) -> np.ndarray:
     """A (rows, cols) int64 index matrix of tiles 0..n_tiles-1.
 
     Parameters
@@ -112,7 +113,9 @@ def assemble(tiles, layout, *, map_name: str | None = None) -> np.ndarray:
     shape = np.shape(arrs[0])
     for i, a in enumerate(arrs):
         if np.shape(a) != shape:
-            raise ValueError(f"tiles[{i}] is shaped {np.shape(a)}, tiles[0] {shape}: all must match")
+            raise ValueError(
+                f"tiles[{i}] is shaped {np.shape(a)}, tiles[0] {shape}: all must match"
+            )
     if isinstance(layout, numbers.Integral):
         raise TypeError("layout must be a 2-D index matrix")
     return assemble_layout(arrs, layout)

@@ -21,10 +21,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from engine._validate import as_image, choice, positive_int
+from engine.blend import BLEND_MODES, blend_weights
 from engine.cancel import check
 from engine.events import Progress, Snapshot, drain, frozen_array
 from engine.materials import apply_cut, material_error
-from engine.blend import BLEND_MODES, blend_weights
 from engine.seams import CYCLIC_METHODS, METHODS, Seam, SeamUpdate, iter_find_seam
 from engine.tiles.template import Template, _check_rect, flat_warning
 
@@ -164,10 +164,21 @@ def iter_seam(error, *, method, cyclic=False, waypoints=(), cancel=None, **optio
             kw["start"] = v
         if e.shape[0] - 1 not in pinned:
             kw["end"] = v
-        return (yield from iter_find_seam(error, method=method, waypoints=tuple(waypoints),
-                                          cancel=cancel, **kw, **options))
-    return (yield from iter_find_seam(error, method=method, waypoints=tuple(waypoints),
-                                      cyclic=bool(cyclic), cancel=cancel, **options))
+        return (
+            yield from iter_find_seam(
+                error, method=method, waypoints=tuple(waypoints), cancel=cancel, **kw, **options
+            )
+        )
+    return (
+        yield from iter_find_seam(
+            error,
+            method=method,
+            waypoints=tuple(waypoints),
+            cyclic=bool(cyclic),
+            cancel=cancel,
+            **options,
+        )
+    )
 
 
 def _restrict(error: np.ndarray, lo: int, hi: int) -> np.ndarray:
@@ -200,9 +211,22 @@ def _check_waypoints(waypoints) -> dict:
 
 
 # --------------------------------------------------------------------------- API
-def iter_make_seamless(source, rect, *, overlap=None, method: str = "dp", metric: str = "euclid",
-                       blend: str = "none", width: int = 4, rho: int = 3, waypoints=None,
-                       maps=None, weights=None, cancel=None, **seam_options):
+def iter_make_seamless(
+    source,
+    rect,
+    *,
+    overlap=None,
+    method: str = "dp",
+    metric: str = "euclid",
+    blend: str = "none",
+    width: int = 4,
+    rho: int = 3,
+    waypoints=None,
+    maps=None,
+    weights=None,
+    cancel=None,
+    **seam_options,
+):
     """Make the tile of ``rect`` seamless; returns a generator whose value is a SeamlessTile.
 
     Parameters
@@ -248,15 +272,50 @@ def iter_make_seamless(source, rect, *, overlap=None, method: str = "dp", metric
     if flat:
         notes.append(flat)
         warnings.warn(flat, stacklevel=2)
-    params = dict(method=method, metric=metric, blend=blend, width=int(width), rho=int(rho),
-                  **{k: v for k, v in seam_options.items() if isinstance(v, (int, float, str))})
-    return _iter_make_seamless(S, extra, (x, y, a, b), int(overlap), method, metric, blend,
-                               int(width), int(rho), wps, wts, cancel, seam_options, params,
-                               tuple(notes))
+    params = dict(
+        method=method,
+        metric=metric,
+        blend=blend,
+        width=int(width),
+        rho=int(rho),
+        **{k: v for k, v in seam_options.items() if isinstance(v, (int, float, str))},
+    )
+    return _iter_make_seamless(
+        S,
+        extra,
+        (x, y, a, b),
+        int(overlap),
+        method,
+        metric,
+        blend,
+        int(width),
+        int(rho),
+        wps,
+        wts,
+        cancel,
+        seam_options,
+        params,
+        tuple(notes),
+    )
 
 
-def _iter_make_seamless(S, extra, rect, wT, method, metric, blend, width, rho, wps, wts, cancel,
-                        seam_options, params, notes):
+def _iter_make_seamless(
+    S,
+    extra,
+    rect,
+    wT,
+    method,
+    metric,
+    blend,
+    width,
+    rho,
+    wps,
+    wts,
+    cancel,
+    seam_options,
+    params,
+    notes,
+):
     x, y, a, b = rect
     stack = {MAIN: S, **extra}
     F = {k: v[y : y + b + wT, x : x + a + wT] for k, v in stack.items()}
@@ -268,32 +327,48 @@ def _iter_make_seamless(S, extra, rect, wT, method, metric, blend, width, rho, w
     E_h = seam_error(R_R, R_L, wts, metric)
     lo, hi = _allowed(wT, blend, width)
     seam_h = yield from _stream(
-        iter_seam(_restrict(E_h, lo, hi), method=method, waypoints=wps.get("horizontal", ()),
-                  cancel=cancel, **seam_options),
-        "horizontal", (y, x))
+        iter_seam(
+            _restrict(E_h, lo, hi),
+            method=method,
+            waypoints=wps.get("horizontal", ()),
+            cancel=cancel,
+            **seam_options,
+        ),
+        "horizontal",
+        (y, x),
+    )
     check(cancel)
     alpha_h = _alpha(seam_h, E_h, blend, width, rho)
     strip = apply_cut(R_R, R_L, alpha_h)
-    I = {k: v[:, :a].copy() for k, v in F.items()}
-    for k in I:
-        I[k][:, :wT] = strip[k]
+    inner = {k: v[:, :a].copy() for k, v in F.items()}  # I of §1.7
+    for k in inner:
+        inner[k][:, :wT] = strip[k]
     yield _update("horizontal", seam_h, True, (y, x))
     yield Progress(1, 2, "seamless: vertical stitch")
 
     # ---- vertical: R1 = R_B kept on top; canonical = transpose (rows = tile columns), cyclic
-    R_T = {k: v[:wT] for k, v in I.items()}
-    R_B = {k: v[b : b + wT] for k, v in I.items()}
+    R_T = {k: v[:wT] for k, v in inner.items()}
+    R_B = {k: v[b : b + wT] for k, v in inner.items()}
     E_v = seam_error(R_B, R_T, wts, metric)
     Ec = np.ascontiguousarray(E_v.T)
     wv = tuple((c, r) for r, c in wps.get("vertical", ()))
     seam_v = yield from _stream(
-        iter_seam(_restrict(Ec, lo, hi), method=method, cyclic=True, waypoints=wv,
-                  cancel=cancel, **seam_options),
-        "vertical", (y, x), transpose=True)
+        iter_seam(
+            _restrict(Ec, lo, hi),
+            method=method,
+            cyclic=True,
+            waypoints=wv,
+            cancel=cancel,
+            **seam_options,
+        ),
+        "vertical",
+        (y, x),
+        transpose=True,
+    )
     check(cancel)
     alpha_v = np.ascontiguousarray(_alpha(seam_v, Ec, blend, width, rho, cyclic=True).T)
     band = apply_cut(R_B, R_T, alpha_v)
-    tiles = {k: v[:b].copy() for k, v in I.items()}
+    tiles = {k: v[:b].copy() for k, v in inner.items()}
     for k in tiles:
         tiles[k][:wT] = band[k]
     up_v = _update("vertical", seam_v, True, (y, x), transpose=True)
@@ -332,11 +407,14 @@ def _iter_make_seamless(S, extra, rect, wT, method, metric, blend, width, rho, w
     )
 
 
-def _alpha(seam: Seam, error: np.ndarray, blend: str, width: int, rho: int,
-           cyclic: bool = False) -> np.ndarray:
+def _alpha(
+    seam: Seam, error: np.ndarray, blend: str, width: int, rho: int, cyclic: bool = False
+) -> np.ndarray:
     """Canonical weight of R1 with the outer column pinned to R1 and the inner one to R2."""
-    alpha = np.array(blend_weights(seam, error, mode=blend, width=width, rho=rho, cyclic=cyclic),
-                     dtype=np.float32)
+    alpha = np.array(
+        blend_weights(seam, error, mode=blend, width=width, rho=rho, cyclic=cyclic),
+        dtype=np.float32,
+    )
     alpha[:, 0] = 1.0
     alpha[:, -1] = 0.0
     return alpha
@@ -363,8 +441,13 @@ def _update(which: str, seam: Seam, final: bool, origin, *, transpose: bool = Fa
     path = np.asarray(seam.path, dtype=np.intp)
     if transpose:
         path = path[:, ::-1]
-    return SeamlessUpdate(which=which, seam=seam, path=frozen_array(path),
-                          path_source=frozen_array(path + np.asarray(origin)), final=final)
+    return SeamlessUpdate(
+        which=which,
+        seam=seam,
+        path=frozen_array(path),
+        path_source=frozen_array(path + np.asarray(origin)),
+        final=final,
+    )
 
 
 def make_seamless(source, rect, **options) -> SeamlessTile:

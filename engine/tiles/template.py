@@ -162,8 +162,7 @@ def flat_warning(source: np.ndarray) -> str | None:
     """A warning text when ``source`` is (nearly) a single colour, else None."""
     if float(np.ptp(source.reshape(-1, source.shape[2]), axis=0).max()) < 1e-6:
         return (
-            "the source is a single flat colour: every tile (and every candidate) will be "
-            "identical"
+            "the source is a single flat colour: every tile (and every candidate) will be identical"
         )
     return None
 
@@ -225,8 +224,16 @@ class _Scan:
         valid = self.valid if use_valid else np.ones((1, 1), dtype=np.bool_)
         for k0 in range(0, self.shifts.size, _CHUNK):
             k1 = min(k0 + _CHUNK, self.shifts.size)
-            _shift_sums(self.S, valid, use_valid, self.rows[0], self.rows[1],
-                        self.shifts[k0:k1], self.sum[k0:k1], self.cnt[k0:k1])
+            _shift_sums(
+                self.S,
+                valid,
+                use_valid,
+                self.rows[0],
+                self.rows[1],
+                self.shifts[k0:k1],
+                self.sum[k0:k1],
+                self.cnt[k0:k1],
+            )
             yield k1
 
     def costs(self, feasible_run: np.ndarray | None) -> np.ndarray:
@@ -316,8 +323,16 @@ def _check_rect(rect, overlap, shape) -> tuple[int, int, int, int]:
     return x, y, a, b
 
 
-def iter_find_template(source, *, tile_min, tile_max=None, overlap=None, excluded=None,
-                       refine: bool = True, cancel=None):
+def iter_find_template(
+    source,
+    *,
+    tile_min,
+    tile_max=None,
+    overlap=None,
+    excluded=None,
+    refine: bool = True,
+    cancel=None,
+):
     """Search the tile rectangle; returns a generator of events whose value is a Template.
 
     Parameters
@@ -418,10 +433,17 @@ def _iter_find_template(S, valid, run0, lo, hi, overlap, refine, cancel, notes):
         ch, cv = _rect_costs(S, valid, rect, overlap)
         cost = (ch + cv) / 2.0
         if best is None or cost < best.cost - 1e-12:
-            best = Template(rect=rect, overlap=overlap, cost=cost, cost_horizontal=ch,
-                            cost_vertical=cv, warnings=notes)
-            yield TemplateUpdate(rect=rect, cost=cost, overlap=overlap,
-                                 phase="search" if _round == 0 else "refine")
+            best = Template(
+                rect=rect,
+                overlap=overlap,
+                cost=cost,
+                cost_horizontal=ch,
+                cost_vertical=cv,
+                warnings=notes,
+            )
+            yield TemplateUpdate(
+                rect=rect, cost=cost, overlap=overlap, phase="search" if _round == 0 else "refine"
+            )
         elif _round > 0:
             break
         # refinement: the horizontal phase again on the chosen rows

@@ -24,8 +24,13 @@ def src(tmp_path_factory):
     gray = np.round(S[:, :, :1] * 65535).astype(np.uint16)
     rgb16 = np.round(S * 65535).astype(np.uint16)
     rgb16[::3, ::5] += 1  # values that 8 bits cannot hold
-    paths = {"rgb8": d / "rgb8.png", "gray16": d / "gray16.png", "rgb16": d / "rgb16.png",
-             "height": d / "height.png", "mask": d / "mask.png"}
+    paths = {
+        "rgb8": d / "rgb8.png",
+        "gray16": d / "gray16.png",
+        "rgb16": d / "rgb16.png",
+        "height": d / "height.png",
+        "mask": d / "mask.png",
+    }
     paths["rgb8"].write_bytes(encode_png(q8))
     paths["gray16"].write_bytes(encode_png(gray))
     paths["rgb16"].write_bytes(encode_png(rgb16))
@@ -36,8 +41,18 @@ def src(tmp_path_factory):
     return paths
 
 
-ARGS = ["--candidates", "5", "--tile-min", "48", "--tile-max", "56", "--seed", "3",
-        "--preview", "3x4"]
+ARGS = [
+    "--candidates",
+    "5",
+    "--tile-min",
+    "48",
+    "--tile-max",
+    "56",
+    "--seed",
+    "3",
+    "--preview",
+    "3x4",
+]
 
 
 def png(path):
@@ -47,8 +62,9 @@ def png(path):
 def test_end_to_end_files_manifest_layout_and_determinism(src, tmp_path, capsys):
     out = tmp_path / "set"
     proj = tmp_path / "set.quiltproj"
-    assert main(["tileset", str(src["rgb8"]), "--out", str(out), *ARGS, "--project",
-                 str(proj)]) == 0
+    assert (
+        main(["tileset", str(src["rgb8"]), "--out", str(out), *ARGS, "--project", str(proj)]) == 0
+    )
     err = capsys.readouterr().err
     assert "template:" in err and err.count("candidate") >= 5 and "wrote" in err
     names = {p.name for p in out.iterdir()}
@@ -71,8 +87,7 @@ def test_end_to_end_files_manifest_layout_and_determinism(src, tmp_path, capsys)
     np.testing.assert_array_equal(png(out / "template.png"), np.round(st.tile * 255))
     cands = candidates(S, st, 5, rng=3, workers=1)
     for c in cands:
-        np.testing.assert_array_equal(png(out / f"tile_{c.index:03d}.png"),
-                                      np.round(c.tile * 255))
+        np.testing.assert_array_equal(png(out / f"tile_{c.index:03d}.png"), np.round(c.tile * 255))
         assert man["tiles"][c.index]["source_rect"] == list(c.patch_rect)
     # layout CSV == JSON, no equal neighbours, preview assembled from it
     rows = [[int(v) for v in r] for r in csv.reader((out / "layout.csv").open())]
@@ -103,16 +118,41 @@ def test_sixteen_bit_and_gray_keep_their_depth(src, tmp_path):
         x, y, w, h = man["template"]["rect"]
         wt = man["template"]["overlap"]
         s = png(src[key])
-        np.testing.assert_array_equal(png(out / "template.png")[wt:, wt:],
-                                      s[y + wt : y + h, x + wt : x + w])
+        np.testing.assert_array_equal(
+            png(out / "template.png")[wt:, wt:], s[y + wt : y + h, x + wt : x + w]
+        )
 
 
 def test_picks_maps_exclusion_and_options(src, tmp_path):
     out = tmp_path / "opts"
-    assert main(["tileset", str(src["rgb8"]), "--out", str(out), *ARGS, "--pick", "1,3",
-                 "--map", f"height={src['height']}", "--weight", "main=1",
-                 "--weight", "height=0.5", "--exclude-mask", str(src["mask"]),
-                 "--seam", "oscillating", "--blend", "feather", "--workers", "1"]) == 0
+    assert (
+        main(
+            [
+                "tileset",
+                str(src["rgb8"]),
+                "--out",
+                str(out),
+                *ARGS,
+                "--pick",
+                "1,3",
+                "--map",
+                f"height={src['height']}",
+                "--weight",
+                "main=1",
+                "--weight",
+                "height=0.5",
+                "--exclude-mask",
+                str(src["mask"]),
+                "--seam",
+                "oscillating",
+                "--blend",
+                "feather",
+                "--workers",
+                "1",
+            ]
+        )
+        == 0
+    )
     man = json.loads((out / "manifest.json").read_text())
     assert man["picks"] == [1, 3]
     cells = np.array(json.loads((out / "layout.json").read_text())["cells"])
@@ -140,8 +180,7 @@ def test_bad_input_gives_clear_errors(src, tmp_path, capsys):
         main(["tileset", str(src["rgb8"]), "--out", out, "--tile-min", "big"])
     flat = tmp_path / "flat.png"
     flat.write_bytes(encode_png(np.full((90, 90, 3), 120, np.uint8)))
-    assert main(["tileset", str(flat), "--out", out, "--candidates", "2", "--tile-min",
-                 "32"]) == 0
+    assert main(["tileset", str(flat), "--out", out, "--candidates", "2", "--tile-min", "32"]) == 0
     assert "warning: the source is a single flat colour" in capsys.readouterr().err
     man = json.loads((tmp_path / "bad" / "manifest.json").read_text())
     assert any("flat" in w for w in man["warnings"])
@@ -149,8 +188,23 @@ def test_bad_input_gives_clear_errors(src, tmp_path, capsys):
 
 def test_installed_command_runs(src, tmp_path):
     out = tmp_path / "cmd"
-    r = subprocess.run([sys.executable, "-m", "quilt_gui", "tileset", str(src["rgb8"]), "--out",
-                        str(out), "--candidates", "2", "--tile-min", "48"],
-                       capture_output=True, text=True, timeout=120)
+    r = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "quilt_gui",
+            "tileset",
+            str(src["rgb8"]),
+            "--out",
+            str(out),
+            "--candidates",
+            "2",
+            "--tile-min",
+            "48",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert r.returncode == 0, r.stderr
     assert "candidate" in r.stderr and (out / "tile_001.png").exists()

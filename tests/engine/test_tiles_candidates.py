@@ -136,9 +136,23 @@ def test_make_candidate_from_origin_and_from_seed(small):
 
 def test_position_refinement_against_brute_force(small):
     S, st = small
-    setup = _Setup(S, st, patch_size=None, patch_overlap=None, margin=2, neighbourhood=4,
-                   method="dp", metric="euclid", blend="adaptive", width=4, rho=3,
-                   excluded=None, maps=None, weights=None, seam_options={})
+    setup = _Setup(
+        S,
+        st,
+        patch_size=None,
+        patch_overlap=None,
+        margin=2,
+        neighbourhood=4,
+        method="dp",
+        metric="euclid",
+        blend="adaptive",
+        width=4,
+        rho=3,
+        excluded=None,
+        maps=None,
+        weights=None,
+        seam_options={},
+    )
     (y, x), cost = setup.refine((30, 40), 4)
     h, w = st.tile.shape[:2]
     r, c = np.mgrid[0:h, 0:w]
@@ -159,8 +173,9 @@ def test_excluded_patches_and_material_maps():
     st = make_seamless(S, RECT, overlap=W_T, maps={"height": height})
     ex = np.zeros(S.shape[:2], bool)
     ex[:, 60:] = True  # only the left 60 columns may be used
-    cands = candidates(S, st, 4, rng=2, workers=1, excluded=ex, maps={"height": height},
-                       patch_size=(48, 52))
+    cands = candidates(
+        S, st, 4, rng=2, workers=1, excluded=ex, maps={"height": height}, patch_size=(48, 52)
+    )
     for c in cands:
         x, y, w, h = c.patch_rect
         assert (h, w) == (48, 52) and not ex[y : y + h, x : x + w].any()

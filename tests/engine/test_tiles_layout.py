@@ -60,9 +60,17 @@ def test_assemble_arrays_dicts_and_candidates():
     np.testing.assert_array_equal(img[4:, :5], tiles[1])
     assert (img[4:, 5:] == 0).all()
     cands = [
-        CandidateTile(index=i, tile=t, maps={"height": t[:, :, :1]}, patch_rect=(0, 0, 5, 4),
-                      patch_origin=(0, 0), target_rect=(0, 0, 5, 4), loop=np.zeros((0, 2)),
-                      mask=np.zeros((4, 5), bool), alpha=np.zeros((4, 5), np.float32))
+        CandidateTile(
+            index=i,
+            tile=t,
+            maps={"height": t[:, :, :1]},
+            patch_rect=(0, 0, 5, 4),
+            patch_origin=(0, 0),
+            target_rect=(0, 0, 5, 4),
+            loop=np.zeros((0, 2)),
+            mask=np.zeros((4, 5), bool),
+            alpha=np.zeros((4, 5), np.float32),
+        )
         for i, t in enumerate(tiles)
     ]
     np.testing.assert_array_equal(assemble(cands, layout), img)

@@ -99,7 +99,8 @@ def test_regions_errors_and_paths_are_consistent():
     assert pv[:, 0].max() < W_T and pv[:, 1].max() == a - 1
     # criterion is the sum of the (drawn) error along the drawn path
     assert st.criterion["vertical"] == pytest.approx(
-        st.errors["vertical"][pv[:, 0], pv[:, 1]].sum(), rel=1e-5)
+        st.errors["vertical"][pv[:, 0], pv[:, 1]].sum(), rel=1e-5
+    )
     np.testing.assert_array_equal(st.paths_source["vertical"], pv + (y, x))
     assert (st.paths_tile["horizontal"][:, 0] < b).all()
     assert not st.tile.flags.writeable
@@ -156,8 +157,9 @@ def test_material_maps_follow_the_same_cut_and_weights_steer_it():
         np.testing.assert_array_equal(t[W_T:, :W_T], np.where(sel[..., None], R_R, R_L))
     # weights: only the height map -> the horizontal seam is the DP seam of the height error
     st_h = make_seamless(S, RECT, overlap=W_T, maps=maps, weights={"main": 0, "height": 1})
-    e = np.abs(height[y : y + b + W_T, x + a : x + a + W_T, 0]
-               - height[y : y + b + W_T, x : x + W_T, 0]).astype(np.float64)
+    e = np.abs(
+        height[y : y + b + W_T, x + a : x + a + W_T, 0] - height[y : y + b + W_T, x : x + W_T, 0]
+    ).astype(np.float64)
     e /= e.mean()
     e[:, -1] = e.sum() + 1  # the innermost column stays R_L
     want = find_seam(e, method="dp")

@@ -1,0 +1,244 @@
+"""Tile-set benchmark: quality per bundled sample, speed and memory at 512 and 4096 px.
+
+Run ``python -m benchmarks.tileset`` (or ``python benchmarks/tileset.py``); ``--help`` for
+options. Three tables:
+
+1. **Quality** (each bundled 512x512 sample, 256x256 tiles, default parameters): the wrap
+   border ratio and detail ratio of a naive crop (the top-left 256x256), a cross-fade "make
+   seamless" (the same rectangle and overlap as ours, linear ramps instead of cuts) and our
+   template tile; then for 30 candidates the median and max border ratio over all ordered
+   pairs (horizontal and vertical), the mean share of pixels changed vs the template, and the
+   grid score of an 8x8 preview of 8 picked tiles (lowest seam criterion, no equal
+   neighbours) over that of the template repeated.
+2. **Speed** at 512x512 -> 256x256 (cobblestones): template search + seamless tile (first
+   call in the process, i.e. with numba's cache load, and warm), first candidate, 30
+   candidates wall time with 1 and 2 workers, peak traced memory (tracemalloc) and the
+   process's peak RSS.
+3. The same at 4096x4096 -> 1024x1024 (a stand-in large photo: cobblestones resized x8 with
+   fine noise added).
+"""
+
+from __future__ import annotations
+
+import argparse
+import resource
+import sys
+import time
+import tracemalloc
+from pathlib import Path
+
+import numpy as np
+
+if __package__ in (None, ""):  # run as a script: make the repository importable
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+import resources  # noqa: E402
+from benchmarks._util import format_table  # noqa: E402
+from engine.io import load_image  # noqa: E402
+from engine.metrics import border_ratio, detail_ratio, grid_score, wrap_border_ratio  # noqa: E402
+from engine.tiles import (  # noqa: E402
+    CandidateTile,
+    assemble,
+    candidates,
+    find_template,
+    iter_candidates,
+    make_seamless,
+    random_layout,
+)
+
+TARGETS = {"template + seamless": 1.0, "first candidate": 0.5, "30 candidates": 3.0}
+
+
+# ----------------------------------------------------------------------------- references
+def crossfade_tile(S: np.ndarray, rect, overlap: int) -> np.ndarray:
+    """The classic "make seamless": blend R_R into R_L and R_B into R_T with linear ramps."""
+    x, y, a, b = rect
+    w = overlap
+    F = S[y : y + b + w, x : x + a + w].astype(np.float32)
+    t = ((np.arange(w) + 0.5) / w).astype(np.float32)  # weight of the inner side
+    img = F[:, :a].copy()
+    img[:, :w] = (1 - t)[None, :, None] * F[:, a : a + w] + t[None, :, None] * F[:, :w]
+    tile = img[:b].copy()
+    tile[:w] = (1 - t)[:, None, None] * img[b : b + w] + t[:, None, None] * img[:w]
+    return tile
+
+
+def pair_ratios(tiles) -> np.ndarray:
+    """border_ratio for every ordered pair, both directions (vectorised, spot-checked)."""
+    out = []
+    for direction in ("horizontal", "vertical"):
+        t = np.stack([np.asarray(x, np.float64) for x in tiles])
+        if direction == "vertical":
+            t = t.transpose(0, 2, 1, 3)
+        steps = np.abs(np.diff(t, axis=2)).mean(axis=3)
+        inner = steps.sum(axis=(1, 2))
+        joint = np.abs(t[:, None, :, -1] - t[None, :, :, 0]).mean(axis=(2, 3))
+        r = joint / ((inner[:, None] + inner[None, :]) / (2 * steps[0].size))
+        assert np.isclose(r[0, 1], border_ratio(tiles[0], tiles[1], direction=direction))
+        out.append(r.ravel())
+    return np.concatenate(out)
+
+
+# ----------------------------------------------------------------------------- tables
+def quality(tile: int, n: int, seed: int) -> str:
+    rows = []
+    for name in resources.SAMPLE_NAMES:
+        S = load_image(resources.sample_path(name)).pixels
+        tmpl = find_template(S, tile_min=tile, tile_max=tile)
+        st = make_seamless(S, tmpl)
+        a, b = tmpl.rect[2:]
+        naive = S[:b, :a]
+        fade = crossfade_tile(S, tmpl.rect, tmpl.overlap)
+        cands = candidates(S, st, n, rng=seed, workers=2)
+        ratios = pair_ratios([c.tile for c in cands])
+        changed = np.mean([c.scores["changed"] for c in cands])
+        picked = sorted(cands, key=lambda c: c.scores["criterion"])[:8]
+        layout = random_layout(len(picked), 8, 8, rng=seed, no_equal_neighbours=True)
+        g = grid_score(assemble(picked, layout), (b, a), source=S)
+        g0 = grid_score(assemble([st.tile], np.zeros((8, 8), int)), (b, a), source=S)
+        rows.append(
+            [
+                name,
+                f"{wrap_border_ratio(naive):.2f} / {detail_ratio(naive, S):.2f}",
+                f"{wrap_border_ratio(fade):.2f} / {detail_ratio(fade, S):.2f}",
+                f"{wrap_border_ratio(st.tile):.2f} / {detail_ratio(st.tile, S):.2f}",
+                f"{np.median(ratios):.3f}",
+                f"{ratios.max():.3f}",
+                f"{changed:.0%}",
+                f"{g:.3f} / {g0:.3f} = {g / g0:.2f}",
+            ]
+        )
+    wraps = [float(r[3].split(" / ")[0]) for r in rows]
+    details = [float(r[3].split(" / ")[1]) for r in rows]
+    table = format_table(
+        [
+            "sample",
+            "naive crop wrap/detail",
+            "cross-fade wrap/detail",
+            "ours wrap/detail",
+            "pairs median",
+            "pairs max",
+            "changed",
+            "grid 8x8 / template = ratio",
+        ],
+        rows,
+    )
+    return (
+        table + f"\nmedian over samples: ours wrap {np.median(wraps):.2f} (target <= 1.15),"
+        f" detail {np.median(details):.2f} (target >= 0.95); pairs: median <= 1.2, "
+        "max <= 1.6; grid ratio <= 0.35"
+    )
+
+
+def big_source(size: int, seed: int) -> np.ndarray:
+    from skimage.transform import resize
+
+    S = load_image(resources.sample_path("cobblestones")).pixels
+    big = resize(S, (size, size), order=3, anti_aliasing=False).astype(np.float32)
+    big += np.random.default_rng(seed).normal(0, 0.02, big.shape).astype(np.float32)
+    return np.clip(big, 0, 1)
+
+
+def speed(S: np.ndarray, tile: int, n: int, seed: int, label: str) -> list:
+    rows = []
+    t0 = time.perf_counter()
+    tmpl = find_template(S, tile_min=tile, tile_max=tile)
+    st = make_seamless(S, tmpl)
+    first_call = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    tmpl = find_template(S, tile_min=tile, tile_max=tile)
+    st = make_seamless(S, tmpl)
+    warm = time.perf_counter() - t0
+    lo, hi = int(tile * 0.875), int(tile * 1.125)
+    t0 = time.perf_counter()
+    ranged = find_template(S, tile_min=lo, tile_max=hi)
+    make_seamless(S, ranged)
+    ranged_t = time.perf_counter() - t0
+    rows.append(
+        [
+            label,
+            "template + seamless (first call)",
+            f"{first_call:.3f}",
+            TARGETS["template + seamless"],
+        ]
+    )
+    rows.append(
+        [label, "template + seamless (warm)", f"{warm:.3f}", TARGETS["template + seamless"]]
+    )
+    rows.append([label, f"template search {lo}..{hi} + seamless", f"{ranged_t:.3f}", ""])
+    for workers in (1, 2):
+        t0 = time.perf_counter()
+        first = None
+        gen = iter_candidates(S, st, n, rng=seed, workers=workers)
+        while True:
+            try:
+                ev = next(gen)
+            except StopIteration:
+                break
+            if first is None and isinstance(ev, CandidateTile):
+                first = time.perf_counter() - t0
+        total = time.perf_counter() - t0
+        rows.append(
+            [
+                label,
+                f"first candidate ({workers} worker{'s' * (workers > 1)})",
+                f"{first:.3f}",
+                TARGETS["first candidate"],
+            ]
+        )
+        rows.append(
+            [
+                label,
+                f"{n} candidates ({workers} worker{'s' * (workers > 1)})",
+                f"{total:.3f}",
+                TARGETS["30 candidates"] if n == 30 else "",
+            ]
+        )
+    # memory: a separate traced run (tracing slows numpy down, so it is not timed)
+    tracemalloc.start()
+    tracemalloc.reset_peak()
+    tm = find_template(S, tile_min=tile, tile_max=tile)
+    st = make_seamless(S, tm)
+    candidates(S, st, n, rng=seed, workers=2)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024  # KiB on Linux
+    rows.append([label, "peak traced memory (tracemalloc, MiB)", f"{peak / 2**20:.0f}", ""])
+    rows.append([label, "process peak RSS so far (MiB)", f"{rss:.0f}", ""])
+    return rows
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(
+        prog="python -m benchmarks.tileset",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    ap.add_argument("--candidates", type=int, default=30)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--skip-quality", action="store_true")
+    ap.add_argument("--skip-big", action="store_true", help="skip the 4096 px run")
+    args = ap.parse_args(argv)
+    print(f"python -m benchmarks.tileset (candidates={args.candidates}, seed={args.seed})")
+    headers = ["source -> tile", "step", "seconds / MiB", "target"]
+    print("\n## Speed and memory\n")
+    S = load_image(resources.sample_path("cobblestones")).pixels
+    print(
+        format_table(headers, speed(S, 256, args.candidates, args.seed, "512 -> 256")), flush=True
+    )
+    if not args.skip_big:
+        print()
+        big = big_source(4096, args.seed)
+        print(
+            format_table(headers, speed(big, 1024, args.candidates, args.seed, "4096 -> 1024")),
+            flush=True,
+        )
+        del big
+    if not args.skip_quality:
+        print("\n## Quality: 512x512 samples, 256x256 tiles\n")
+        print(quality(256, args.candidates, args.seed), flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
