@@ -6,8 +6,9 @@ import time
 from collections.abc import Callable, Sequence
 
 
-def median_time(fn: Callable[[], object], *, min_time: float = 0.2, min_repeats: int = 3,
-                max_repeats: int = 50) -> tuple[float, object]:
+def median_time(
+    fn: Callable[[], object], *, min_time: float = 0.2, min_repeats: int = 3, max_repeats: int = 50
+) -> tuple[float, object]:
     """Median wall time of ``fn()`` in seconds over repeats, and the last result.
 
     Repeats until ``min_time`` seconds were spent and at least ``min_repeats`` runs were made

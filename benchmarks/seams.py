@@ -115,7 +115,9 @@ def run(sizes, sample: str, min_time: float, max_seconds: float) -> tuple[list, 
                     continue
                 t, seam = median_time(
                     lambda e=error, m=method, o=opts: find_seam(e, method=m, **o),
-                    min_time=min_time, max_repeats=50 if h * w <= 40_000 else 9)
+                    min_time=min_time,
+                    max_repeats=50 if h * w <= 40_000 else 9,
+                )
                 first = ""
                 if method == "oscillating":
                     ft = first_path_time(error, **opts)
@@ -126,38 +128,76 @@ def run(sizes, sample: str, min_time: float, max_seconds: float) -> tuple[list, 
                     at_512.setdefault(label, []).append(1e3 * t)
                 if t > max_seconds:
                     skip.add((label, kind))
-                rows.append((f"{h}x{w}", kind, label, f"{1e3 * t:.3f}", f"{t / base_t:.3f}",
-                             f"{seam.criterion / dp_crit:.3f}", first))
-            rows.append((f"{h}x{w}", kind, "numpy row DP (baseline)", f"{1e3 * base_t:.3f}",
-                         "1.000", "1.000", ""))
+                rows.append(
+                    (
+                        f"{h}x{w}",
+                        kind,
+                        label,
+                        f"{1e3 * t:.3f}",
+                        f"{t / base_t:.3f}",
+                        f"{seam.criterion / dp_crit:.3f}",
+                        first,
+                    )
+                )
+            rows.append(
+                (
+                    f"{h}x{w}",
+                    kind,
+                    "numpy row DP (baseline)",
+                    f"{1e3 * base_t:.3f}",
+                    "1.000",
+                    "1.000",
+                    "",
+                )
+            )
     return rows, at_512
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--sizes", default="all",
-                    help="comma-separated HxW list, e.g. 32x6,512x64 (default: all four)")
+    ap.add_argument(
+        "--sizes",
+        default="all",
+        help="comma-separated HxW list, e.g. 32x6,512x64 (default: all four)",
+    )
     ap.add_argument("--sample", default="cobblestones", help="bundled sample for real overlaps")
-    ap.add_argument("--min-time", type=float, default=0.2,
-                    help="seconds of repeats per measurement (at least 3 runs)")
-    ap.add_argument("--max-seconds", type=float, default=5.0,
-                    help="a variant slower than this (one run) is skipped at larger sizes")
+    ap.add_argument(
+        "--min-time",
+        type=float,
+        default=0.2,
+        help="seconds of repeats per measurement (at least 3 runs)",
+    )
+    ap.add_argument(
+        "--max-seconds",
+        type=float,
+        default=5.0,
+        help="a variant slower than this (one run) is skipped at larger sizes",
+    )
     args = ap.parse_args(argv)
-    sizes = SIZES if args.sizes == "all" else [
-        tuple(int(v) for v in s.lower().split("x")) for s in args.sizes.split(",")]
+    sizes = (
+        SIZES
+        if args.sizes == "all"
+        else [tuple(int(v) for v in s.lower().split("x")) for s in args.sizes.split(",")]
+    )
     t0 = time.perf_counter()
     warmup()
     print(f"numba warm-up (compile or cache load): {time.perf_counter() - t0:.2f} s")
     rows, at_512 = run(sizes, args.sample, args.min_time, args.max_seconds)
-    print(format_table(("size", "map", "method", "median ms", "x numpy DP", "criterion / dp",
-                        "first path ms"), rows))
+    print(
+        format_table(
+            ("size", "map", "method", "median ms", "x numpy DP", "criterion / dp", "first path ms"),
+            rows,
+        )
+    )
     if at_512:
         print("\nTargets at 512x64 (worst of the two maps):")
         for label, limit in TARGETS.items():
             if label in at_512:
                 worst = max(at_512[label])
-                print(f"  {label:<22} {worst:8.3f} ms  (target <= {limit:g} ms: "
-                      f"{'ok' if worst <= limit else 'MISSED'})")
+                print(
+                    f"  {label:<22} {worst:8.3f} ms  (target <= {limit:g} ms: "
+                    f"{'ok' if worst <= limit else 'MISSED'})"
+                )
     return 0
 
 

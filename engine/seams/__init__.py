@@ -96,7 +96,9 @@ def _waypoints(waypoints, h: int, w: int) -> list[tuple[int, int]]:
     try:
         pts = list(waypoints)
     except TypeError:
-        raise TypeError(f"waypoints must be an iterable of (row, col) pairs, got {waypoints!r}")
+        raise TypeError(
+            f"waypoints must be an iterable of (row, col) pairs, got {waypoints!r}"
+        ) from None
     out = set()
     for p in pts:
         try:
@@ -123,8 +125,10 @@ def _pins(shape, start, end, waypoints) -> np.ndarray:
     for r, c in _waypoints(waypoints, h, w):
         pins[r] = c
     by = {r: f"waypoint {(r, int(pins[r]))}" for r in np.flatnonzero(pins >= 0)}
-    for name, row, col in (("start", 0, _column(start, "start", w)),
-                           ("end", h - 1, _column(end, "end", w))):
+    for name, row, col in (
+        ("start", 0, _column(start, "start", w)),
+        ("end", h - 1, _column(end, "end", w)),
+    ):
         if col is None:
             continue
         if pins[row] >= 0 and pins[row] != col:
@@ -138,8 +142,10 @@ def _options(method: str, options: dict, shape) -> dict:
     allowed = OPTIONS[method]
     unknown = sorted(set(options) - set(allowed))
     if unknown:
-        raise TypeError(f"unexpected option(s) for method {method!r}: {', '.join(unknown)}"
-                        f" (allowed: {', '.join(allowed) or 'none'})")
+        raise TypeError(
+            f"unexpected option(s) for method {method!r}: {', '.join(unknown)}"
+            f" (allowed: {', '.join(allowed) or 'none'})"
+        )
     opts = {**allowed, **options}
     if "connectivity" in opts:
         opts["connectivity"] = check_connectivity(opts["connectivity"])
@@ -164,8 +170,9 @@ def _step_image(image, shape) -> np.ndarray:
     if a.ndim == 2:
         a = a[:, :, None]
     if a.ndim != 3 or a.shape[:2] != tuple(shape):
-        raise ValueError(f"image must be shaped {tuple(shape)} or {tuple(shape)} + (C,), "
-                         f"got {np.shape(image)}")
+        raise ValueError(
+            f"image must be shaped {tuple(shape)} or {tuple(shape)} + (C,), got {np.shape(image)}"
+        )
     if not np.all(np.isfinite(a)):
         raise ValueError("image must be finite")
     return np.ascontiguousarray(a)
@@ -189,7 +196,7 @@ def _segmented(e: np.ndarray, pins: np.ndarray, solve, cancel) -> np.ndarray:
     for (ra, ca), (rb, cb) in zip(anchors, anchors[1:], strict=False):
         check(cancel)
         dom = np.zeros(e.shape, dtype=bool)
-        dom[ra:rb + 1] = True
+        dom[ra : rb + 1] = True
         dom &= ~used
         src = np.zeros(e.shape, dtype=bool)
         tgt = np.zeros(e.shape, dtype=bool)
@@ -213,8 +220,16 @@ def _graph_seam(e, pins, method, opts, cancel) -> Seam:
     metric = _MINIMAX_METRIC[opts["variant"]] if method == "minimax" else "sum"
 
     def solve(src, tgt, dom):
-        return shortest_path(e, src, tgt, dom, metric=metric, levels=opts.get("levels", 32),
-                             connectivity=opts["connectivity"], cancel=cancel)
+        return shortest_path(
+            e,
+            src,
+            tgt,
+            dom,
+            metric=metric,
+            levels=opts.get("levels", 32),
+            connectivity=opts["connectivity"],
+            cancel=cancel,
+        )
 
     return make_seam(e, _segmented(e, pins, solve, cancel), method)
 
@@ -241,11 +256,11 @@ def _iter_single(e, method, pins, cyclic, opts, cancel):
 
 
 def _iter_anytime(e, pins, cyclic, opts, cancel):
-    e = e.copy()  # streamed seams are built lazily from it: keep a private, frozen copy
-    e.setflags(write=False)
+    e = e.copy()  # streamed seams are built lazily from it: keep a private copy
     best = None
-    for seam in iter_oscillating(e, pins, o_max=opts["o_max"], variant=opts["variant"],
-                                 cyclic=cyclic, cancel=cancel):
+    for seam in iter_oscillating(
+        e, pins, o_max=opts["o_max"], variant=opts["variant"], cyclic=cyclic, cancel=cancel
+    ):
         if best is not None:
             yield SeamUpdate(best, final=False)
         best = seam
@@ -254,9 +269,17 @@ def _iter_anytime(e, pins, cyclic, opts, cancel):
 
 
 # ----------------------------------------------------------------------------- public API
-def iter_find_seam(error, *, method: str = "dp", start: int | None = None,
-                   end: int | None = None, waypoints=(), cyclic: bool = False, cancel=None,
-                   **options):
+def iter_find_seam(
+    error,
+    *,
+    method: str = "dp",
+    start: int | None = None,
+    end: int | None = None,
+    waypoints=(),
+    cyclic: bool = False,
+    cancel=None,
+    **options,
+):
     """Validate eagerly, then return a generator of :class:`SeamUpdate` returning the Seam.
 
     Parameters
@@ -285,6 +308,8 @@ def iter_find_seam(error, *, method: str = "dp", start: int | None = None,
         with ``final=True``; other methods: one final update.
     """
     e = np.ascontiguousarray(as_error_map(error))
+    if not e.flags.writeable:  # numba compiles read-only arrays separately: avoid a recompile
+        e = e.copy()
     choice(method, "method", METHODS)
     opts = _options(method, options, e.shape)
     pins = _pins(e.shape, start, end, waypoints)
@@ -292,8 +317,10 @@ def iter_find_seam(error, *, method: str = "dp", start: int | None = None,
         raise TypeError(f"cyclic must be a bool, got {cyclic!r}")
     cyclic = bool(cyclic)
     if cyclic and method not in CYCLIC_METHODS:
-        raise ValueError(f"cyclic=True is not supported by method {method!r} "
-                         f"(use one of {', '.join(CYCLIC_METHODS)})")
+        raise ValueError(
+            f"cyclic=True is not supported by method {method!r} "
+            f"(use one of {', '.join(CYCLIC_METHODS)})"
+        )
     if method == "oscillating":
         return _iter_anytime(e, pins, cyclic, opts, cancel)
     return _iter_single(e, method, pins, cyclic, opts, cancel)

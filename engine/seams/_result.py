@@ -31,8 +31,14 @@ class Seam:
     __slots__ = ("_path", "_mask", "_criterion", "_peak", "method", "_build")
 
     def __init__(self, path, mask, criterion, peak, method: str = ""):
-        for name, value in (("_path", path), ("_mask", mask), ("_criterion", float(criterion)),
-                            ("_peak", float(peak)), ("method", method), ("_build", None)):
+        for name, value in (
+            ("_path", path),
+            ("_mask", mask),
+            ("_criterion", float(criterion)),
+            ("_peak", float(peak)),
+            ("method", method),
+            ("_build", None),
+        ):
             object.__setattr__(self, name, value)
 
     @classmethod
@@ -49,8 +55,13 @@ class Seam:
             path, mask, crit, peak = build()
             path.setflags(write=False)
             mask.setflags(write=False)
-            for name, value in (("_path", path), ("_mask", mask), ("_criterion", float(crit)),
-                                ("_peak", float(peak)), ("_build", None)):
+            for name, value in (
+                ("_path", path),
+                ("_mask", mask),
+                ("_criterion", float(crit)),
+                ("_peak", float(peak)),
+                ("_build", None),
+            ):
                 object.__setattr__(self, name, value)
         return self
 
@@ -84,8 +95,10 @@ class Seam:
         return (Seam, (self.path, self.mask, self.criterion, self.peak, self.method))
 
     def __repr__(self) -> str:
-        return (f"Seam(method={self.method!r}, shape={self.shape}, pixels={len(self.path)}, "
-                f"criterion={self.criterion:.6g}, peak={self.peak:.6g})")
+        return (
+            f"Seam(method={self.method!r}, shape={self.shape}, pixels={len(self.path)}, "
+            f"criterion={self.criterion:.6g}, peak={self.peak:.6g})"
+        )
 
 
 def mask_from_columns(cols: np.ndarray, width: int) -> np.ndarray:
@@ -119,4 +132,6 @@ def make_seam(error: np.ndarray, path, method: str, mask: np.ndarray | None = No
     path.setflags(write=False)
     mask = np.asarray(mask, dtype=bool)
     mask.setflags(write=False)
-    return Seam(path=path, mask=mask, criterion=float(values.sum()), peak=float(values.max()), method=method)
+    return Seam(
+        path=path, mask=mask, criterion=float(values.sum()), peak=float(values.max()), method=method
+    )

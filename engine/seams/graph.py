@@ -12,7 +12,8 @@ nodes pay their own cost. Labels and their order, by metric:
   count vector of path nodes per level compared from the top level down, ties by sum. The
   order is invariant under adding the same node to both paths, so Dijkstra is exact.
 
-One numba kernel with an indexed binary heap (decrease-key) serves every metric.
+Two numba kernels: the scalar labels (sum; lm, whose max also gives minimax's m*) with keys
+inline in a lazy-deletion heap, the sorted label in an indexed heap with decrease-key.
 """
 
 from __future__ import annotations
@@ -28,25 +29,21 @@ _SUM, _LM, _SORTED = 0, 1, 2
 
 
 @njit(cache=True, nogil=True)
-def _less(u, v, mode, k1, k2, cnt, nlev):
-    """Label of node u strictly smaller than label of node v."""
-    if mode == _SORTED:
-        for lv in range(nlev - 1, -1, -1):
-            if cnt[u, lv] != cnt[v, lv]:
-                return cnt[u, lv] < cnt[v, lv]
-        return k2[u] < k2[v]
-    if k1[u] != k1[v]:
-        return k1[u] < k1[v]
-    return k2[u] < k2[v]
+def _less(u, v, cnt, total):
+    """Sorted-vector label of node u strictly smaller than that of node v."""
+    for lv in range(cnt.shape[1] - 1, -1, -1):
+        if cnt[u, lv] != cnt[v, lv]:
+            return cnt[u, lv] < cnt[v, lv]
+    return total[u] < total[v]
 
 
 @njit(cache=True, nogil=True)
-def _sift_up(heap, pos, t, mode, k1, k2, cnt, nlev):
+def _sift_up(heap, pos, t, cnt, total):
     node = heap[t]
     while t > 0:
         parent = (t - 1) >> 1
         q = heap[parent]
-        if not _less(node, q, mode, k1, k2, cnt, nlev):
+        if not _less(node, q, cnt, total):
             break
         heap[t] = q
         pos[q] = t
@@ -56,7 +53,7 @@ def _sift_up(heap, pos, t, mode, k1, k2, cnt, nlev):
 
 
 @njit(cache=True, nogil=True)
-def _sift_down(heap, pos, size, t, mode, k1, k2, cnt, nlev):
+def _sift_down(heap, pos, size, t, cnt, total):
     node = heap[t]
     while True:
         left = 2 * t + 1
@@ -64,10 +61,10 @@ def _sift_down(heap, pos, size, t, mode, k1, k2, cnt, nlev):
             break
         child = left
         right = left + 1
-        if right < size and _less(heap[right], heap[left], mode, k1, k2, cnt, nlev):
+        if right < size and _less(heap[right], heap[left], cnt, total):
             child = right
         q = heap[child]
-        if not _less(q, node, mode, k1, k2, cnt, nlev):
+        if not _less(q, node, cnt, total):
             break
         heap[t] = q
         pos[q] = t
@@ -77,38 +74,29 @@ def _sift_down(heap, pos, size, t, mode, k1, k2, cnt, nlev):
 
 
 @njit(cache=True, nogil=True)
-def _dijkstra(cost, domain, sources, targets, mode, lev, nlev, conn, pred):
-    """Search from every source pixel to the first target popped; returns its flat index
-    (-1 when no target is reachable). ``pred`` receives the predecessor of each settled node."""
+def _dijkstra_sorted(cost, domain, sources, targets, lev, nlev, conn, pred):
+    """Dijkstra with the quantised sorted-vector label (per-level node counts, compared from
+    the top level down, ties by sum) in an indexed heap with decrease-key. Returns the flat
+    index of the first target settled (-1: none reachable); ``pred`` gets the predecessors."""
     h, w = cost.shape
     n = h * w
-    inf = np.inf
-    k1 = np.full(n, inf)
-    k2 = np.zeros(n)
-    cnt = np.zeros((n if mode == _SORTED else 1, max(nlev, 1)), dtype=np.int32)
+    total = np.zeros(n)
+    cnt = np.zeros((n, nlev), dtype=np.int32)
     heap = np.empty(n, dtype=np.int64)
     pos = np.full(n, -1, dtype=np.int64)  # -1: never queued, -2: settled
-    if conn == 8:
-        dr = np.array([-1, -1, -1, 0, 0, 1, 1, 1])
-        dc = np.array([-1, 0, 1, -1, 1, -1, 0, 1])
-    else:
-        dr = np.array([-1, 0, 0, 1])
-        dc = np.array([0, -1, 1, 0])
+    dr, dc = _steps(conn)
     size = 0
     for r in range(h):
         for c in range(w):
             if sources[r, c] and domain[r, c]:
                 u = r * w + c
-                e = cost[r, c]
-                k1[u] = e
-                k2[u] = e if mode != _SUM else 0.0
-                if mode == _SORTED:
-                    cnt[u, lev[r, c]] = 1
+                total[u] = cost[r, c]
+                cnt[u, lev[r, c]] = 1
                 pred[u] = -1
                 heap[size] = u
                 pos[u] = size
                 size += 1
-                _sift_up(heap, pos, size - 1, mode, k1, k2, cnt, nlev)
+                _sift_up(heap, pos, size - 1, cnt, total)
     while size > 0:
         u = heap[0]
         size -= 1
@@ -116,7 +104,7 @@ def _dijkstra(cost, domain, sources, targets, mode, lev, nlev, conn, pred):
         if size > 0:
             heap[0] = heap[size]
             pos[heap[0]] = 0
-            _sift_down(heap, pos, size, 0, mode, k1, k2, cnt, nlev)
+            _sift_down(heap, pos, size, 0, cnt, total)
         ur, uc = u // w, u % w
         if targets[ur, uc]:
             return u
@@ -127,40 +115,38 @@ def _dijkstra(cost, domain, sources, targets, mode, lev, nlev, conn, pred):
             v = vr * w + vc
             if pos[v] == -2:
                 continue
-            e = cost[vr, vc]
-            if mode == _SUM:
-                n1, n2 = k1[u] + e, 0.0
-            else:
-                n1, n2 = max(k1[u], e), k2[u] + e
+            lv = lev[vr, vc]
+            new_total = total[u] + cost[vr, vc]
             better = pos[v] == -1
             if not better:
-                if mode == _SORTED:
-                    lv = lev[vr, vc]
-                    decided = False
-                    for m in range(nlev - 1, -1, -1):
-                        a = cnt[u, m] + (1 if m == lv else 0)
-                        if a != cnt[v, m]:
-                            better = a < cnt[v, m]
-                            decided = True
-                            break
-                    if not decided:
-                        better = n2 < k2[v]
-                else:
-                    better = n1 < k1[v] or (n1 == k1[v] and n2 < k2[v])
+                decided = False
+                for m in range(nlev - 1, -1, -1):
+                    a = cnt[u, m] + (1 if m == lv else 0)
+                    if a != cnt[v, m]:
+                        better = a < cnt[v, m]
+                        decided = True
+                        break
+                if not decided:
+                    better = new_total < total[v]
             if better:
-                k1[v] = n1
-                k2[v] = n2
-                if mode == _SORTED:
-                    for m in range(nlev):
-                        cnt[v, m] = cnt[u, m]
-                    cnt[v, lev[vr, vc]] += 1
+                total[v] = new_total
+                for m in range(nlev):
+                    cnt[v, m] = cnt[u, m]
+                cnt[v, lv] += 1
                 pred[v] = u
                 if pos[v] == -1:
                     heap[size] = v
                     pos[v] = size
                     size += 1
-                _sift_up(heap, pos, pos[v], mode, k1, k2, cnt, nlev)
+                _sift_up(heap, pos, pos[v], cnt, total)
     return -1
+
+
+@njit(cache=True, nogil=True)
+def _steps(conn):
+    if conn == 8:
+        return (np.array([-1, -1, -1, 0, 0, 1, 1, 1]), np.array([-1, 0, 1, -1, 1, -1, 0, 1]))
+    return np.array([-1, 0, 0, 1]), np.array([0, -1, 1, 0])
 
 
 @njit(cache=True, nogil=True)
@@ -209,8 +195,9 @@ def _heap_pop(hk1, hk2, hn, size):
 
 @njit(cache=True, nogil=True)
 def _dijkstra_scalar(cost, domain, sources, targets, lm, conn, pred):
-    """:func:`_dijkstra` for the scalar labels (sum, or lm's (max, sum)) with the keys inline
-    in a lazy-deletion heap (faster than the indexed heap)."""
+    """Dijkstra for the scalar labels: sum, or (with ``lm``) Long & Mould's (max, sum), keys
+    inline in a lazy-deletion heap. Returns the flat index of the first target settled
+    (-1: none reachable); ``pred`` gets the predecessors."""
     h, w = cost.shape
     n = h * w
     d1 = np.full(n, np.inf)
@@ -220,12 +207,7 @@ def _dijkstra_scalar(cost, domain, sources, targets, lm, conn, pred):
     hk1 = np.empty(cap)
     hk2 = np.empty(cap)
     hn = np.empty(cap, dtype=np.int64)
-    if conn == 8:
-        dr = np.array([-1, -1, -1, 0, 0, 1, 1, 1])
-        dc = np.array([-1, 0, 1, -1, 1, -1, 0, 1])
-    else:
-        dr = np.array([-1, 0, 0, 1])
-        dc = np.array([0, -1, 1, 0])
+    dr, dc = _steps(conn)
     size = 0
     for r in range(h):
         for c in range(w):
@@ -265,10 +247,11 @@ def _dijkstra_scalar(cost, domain, sources, targets, lm, conn, pred):
     return -1
 
 
-def _run(cost, domain, sources, targets, mode, lev, nlev, conn):
+def _run(cost, domain, sources, targets, mode, conn, levels=0):
     pred = np.full(cost.size, -1, dtype=np.int64)
     if mode == _SORTED:
-        t = _dijkstra(cost, domain, sources, targets, mode, lev, nlev, conn, pred)
+        lev = quantise(cost, domain, levels)
+        t = _dijkstra_sorted(cost, domain, sources, targets, lev, levels, conn, pred)
     else:
         t = _dijkstra_scalar(cost, domain, sources, targets, mode == _LM, conn, pred)
     if t < 0:
@@ -280,9 +263,6 @@ def _run(cost, domain, sources, targets, mode, lev, nlev, conn):
     return np.column_stack(np.divmod(nodes, cost.shape[1]))
 
 
-_NO_LEVELS = np.zeros((1, 1), dtype=np.int64)
-
-
 def quantise(cost: np.ndarray, domain: np.ndarray, levels: int) -> np.ndarray:
     """Level 0..levels-1 of every pixel, uniform between 0 and the largest cost in ``domain``."""
     top = float(cost[domain].max()) if domain.any() else 0.0
@@ -291,22 +271,30 @@ def quantise(cost: np.ndarray, domain: np.ndarray, levels: int) -> np.ndarray:
     return np.minimum((cost * (levels / top)).astype(np.int64), levels - 1)
 
 
-def shortest_path(cost, sources, targets, domain, *, metric: str, levels: int = 32,
-                  connectivity: int = 8, cancel=None):
+def shortest_path(
+    cost,
+    sources,
+    targets,
+    domain,
+    *,
+    metric: str,
+    levels: int = 32,
+    connectivity: int = 8,
+    cancel=None,
+):
     """Path ((N, 2) intp, source to target) on validated C-contiguous inputs, or None."""
     check(cancel)
     if metric == "sum":
-        path = _run(cost, domain, sources, targets, _SUM, _NO_LEVELS, 0, connectivity)
+        path = _run(cost, domain, sources, targets, _SUM, connectivity)
     elif metric == "sorted":
-        lev = quantise(cost, domain, levels)
-        path = _run(cost, domain, sources, targets, _SORTED, lev, levels, connectivity)
+        path = _run(cost, domain, sources, targets, _SORTED, connectivity, levels)
     else:
-        path = _run(cost, domain, sources, targets, _LM, _NO_LEVELS, 0, connectivity)
+        path = _run(cost, domain, sources, targets, _LM, connectivity)
         if metric == "minimax" and path is not None:
             check(cancel)
             peak = cost[path[:, 0], path[:, 1]].max()
             low = domain & (cost <= peak)
-            path = _run(cost, low, sources, targets, _SUM, _NO_LEVELS, 0, connectivity)
+            path = _run(cost, low, sources, targets, _SUM, connectivity)
     check(cancel)
     return path
 
@@ -320,8 +308,17 @@ def _bool_mask(a, name: str, shape) -> np.ndarray:
     return np.ascontiguousarray(m)
 
 
-def graph_path(cost, sources, targets, *, domain=None, metric: str = "sum", levels: int = 32,
-               connectivity: int = 8, cancel=None) -> np.ndarray:
+def graph_path(
+    cost,
+    sources,
+    targets,
+    *,
+    domain=None,
+    metric: str = "sum",
+    levels: int = 32,
+    connectivity: int = 8,
+    cancel=None,
+) -> np.ndarray:
     """Best path on the pixel graph from any pixel of ``sources`` to the first reached target.
 
     Parameters
@@ -362,8 +359,9 @@ def graph_path(cost, sources, targets, *, domain=None, metric: str = "sum", leve
         raise ValueError("sources has no pixel inside domain")
     if not (tgt & dom).any():
         raise ValueError("targets has no pixel inside domain")
-    path = shortest_path(c, src, tgt, dom, metric=metric, levels=levels,
-                         connectivity=connectivity, cancel=cancel)
+    path = shortest_path(
+        c, src, tgt, dom, metric=metric, levels=levels, connectivity=connectivity, cancel=cancel
+    )
     if path is None:
         raise ValueError("no path from sources to targets within domain")
     return path

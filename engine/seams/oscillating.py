@@ -331,8 +331,9 @@ def initial_controls(error: np.ndarray, pins: np.ndarray) -> np.ndarray:
     return np.where(pins >= 0, pins, c)
 
 
-def iter_oscillating(error, pins, *, o_max: int, variant: str, cyclic: bool, cancel,
-                     method: str = "oscillating"):
+def iter_oscillating(
+    error, pins, *, o_max: int, variant: str, cyclic: bool, cancel, method: str = "oscillating"
+):
     """Generator: yields a Seam for the initial path and for every improvement (in order, each
     strictly better than the one before). Stops early, keeping the best path so far, when
     ``cancel`` is set. ``error`` must stay unchanged while the seams are in use."""
@@ -511,7 +512,9 @@ def _optimal_kernel(p, lo, hi, cyclic, cols):
 def optimal_controls(error: np.ndarray, lo: np.ndarray, hi: np.ndarray, *, cyclic: bool):
     """Control points of the exact optimum (row j limited to lo[j]..hi[j])."""
     if error.shape[1] >= 32768:
-        raise ValueError(f"method 'oscillating-optimal' needs fewer than 32768 columns, got {error.shape[1]}")
+        raise ValueError(
+            f"method 'oscillating-optimal' needs fewer than 32768 columns, got {error.shape[1]}"
+        )
     cols = np.zeros(error.shape[0], dtype=np.int64)
     _optimal_kernel(prefix_sums(error), lo, hi, bool(cyclic), cols)
     return cols

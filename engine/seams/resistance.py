@@ -71,10 +71,10 @@ def _walk(error, image, use_image, start, trow, tcol, max_run, path):
                 cr = col_run + 1 if _DC[d] == 0 else 1
                 if rr > max_run or cr > max_run:
                     continue
-                if tc >= 0 and (tr - nr) < abs(nc - tc):
-                    # outside the cone: only a sideways step that gets closer is allowed
-                    if not (_DR[d] == 0 and abs(nc - tc) < abs(c - tc)):
-                        continue
+                outside = tc >= 0 and (tr - nr) < abs(nc - tc)
+                # outside the target's cone only a sideways step that gets closer is allowed
+                if outside and not (_DR[d] == 0 and abs(nc - tc) < abs(c - tc)):
+                    continue
                 v = _step_cost(error, image, use_image, r, c, nr, nc)
                 if v < best:
                     best = v
@@ -114,18 +114,15 @@ _NO_IMAGE = np.zeros((1, 1, 1))
 def resistance_path(error: np.ndarray, pins: np.ndarray, *, max_run: int, image=None):
     """The walk's pixels ((N, 2) intp, top to bottom) honouring the pinned rows of ``pins``."""
     h, w = error.shape
-    rows = np.flatnonzero(pins >= 0)
-    rows = rows[rows > 0]
-    trow = np.append(rows, h - 1)
-    tcol = np.append(pins[rows], -1)
-    if h == 1 or pins[h - 1] >= 0:
-        trow, tcol = trow[:-1], tcol[:-1]  # a pinned last row is already the last target
-    if h == 1:
-        trow, tcol = np.zeros(1), np.full(1, -1)
+    trow = np.flatnonzero(pins[1:] >= 0) + 1  # pinned rows below the top, in order
+    tcol = pins[trow]
+    if pins[h - 1] < 0 or h == 1:  # end free: stop anywhere in the bottom row
+        trow, tcol = np.append(trow, h - 1), np.append(tcol, -1)
     start = int(pins[0])
     use_image = image is not None
     img = _NO_IMAGE if image is None else image
     path = np.empty((h * w, 2), dtype=np.int64)
-    n = _walk(error, img, use_image, start, trow.astype(np.int64), tcol.astype(np.int64),
-              max_run, path)
+    n = _walk(
+        error, img, use_image, start, trow.astype(np.int64), tcol.astype(np.int64), max_run, path
+    )
     return path[:n].copy()

@@ -140,8 +140,9 @@ def test_optimal_frozen_ends_equal_brute_force(cyclic):
     for seed in range(4):
         e = rand_map((5, 4), seed)
         start, end, wp = seed % 4, (seed * 3 + 1) % 4, (2, (seed + 2) % 4)
-        s = find_seam(e, method="oscillating-optimal", start=start, end=end, waypoints=[wp],
-                      cyclic=cyclic)
+        s = find_seam(
+            e, method="oscillating-optimal", start=start, end=end, waypoints=[wp], cyclic=cyclic
+        )
         c = controls_of(s)
         assert (c[0], c[-1], c[2]) == (start, end, wp[1])
         want = brute_osc(e, {0: start, 4: end, 2: wp[1]}, cyclic)
@@ -183,8 +184,9 @@ def improves(e, c, o_max, cyclic, frozen=()):
 def test_oscillating_monotone_and_locally_optimal(variant, cyclic, o_max):
     for seed in range(3):
         e = smooth_map((24, 7), seed, sigma=1.0)
-        updates = list(iter_find_seam(e, method="oscillating", o_max=o_max, variant=variant,
-                                      cyclic=cyclic))
+        updates = list(
+            iter_find_seam(e, method="oscillating", o_max=o_max, variant=variant, cyclic=cyclic)
+        )
         crits = [u.seam.criterion for u in updates]
         assert all(b <= a + 1e-12 for a, b in zip(crits, crits[1:], strict=False))
         assert len(updates) > 2, "the search never improved the initial path"
@@ -247,8 +249,10 @@ def test_oscillating_gap_to_optimum_on_samples(record_property):
         assert np.all(osc >= opt - 1e-9)
         means[o_max] = float(np.mean(osc / opt - 1))
         record_property(f"oscillating_gap_o_max_{o_max}", means[o_max])
-    print(f"oscillating vs optimum, {len(maps)} sample overlaps 64x16: "
-          + ", ".join(f"o_max={o}: +{100 * m:.1f} %" for o, m in means.items()))
+    print(
+        f"oscillating vs optimum, {len(maps)} sample overlaps 64x16: "
+        + ", ".join(f"o_max={o}: +{100 * m:.1f} %" for o, m in means.items())
+    )
     assert means[16] <= 0.15
     assert means[3] <= 0.60
 

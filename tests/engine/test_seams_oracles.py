@@ -102,8 +102,11 @@ def path_key(error, path, metric, levels=32):
     if metric == "minimax":
         return (v.max(), v.sum())
     top = error.max()
-    lev = np.zeros(len(v), int) if top <= 0 else np.minimum((v * (levels / top)).astype(int),
-                                                          levels - 1)
+    lev = (
+        np.zeros(len(v), int)
+        if top <= 0
+        else np.minimum((v * (levels / top)).astype(int), levels - 1)
+    )
     return (tuple(sorted(lev.tolist(), reverse=True)), v.sum())
 
 
