@@ -179,8 +179,11 @@ class Document(QObject):
     def commit_template_rect(self, old, *, text: str = "Find best tile") -> None:
         """One undo step for a rectangle the template search already streamed in."""
         if old != self.template_rect:
-            self.undo_stack.push(commands.SetTemplateRect(
-                self, self.template_rect, text=text, old=old, already_applied=True))
+            self.undo_stack.push(
+                commands.SetTemplateRect(
+                    self, self.template_rect, text=text, old=old, already_applied=True
+                )
+            )
 
     def add_waypoint(self, key: str, point: tuple[int, int]) -> None:
         pt = (int(point[0]), int(point[1]))

@@ -294,8 +294,9 @@ class JobManager(QObject):
         return job
 
     def get(self, key: str) -> Job | None:
+        """The current job of ``key`` if it is running and not aborted."""
         job = self._jobs.get(key)
-        return job if job is not None and job.running else None
+        return job if job is not None and job.running and job.alive else None
 
     def running(self) -> list[Job]:
         """Jobs still computing whose results are wanted, oldest first."""

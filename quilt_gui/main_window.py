@@ -97,8 +97,9 @@ class MainWindow(QMainWindow):
         self._update_actions()
 
     # ------------------------------------------------------------------ construction
-    def _action(self, text: str, slot, shortcut=None, tip: str = "", *, checkable=False,
-                checked=False) -> QAction:
+    def _action(
+        self, text: str, slot, shortcut=None, tip: str = "", *, checkable=False, checked=False
+    ) -> QAction:
         a = QAction(text, self)
         if shortcut is not None:
             a.setShortcut(QKeySequence(shortcut))
@@ -118,16 +119,28 @@ class MainWindow(QMainWindow):
     def _make_actions(self) -> None:
         A = self._action
         K = QKeySequence.StandardKey
-        self.act_open = A("&Open image or project…", self.open_dialog, K.Open,
-                          "Open a texture image or a .quiltproj project")
-        self.act_attach = A("Attach &material map…", self.attach_dialog, None,
-                            "Add a normal / roughness / height ... map of the same size; it "
-                            "follows every cut")
+        self.act_open = A(
+            "&Open image or project…",
+            self.open_dialog,
+            K.Open,
+            "Open a texture image or a .quiltproj project",
+        )
+        self.act_attach = A(
+            "Attach &material map…",
+            self.attach_dialog,
+            None,
+            "Add a normal / roughness / height ... map of the same size; it follows every cut",
+        )
         self.act_save = A("&Save project", self.save, K.Save, "Save the project")
-        self.act_save_as = A("Save project &as…", self.save_as, K.SaveAs,
-                             "Save the project under a new name")
-        self.act_export = A("&Export tile set…", self.export_dialog, "Ctrl+E",
-                            "Write the picked tiles, atlases, manifest, Tiled and Godot files")
+        self.act_save_as = A(
+            "Save project &as…", self.save_as, K.SaveAs, "Save the project under a new name"
+        )
+        self.act_export = A(
+            "&Export tile set…",
+            self.export_dialog,
+            "Ctrl+E",
+            "Write the picked tiles, atlases, manifest, Tiled and Godot files",
+        )
         self.act_quit = A("&Quit", self.close, K.Quit, "Close Quilt Studio")
         self.act_undo = self.doc.undo_stack.createUndoAction(self, "&Undo")
         self.act_undo.setShortcut(QKeySequence(K.Undo))
@@ -135,23 +148,46 @@ class MainWindow(QMainWindow):
         self.act_redo.setShortcut(QKeySequence(K.Redo))
         self.addActions([self.act_undo, self.act_redo])
         self.act_fit = A("&Fit in window", self._zoom_fit, "Ctrl+0", "Show the whole image")
-        self.act_100 = A("&Actual size (100 %)", self._zoom_100, "Ctrl+1",
-                         "One image pixel per screen pixel")
+        self.act_100 = A(
+            "&Actual size (100 %)", self._zoom_100, "Ctrl+1", "One image pixel per screen pixel"
+        )
         self.act_zoom_in = A("Zoom &in", self._zoom_in, K.ZoomIn, "Zoom in")
         self.act_zoom_out = A("Zoom &out", self._zoom_out, K.ZoomOut, "Zoom out")
-        self.act_heat = A("&Heat overlay of the error maps", self._set_heat, "H",
-                          "Show each overlap's error map over the source", checkable=True,
-                          checked=settings.get("heat_overlay"))
-        self.act_find = A("&Find best tile", self.pipeline.find_template, "Ctrl+T",
-                          "Search the tile rectangle whose opposite borders match best")
-        self.act_generate = A("&Generate candidates", self.pipeline.generate_candidates,
-                              "Ctrl+G", "Make the candidate tiles (locked ones are kept)")
-        self.act_reroll_layout = A("Re-roll &layout", self.pipeline.reroll_layout, "Ctrl+R",
-                                   "A new random arrangement of the picked tiles")
-        self.act_cancel = A("&Cancel running job", self.jobs.stop_all, "Esc",
-                            "Stop the running computation")
-        self.act_clear_wp = A("Clear &waypoints", self.doc.clear_waypoints, None,
-                              "Remove every waypoint of the template seams")
+        self.act_heat = A(
+            "&Heat overlay of the error maps",
+            self._set_heat,
+            "H",
+            "Show each overlap's error map over the source",
+            checkable=True,
+            checked=settings.get("heat_overlay"),
+        )
+        self.act_find = A(
+            "&Find best tile",
+            self.pipeline.find_template,
+            "Ctrl+T",
+            "Search the tile rectangle whose opposite borders match best",
+        )
+        self.act_generate = A(
+            "&Generate candidates",
+            self.pipeline.generate_candidates,
+            "Ctrl+G",
+            "Make the candidate tiles (locked ones are kept)",
+        )
+        self.act_reroll_layout = A(
+            "Re-roll &layout",
+            self.pipeline.reroll_layout,
+            "Ctrl+R",
+            "A new random arrangement of the picked tiles",
+        )
+        self.act_cancel = A(
+            "&Cancel running job", self.jobs.stop_all, "Esc", "Stop the running computation"
+        )
+        self.act_clear_wp = A(
+            "Clear &waypoints",
+            self.doc.clear_waypoints,
+            None,
+            "Remove every waypoint of the template seams",
+        )
 
     def _make_views(self) -> None:
         doc = self.doc
@@ -169,11 +205,14 @@ class MainWindow(QMainWindow):
         lay.addWidget(self.message_bar)
         lay.addWidget(self.tabs, 1)
         self.setCentralWidget(central)
-        self.params_panel = ParamsPanel(doc, {
-            "Template": [self.act_find],
-            "Candidates": [self.act_generate],
-            "Preview": [self.act_reroll_layout],
-        })
+        self.params_panel = ParamsPanel(
+            doc,
+            {
+                "Template": [self.act_find],
+                "Candidates": [self.act_generate],
+                "Preview": [self.act_reroll_layout],
+            },
+        )
         self.params_panel.show_groups(TILESET_GROUPS)
         self.overlap_panel = OverlapPanel(doc, self.pipeline)
         self.tile_view = TileView(doc)
@@ -181,8 +220,12 @@ class MainWindow(QMainWindow):
         self.docks = {}
         for key, title, widget, area in (
             ("params", "Parameters", self.params_panel, Qt.DockWidgetArea.LeftDockWidgetArea),
-            ("overlaps", "Overlaps, error maps and seams", self.overlap_panel,
-             Qt.DockWidgetArea.RightDockWidgetArea),
+            (
+                "overlaps",
+                "Overlaps, error maps and seams",
+                self.overlap_panel,
+                Qt.DockWidgetArea.RightDockWidgetArea,
+            ),
             ("tile", "Seamless tile", self.tile_view, Qt.DockWidgetArea.RightDockWidgetArea),
             ("gallery", "Candidates", self.gallery, Qt.DockWidgetArea.BottomDockWidgetArea),
         ):
@@ -241,8 +284,10 @@ class MainWindow(QMainWindow):
         self.pixel_label.setMinimumWidth(260)
         self.pixel_label.setToolTip("Pixel under the cursor: x, y and value")
         self.criterion_label = QLabel()
-        self.criterion_label.setToolTip("Seam criterion (sum of the error along the seam) of "
-                                        "the left/right (H) and top/bottom (V) overlaps")
+        self.criterion_label.setToolTip(
+            "Seam criterion (sum of the error along the seam) of "
+            "the left/right (H) and top/bottom (V) overlaps"
+        )
         self.job_status = JobStatus(self.jobs)
         sb.addPermanentWidget(self.pixel_label)
         sb.addPermanentWidget(self.criterion_label)
@@ -269,8 +314,12 @@ class MainWindow(QMainWindow):
         self.source_view.set_heat_visible(self.act_heat.isChecked())
 
     def canvases(self) -> list[ImageCanvas]:
-        return [self.source_view, self.preview_view.canvas, self.tile_view.canvas,
-                *self.overlap_panel.views.values()]
+        return [
+            self.source_view,
+            self.preview_view.canvas,
+            self.tile_view.canvas,
+            *self.overlap_panel.views.values(),
+        ]
 
     # ------------------------------------------------------------------ messages
     @Slot(str, str)
@@ -278,7 +327,8 @@ class MainWindow(QMainWindow):
         """Tell the user something without blocking (banner + status bar + log)."""
         self.messages.append((level, text))
         getattr(log, {"error": "error", "warning": "warning"}.get(level, "info"))(text)
-        self.message_bar.show_message(level, text, actions)
+        if actions or level != "info" or not self.message_bar.waiting_for_answer():
+            self.message_bar.show_message(level, text, actions)
         self.statusBar().showMessage(text, 10_000)
 
     def last_message(self, level: str | None = None) -> str:
@@ -289,24 +339,31 @@ class MainWindow(QMainWindow):
 
     # ------------------------------------------------------------------ questions (patchable)
     def ask_save_changes(self) -> str:
-        """"save", "discard" or "cancel" for unsaved changes (tests replace this)."""
-        box = QMessageBox(QMessageBox.Icon.Warning, APP_NAME,
-                          f"Save the changes to “{self.doc.name}” before closing?",
-                          QMessageBox.StandardButton.Save | QMessageBox.StandardButton.Discard
-                          | QMessageBox.StandardButton.Cancel, self)
+        """ "save", "discard" or "cancel" for unsaved changes (tests replace this)."""
+        box = QMessageBox(
+            QMessageBox.Icon.Warning,
+            APP_NAME,
+            f"Save the changes to “{self.doc.name}” before closing?",
+            QMessageBox.StandardButton.Save
+            | QMessageBox.StandardButton.Discard
+            | QMessageBox.StandardButton.Cancel,
+            self,
+        )
         box.setDefaultButton(QMessageBox.StandardButton.Save)
         answer = box.exec()
-        return {QMessageBox.StandardButton.Save: "save",
-                QMessageBox.StandardButton.Discard: "discard"}.get(
-                    QMessageBox.StandardButton(answer), "cancel")
+        return {
+            QMessageBox.StandardButton.Save: "save",
+            QMessageBox.StandardButton.Discard: "discard",
+        }.get(QMessageBox.StandardButton(answer), "cancel")
 
     def ask_open_path(self, caption: str, filters: str, key: str) -> str:
         path, _ = QFileDialog.getOpenFileName(self, caption, settings.get(key), filters)
         return path
 
     def ask_save_path(self) -> str:
-        start = self.doc.project_path or os.path.join(settings.get("last_project_dir"),
-                                                      self.doc.name + PROJECT_SUFFIX)
+        start = self.doc.project_path or os.path.join(
+            settings.get("last_project_dir"), self.doc.name + PROJECT_SUFFIX
+        )
         path, _ = QFileDialog.getSaveFileName(self, "Save project", start, PROJECT_FILTER)
         if path and not path.endswith(PROJECT_SUFFIX):
             path += PROJECT_SUFFIX
@@ -333,9 +390,11 @@ class MainWindow(QMainWindow):
             self.offer_recovery(untitled)
 
     def open_dialog(self) -> None:
-        path = self.ask_open_path("Open image or project",
-                                  f"{IMAGE_FILTER};;{PROJECT_FILTER};;All files (*)",
-                                  "last_open_dir")
+        path = self.ask_open_path(
+            "Open image or project",
+            f"{IMAGE_FILTER};;{PROJECT_FILTER};;All files (*)",
+            "last_open_dir",
+        )
         if path:
             self.open_path(path)
 
@@ -348,24 +407,42 @@ class MainWindow(QMainWindow):
         if confirm and not self._confirm_discard():
             return
         if path.lower().endswith(PROJECT_SUFFIX):
-            self.jobs.start("open", load_project, path, label=f"Opening {Path(path).name}",
-                            pass_cancel=False, on_done=partial(self._on_project_loaded, path),
-                            on_error=partial(self._on_open_error, path))
+            self.jobs.start(
+                "open",
+                load_project,
+                path,
+                label=f"Opening {Path(path).name}",
+                pass_cancel=False,
+                on_done=partial(self._on_project_loaded, path),
+                on_error=partial(self._on_open_error, path),
+            )
         else:
-            self.jobs.start("open", load_image, path, label=f"Opening {Path(path).name}",
-                            pass_cancel=False,
-                            on_done=partial(self._on_image_loaded, path, remember),
-                            on_error=partial(self._on_open_error, path))
+            self.jobs.start(
+                "open",
+                load_image,
+                path,
+                label=f"Opening {Path(path).name}",
+                pass_cancel=False,
+                on_done=partial(self._on_image_loaded, path, remember),
+                on_error=partial(self._on_open_error, path),
+            )
 
     def _on_image_loaded(self, path: str, remember: bool, loaded) -> None:
-        source = Source(maps={MAIN_MAP: loaded.pixels}, paths={MAIN_MAP: loaded.path},
-                        bit_depth=loaded.bit_depth, kinds={MAIN_MAP: "color"})
+        source = Source(
+            maps={MAIN_MAP: loaded.pixels},
+            paths={MAIN_MAP: loaded.path},
+            bit_depth=loaded.bit_depth,
+            kinds={MAIN_MAP: "color"},
+        )
         self.doc.set_source(source)
         self._remember(path, "last_open_dir", remember)
         h, w = loaded.pixels.shape[:2]
-        self.show_message("info", f"Opened {Path(path).name}: {w}×{h}, {loaded.bit_depth}-bit "
-                                  f"{loaded.mode}. Next: Find best tile (Ctrl+T) or draw the "
-                                  "tile rectangle.")
+        self.show_message(
+            "info",
+            f"Opened {Path(path).name}: {w}×{h}, {loaded.bit_depth}-bit "
+            f"{loaded.mode}. Next: Find best tile (Ctrl+T) or draw the "
+            "tile rectangle.",
+        )
         self.tabs.setCurrentWidget(self.source_view)
 
     def _on_project_loaded(self, path: str, project) -> None:
@@ -425,9 +502,15 @@ class MainWindow(QMainWindow):
         if not self.doc.has_source:
             self.show_message("warning", "Open a source image before attaching material maps.")
             return
-        self.jobs.start("attach", load_image, path, label=f"Opening {Path(path).name}",
-                        pass_cancel=False, on_done=partial(self._on_map_loaded, path),
-                        on_error=partial(self._on_open_error, path))
+        self.jobs.start(
+            "attach",
+            load_image,
+            path,
+            label=f"Opening {Path(path).name}",
+            pass_cancel=False,
+            on_done=partial(self._on_map_loaded, path),
+            on_error=partial(self._on_open_error, path),
+        )
 
     def _on_map_loaded(self, path: str, loaded) -> None:
         kind = infer_kind(Path(path).stem)
@@ -440,8 +523,10 @@ class MainWindow(QMainWindow):
         except ValueError as exc:
             self.show_message("error", str(exc))
             return
-        self.show_message("info", f"Attached {Path(path).name} as the “{name}” map ({kind}); "
-                                  "it follows every cut.")
+        self.show_message(
+            "info",
+            f"Attached {Path(path).name} as the “{name}” map ({kind}); it follows every cut.",
+        )
 
     # ------------------------------------------------------------------ drag and drop
     def dragEnterEvent(self, event) -> None:  # noqa: N802 - Qt API
@@ -482,9 +567,16 @@ class MainWindow(QMainWindow):
                 return False
             self._on_saved(path, None)
             return True
-        self.jobs.start("save", save_project, path, project, label=f"Saving {Path(path).name}",
-                        pass_cancel=False, on_done=partial(self._on_saved, path),
-                        on_error=partial(self._on_save_error, path))
+        self.jobs.start(
+            "save",
+            save_project,
+            path,
+            project,
+            label=f"Saving {Path(path).name}",
+            pass_cancel=False,
+            on_done=partial(self._on_saved, path),
+            on_error=partial(self._on_save_error, path),
+        )
         return True
 
     def _on_saved(self, path: str, _result) -> None:
@@ -515,8 +607,15 @@ class MainWindow(QMainWindow):
             return None
         target = self.recovery_file()
         target.parent.mkdir(parents=True, exist_ok=True)
-        return self.jobs.start("autosave", save_project, target, project, label="Autosaving",
-                               pass_cancel=False, on_error=self._on_autosave_error)
+        return self.jobs.start(
+            "autosave",
+            save_project,
+            target,
+            project,
+            label="Autosaving",
+            pass_cancel=False,
+            on_error=self._on_autosave_error,
+        )
 
     def _on_autosave_error(self, exc) -> None:
         self.show_message("warning", f"Autosave failed: {error_text(exc)}")
@@ -527,8 +626,11 @@ class MainWindow(QMainWindow):
             "warning",
             f"Quilt Studio did not close normally: unsaved work was recovered ({path.name}). "
             "Restore it?",
-            actions=(("Restore", partial(self.restore_recovery, path)),
-                     ("Discard", partial(self._discard_recovery, path))))
+            actions=(
+                ("Restore", partial(self.restore_recovery, path)),
+                ("Discard", partial(self._discard_recovery, path)),
+            ),
+        )
 
     def restore_recovery(self, path: Path, *_args) -> None:
         try:
@@ -553,8 +655,9 @@ class MainWindow(QMainWindow):
         from quilt_gui.widgets.export_dialog import ExportDialog
 
         if not self.doc.candidates:
-            self.show_message("warning", "Nothing to export yet: generate candidates and pick "
-                                         "the tiles to keep.")
+            self.show_message(
+                "warning", "Nothing to export yet: generate candidates and pick the tiles to keep."
+            )
             return
         dlg = getattr(self, "_export_dialog", None)
         if dlg is None:
@@ -582,8 +685,7 @@ class MainWindow(QMainWindow):
     @Slot(int)
     def reroll_candidate(self, index: int) -> None:
         if self.doc.candidates[index].locked:
-            self.show_message("warning", f"Candidate #{index + 1} is locked; unlock it to "
-                                         "re-roll.")
+            self.show_message("warning", f"Candidate #{index + 1} is locked; unlock it to re-roll.")
             return
         self.pipeline.remake_candidate(index)
 
@@ -626,12 +728,16 @@ class MainWindow(QMainWindow):
         apply_theme(QApplication.instance(), name)
 
     def show_help(self) -> None:
-        self.show_message("info", (
-            "Wheel: zoom about the cursor · drag: pan · Ctrl+0 fit · Ctrl+1 100 % · "
-            "drag the yellow rectangle or its handles, arrow keys nudge (Shift: 10 px) · "
-            "Ctrl+click an overlap (or click in the overlaps panel): waypoint, right-click "
-            "removes · gallery: click picks, Shift+click picks a range, Space, Enter opens, "
-            "L locks, R re-rolls · Esc cancels the running job."))
+        self.show_message(
+            "info",
+            (
+                "Wheel: zoom about the cursor · drag: pan · Ctrl+0 fit · Ctrl+1 100 % · "
+                "drag the yellow rectangle or its handles, arrow keys nudge (Shift: 10 px) · "
+                "Ctrl+click an overlap (or click in the overlaps panel): waypoint, right-click "
+                "removes · gallery: click picks, Shift+click picks a range, Space, Enter opens, "
+                "L locks, R re-rolls · Esc cancels the running job."
+            ),
+        )
 
     # ------------------------------------------------------------------ status
     def _on_hover(self, canvas: ImageCanvas, px) -> None:
@@ -640,8 +746,7 @@ class MainWindow(QMainWindow):
             self.pixel_label.setText("")
             return
         r, c = px
-        depth = self.doc.source.bit_depth if canvas is self.source_view and self.doc.source \
-            else 8
+        depth = self.doc.source.bit_depth if canvas is self.source_view and self.doc.source else 8
         self.pixel_label.setText(f"x {c}, y {r} = ({pixel_text(a, r, c, depth)})")
 
     @Slot(object)
@@ -690,4 +795,3 @@ class MainWindow(QMainWindow):
             dlg.close()
         event.accept()
         super().closeEvent(event)
-

@@ -38,8 +38,7 @@ class Pipeline(QObject):
     seam_updated = Signal(object)  # engine.tiles.seamless.SeamlessUpdate, live
     template_searching = Signal(bool)
 
-    def __init__(self, doc: Document, manager: jobs.JobManager | None = None,
-                 parent=None) -> None:
+    def __init__(self, doc: Document, manager: jobs.JobManager | None = None, parent=None) -> None:
         super().__init__(parent)
         self.doc = doc
         self.jobs = manager or jobs.manager()
@@ -99,6 +98,12 @@ class Pipeline(QObject):
     def stop(self, key: str) -> None:
         self.jobs.stop(key)
 
+    def busy(self) -> bool:
+        """True while a job runs or a recompute is scheduled (tests wait for False)."""
+        return bool(
+            self.jobs.running() or self._seamless_timer.isActive() or self._preview_timer.isActive()
+        )
+
     # ------------------------------------------------------------------ template search
     def find_template(self) -> jobs.Job | None:
         """Search the best tile rectangle; the rectangle animates as the search improves."""
@@ -112,10 +117,16 @@ class Pipeline(QObject):
         self._template_old_rect = doc.template_rect
         self.template_searching.emit(True)
         return self.jobs.start(
-            "template", iter_find_template, doc.source.main, label="Finding the best tile",
-            tile_min=p["tile_min"], tile_max=max(p["tile_min"], p["tile_max"]),
-            overlap=p["overlap"], on_event=self._on_template_event,
-            on_done=self._on_template_done, on_error=self._on_template_error,
+            "template",
+            iter_find_template,
+            doc.source.main,
+            label="Finding the best tile",
+            tile_min=p["tile_min"],
+            tile_max=max(p["tile_min"], p["tile_max"]),
+            overlap=p["overlap"],
+            on_event=self._on_template_event,
+            on_done=self._on_template_done,
+            on_error=self._on_template_error,
             on_cancel=self._on_template_cancel,
         )
 
@@ -130,8 +141,9 @@ class Pipeline(QObject):
         for note in template.warnings:
             self.message.emit("warning", note)
         x, y, w, h = template.rect
-        self.message.emit("info", f"Best tile: {w}x{h} at ({x}, {y}), border cost "
-                                  f"{template.cost:.4f}")
+        self.message.emit(
+            "info", f"Best tile: {w}x{h} at ({x}, {y}), border cost {template.cost:.4f}"
+        )
         self.template_searching.emit(False)
 
     def _on_template_error(self, exc) -> None:
@@ -156,16 +168,31 @@ class Pipeline(QObject):
         p = doc.params
         extra = {k: v for k, v in doc.source.maps.items() if k != doc.source.main_name}
         wps = {k: list(v) for k, v in doc.waypoints.items() if v}
-        kwargs = dict(overlap=p["overlap"], method=p["method"], metric=p["metric"],
-                      blend=p["blend"], width=p["width"], rho=p["rho"],
-                      waypoints=wps or None, maps=extra or None, **params.seam_options(p))
-        inputs = (doc.template_rect, tuple(sorted((k, repr(v)) for k, v in kwargs.items()
-                                                  if k != "maps")), tuple(extra))
+        kwargs = dict(
+            overlap=p["overlap"],
+            method=p["method"],
+            metric=p["metric"],
+            blend=p["blend"],
+            width=p["width"],
+            rho=p["rho"],
+            waypoints=wps or None,
+            maps=extra or None,
+            **params.seam_options(p),
+        )
+        inputs = (
+            doc.template_rect,
+            tuple(sorted((k, repr(v)) for k, v in kwargs.items() if k != "maps")),
+            tuple(extra),
+        )
         return (doc.source.main, doc.template_rect), kwargs, inputs
 
     @Slot()
     def schedule_seamless(self) -> None:
-        """Recompute the seamless tile soon (coalesces several edits in one event cycle)."""
+        """Recompute the seamless tile soon (coalesces several edits in one event cycle).
+
+        The running job is aborted now: its inputs are stale, so none of its events may
+        reach the views any more."""
+        self.jobs.abort("seamless")
         self._seamless_timer.start()
 
     @Slot()
@@ -183,9 +210,16 @@ class Pipeline(QObject):
         if inputs == self.seamless_inputs and self.jobs.get("seamless") is None:
             return
         self._seamless_pending = inputs
-        self.jobs.start("seamless", iter_make_seamless, *args, label="Stitching the tile",
-                        on_event=self._on_seamless_event, on_done=self._on_seamless_done,
-                        on_error=self._on_seamless_error, **kwargs)
+        self.jobs.start(
+            "seamless",
+            iter_make_seamless,
+            *args,
+            label="Stitching the tile",
+            on_event=self._on_seamless_event,
+            on_done=self._on_seamless_done,
+            on_error=self._on_seamless_error,
+            **kwargs,
+        )
 
     def _on_seamless_event(self, event) -> None:
         if hasattr(event, "which") and hasattr(event, "path_source"):
@@ -210,9 +244,17 @@ class Pipeline(QObject):
         p = self.doc.params
         extra = {k: v for k, v in self.doc.source.maps.items() if k != self.doc.source.main_name}
         return dict(
-            patch_size=p["patch_size"] or None, patch_overlap=p["patch_overlap"] or None,
-            margin=p["margin"], method=p["method"], metric=p["metric"], blend=p["blend"],
-            width=p["width"], rho=p["rho"], maps=extra or None, **params.seam_options(p))
+            patch_size=p["patch_size"] or None,
+            patch_overlap=p["patch_overlap"] or None,
+            margin=p["margin"],
+            method=p["method"],
+            metric=p["metric"],
+            blend=p["blend"],
+            width=p["width"],
+            rho=p["rho"],
+            maps=extra or None,
+            **params.seam_options(p),
+        )
 
     def _template_ready(self) -> bool:
         doc = self.doc
@@ -220,8 +262,10 @@ class Pipeline(QObject):
             self.message.emit("warning", "Open a source image first.")
             return False
         if doc.seamless is None or self.seamless_inputs is None:
-            self.message.emit("warning", "Make the seamless tile first: draw the tile rectangle "
-                                         "or use Find best tile.")
+            self.message.emit(
+                "warning",
+                "Make the seamless tile first: draw the tile rectangle or use Find best tile.",
+            )
             return False
         return True
 
@@ -230,10 +274,14 @@ class Pipeline(QObject):
         maps = {self.doc.source.main_name: c.tile, **dict(c.maps)}
         loop_len = max(1, len(c.loop))
         return CandidateEntry(
-            maps=maps, patch_origin=tuple(int(v) for v in c.patch_origin),
-            patch_rect=tuple(int(v) for v in c.patch_rect), seed=c.seed,
-            score=float(c.scores["criterion"]) / loop_len, scores=dict(c.scores),
-            loop=np.asarray(c.loop))
+            maps=maps,
+            patch_origin=tuple(int(v) for v in c.patch_origin),
+            patch_rect=tuple(int(v) for v in c.patch_rect),
+            seed=c.seed,
+            score=float(c.scores["criterion"]) / loop_len,
+            scores=dict(c.scores),
+            loop=np.asarray(c.loop),
+        )
 
     def generate_candidates(self) -> jobs.Job | None:
         """Stream ``n_candidates`` new variants into the document (locked ones are kept)."""
@@ -255,8 +303,11 @@ class Pipeline(QObject):
                 keep_picks.append((doc.picks.index(i), len(keep)))
             keep.append(e)
         if dropped:
-            self.message.emit("warning", f"{dropped} locked candidate(s) were made from another "
-                                         "template and do not connect to this one; dropped.")
+            self.message.emit(
+                "warning",
+                f"{dropped} locked candidate(s) were made from another "
+                "template and do not connect to this one; dropped.",
+            )
         self.jobs.abort_matching("candidate:")
         self._gen_old = (list(doc.candidates), list(doc.picks))
         doc.apply_candidates(keep, [k for _, k in sorted(keep_picks)])
@@ -265,11 +316,20 @@ class Pipeline(QObject):
             self._on_candidates_done([])
             return None
         return self.jobs.start(
-            "candidates", iter_candidates, doc.source.main, doc.seamless, n,
-            label=f"Generating {n} candidates", rng=int(doc.params["seed"]),
-            neighbourhood=doc.params["neighbourhood"], workers=2,
-            on_event=self._on_candidate_event, on_done=self._on_candidates_done,
-            on_error=self._on_candidates_error, **self._tile_options())
+            "candidates",
+            iter_candidates,
+            doc.source.main,
+            doc.seamless,
+            n,
+            label=f"Generating {n} candidates",
+            rng=int(doc.params["seed"]),
+            neighbourhood=doc.params["neighbourhood"],
+            workers=2,
+            on_event=self._on_candidate_event,
+            on_done=self._on_candidates_done,
+            on_error=self._on_candidates_error,
+            **self._tile_options(),
+        )
 
     def _on_candidate_event(self, event) -> None:
         if hasattr(event, "tile") and hasattr(event, "patch_rect"):
@@ -277,10 +337,18 @@ class Pipeline(QObject):
 
     def _on_candidates_done(self, _result) -> None:
         doc = self.doc
-        doc.set_candidates(list(doc.candidates), list(doc.picks), text="Generate candidates",
-                           old=self._gen_old, already_applied=True)
-        self.message.emit("info", f"{len(doc.candidates)} candidates. Click to pick the tiles "
-                                  "to keep; double-click to open one.")
+        doc.set_candidates(
+            list(doc.candidates),
+            list(doc.picks),
+            text="Generate candidates",
+            old=self._gen_old,
+            already_applied=True,
+        )
+        self.message.emit(
+            "info",
+            f"{len(doc.candidates)} candidates. Click to pick the tiles "
+            "to keep; double-click to open one.",
+        )
 
     def _on_candidates_error(self, exc) -> None:
         self._on_candidates_done(None)
@@ -295,16 +363,26 @@ class Pipeline(QObject):
         doc = self.doc
         kw = self._tile_options()
         if origin is None:
-            kw.update(rng=int(np.random.default_rng().integers(2**31)),
-                      neighbourhood=doc.params["neighbourhood"])
+            kw.update(
+                rng=int(np.random.default_rng().integers(2**31)),
+                neighbourhood=doc.params["neighbourhood"],
+            )
             text = f"Re-roll candidate #{index + 1}"
         else:
             kw.update(patch_origin=(int(origin[0]), int(origin[1])))
             text = f"Move patch of candidate #{index + 1}"
         self._remake_text = text
         return self.jobs.start(
-            f"candidate:{index}", make_candidate, doc.source.main, doc.seamless, index=index,
-            label=text, on_done=self._on_remade, on_error=self._on_remake_error, **kw)
+            f"candidate:{index}",
+            make_candidate,
+            doc.source.main,
+            doc.seamless,
+            index=index,
+            label=text,
+            on_done=self._on_remade,
+            on_error=self._on_remake_error,
+            **kw,
+        )
 
     def _on_remade(self, c) -> None:
         index = int(c.index)
@@ -320,6 +398,7 @@ class Pipeline(QObject):
     # ------------------------------------------------------------------ preview
     @Slot()
     def schedule_preview(self) -> None:
+        self.jobs.abort("preview")
         self._preview_timer.start()
 
     @Slot()
@@ -334,10 +413,20 @@ class Pipeline(QObject):
             return
         p = doc.params
         weights = [e.weight for e in doc.picked_entries()]
-        self.jobs.start("preview", make_preview, tiles, doc.source.main, label="Preview",
-                        rows=p["preview_rows"], cols=p["preview_cols"], seed=p["layout_seed"],
-                        no_equal_neighbours=p["no_equal_neighbours"], weights=weights,
-                        on_done=self._on_preview_done, on_error=self._error)
+        self.jobs.start(
+            "preview",
+            make_preview,
+            tiles,
+            doc.source.main,
+            label="Preview",
+            rows=p["preview_rows"],
+            cols=p["preview_cols"],
+            seed=p["layout_seed"],
+            no_equal_neighbours=p["no_equal_neighbours"],
+            weights=weights,
+            on_done=self._on_preview_done,
+            on_error=self._error,
+        )
 
     def _on_preview_done(self, result) -> None:
         layout, image, score = result
@@ -358,8 +447,9 @@ def make_preview(tiles, source, *, rows, cols, seed, no_equal_neighbours, weight
     n = len(tiles)
     if n < 2 or sum(w > 0 for w in weights) < 2:
         no_equal_neighbours = False
-    layout = random_layout(n, rows, cols, rng=seed, no_equal_neighbours=no_equal_neighbours,
-                           weights=weights)
+    layout = random_layout(
+        n, rows, cols, rng=seed, no_equal_neighbours=no_equal_neighbours, weights=weights
+    )
     image = assemble(tiles, layout)
     th, tw = tiles[0].shape[:2]
     score = None
@@ -370,5 +460,9 @@ def make_preview(tiles, source, *, rows, cols, seed, no_equal_neighbours, weight
 
 def _same_border(a: np.ndarray, b: np.ndarray, m: int) -> bool:
     """True when the outer ``m`` pixels of two tiles are equal (they connect)."""
-    return bool(np.array_equal(a[:m], b[:m]) and np.array_equal(a[-m:], b[-m:])
-                and np.array_equal(a[:, :m], b[:, :m]) and np.array_equal(a[:, -m:], b[:, -m:]))
+    return bool(
+        np.array_equal(a[:m], b[:m])
+        and np.array_equal(a[-m:], b[-m:])
+        and np.array_equal(a[:, :m], b[:, :m])
+        and np.array_equal(a[:, -m:], b[:, -m:])
+    )

@@ -69,8 +69,10 @@ class CandidateDialog(QDialog):
         lines += [f"{k}: {v:.4g}" for k, v in e.scores.items() if isinstance(v, float)]
         if e.patch_rect is not None:
             x, y, w, h = e.patch_rect
-            lines.append(f"Patch source: {w}×{h} at ({x}, {y}) — the orange rectangle on the "
-                         "source; drag it to rebuild this candidate from another place.")
+            lines.append(
+                f"Patch source: {w}×{h} at ({x}, {y}) — the orange rectangle on the "
+                "source; drag it to rebuild this candidate from another place."
+            )
         if e.seed is not None:
             lines.append(f"Seed {e.seed}")
         self.info.setText("<br>".join(lines))
@@ -78,8 +80,7 @@ class CandidateDialog(QDialog):
 
     @Slot()
     def _place_loop(self, *_args) -> None:
-        e = self.doc.candidates[self.index] if 0 <= self.index < len(self.doc.candidates) \
-            else None
+        e = self.doc.candidates[self.index] if 0 <= self.index < len(self.doc.candidates) else None
         if e is None or e.loop is None or self.view.tile is None:
             self.loop_item.hide()
             return

@@ -52,8 +52,10 @@ class ExportDialog(QDialog):
         self.jobs = manager
         self.manifest: dict | None = None
         self.folder = QLineEdit()
-        self.folder.setToolTip("The bundle is written into this folder (created; it must be "
-                               "empty unless Overwrite is on)")
+        self.folder.setToolTip(
+            "The bundle is written into this folder (created; it must be "
+            "empty unless Overwrite is on)"
+        )
         browse = QPushButton("Browse…")
         browse.clicked.connect(self._browse)
         row = QHBoxLayout()
@@ -67,8 +69,13 @@ class ExportDialog(QDialog):
         self.columns = _spin(0, 256, 0, "Tiles per atlas row (0 = about square)", "auto")
         self.spacing = _spin(0, 64, 0, "Pixels between atlas tiles")
         self.margin = _spin(0, 64, 0, "Pixels around the atlas")
-        self.extrude = _spin(0, 16, 0, "Repeat each tile's edge pixels this many times around "
-                                       "it (stops bleeding between atlas tiles)")
+        self.extrude = _spin(
+            0,
+            16,
+            0,
+            "Repeat each tile's edge pixels this many times around "
+            "it (stops bleeding between atlas tiles)",
+        )
         self.bit_depth = QComboBox()
         self.bit_depth.addItems(["Same as the source", "8 bit", "16 bit"])
         self.bit_depth.setToolTip("Bits per channel of the written images")
@@ -98,8 +105,9 @@ class ExportDialog(QDialog):
         form.addRow("Normal maps", self.normal)
         form.addRow("", self.overwrite)
         self.buttons = QDialogButtonBox()
-        self.export_button = self.buttons.addButton("Export",
-                                                    QDialogButtonBox.ButtonRole.AcceptRole)
+        self.export_button = self.buttons.addButton(
+            "Export", QDialogButtonBox.ButtonRole.AcceptRole
+        )
         self.buttons.addButton(QDialogButtonBox.StandardButton.Close)
         self.buttons.accepted.connect(self.export)
         self.buttons.rejected.connect(self.close)
@@ -123,11 +131,15 @@ class ExportDialog(QDialog):
         if doc.candidates:
             h, w = doc.candidates[0].tile.shape[:2]
             size = f", {w}×{h} px"
-        lay = "" if doc.layout is None else f", preview layout {doc.layout.shape[0]}×" \
-                                            f"{doc.layout.shape[1]}"
+        lay = (
+            ""
+            if doc.layout is None
+            else f", preview layout {doc.layout.shape[0]}×{doc.layout.shape[1]}"
+        )
         depth = doc.source.bit_depth if doc.source else 8
-        self.summary.setText(f"<b>{n}</b> tiles {what}{size}; maps: {', '.join(maps)}; "
-                             f"source {depth}-bit{lay}.")
+        self.summary.setText(
+            f"<b>{n}</b> tiles {what}{size}; maps: {', '.join(maps)}; source {depth}-bit{lay}."
+        )
         self.normal.setEnabled("normal" in (doc.source.kinds.values() if doc.source else ()))
         self.status.setText("")
 
@@ -135,11 +147,16 @@ class ExportDialog(QDialog):
         """Keyword options of :func:`engine.project.export_project` from the widgets."""
         depth = {0: None, 1: 8, 2: 16}[self.bit_depth.currentIndex()]
         return dict(
-            columns=self.columns.value() or None, spacing=self.spacing.value(),
-            margin=self.margin.value(), extrude=self.extrude.value(), bit_depth=depth,
+            columns=self.columns.value() or None,
+            spacing=self.spacing.value(),
+            margin=self.margin.value(),
+            extrude=self.extrude.value(),
+            bit_depth=depth,
             dither=self.dither.isChecked() if depth == 8 else None,
-            tile_format=self.tile_format.currentText(), overwrite=self.overwrite.isChecked(),
-            normal_convention=self.normal.currentText())
+            tile_format=self.tile_format.currentText(),
+            overwrite=self.overwrite.isChecked(),
+            normal_convention=self.normal.currentText(),
+        )
 
     @Slot()
     def _browse(self) -> None:
@@ -163,9 +180,17 @@ class ExportDialog(QDialog):
         self.export_button.setEnabled(False)
         self.status.setText("Exporting…")
         self._folder = folder
-        return self.jobs.start("export", export_project, project, folder, label="Exporting",
-                               pass_cancel=False, on_done=self._on_done,
-                               on_error=self._on_error, **self.options())
+        return self.jobs.start(
+            "export",
+            export_project,
+            project,
+            folder,
+            label="Exporting",
+            pass_cancel=False,
+            on_done=self._on_done,
+            on_error=self._on_error,
+            **self.options(),
+        )
 
     def _on_done(self, manifest: dict) -> None:
         self.manifest = manifest

@@ -90,16 +90,22 @@ class CandidateModel(QAbstractListModel):
     def flags(self, index):
         if not index.isValid():
             return Qt.ItemFlag.NoItemFlags
-        return Qt.ItemFlag.ItemIsEnabled | Qt.ItemFlag.ItemIsSelectable | \
-            Qt.ItemFlag.ItemNeverHasChildren
+        return (
+            Qt.ItemFlag.ItemIsEnabled
+            | Qt.ItemFlag.ItemIsSelectable
+            | Qt.ItemFlag.ItemNeverHasChildren
+        )
 
     def thumbnail(self, entry: CandidateEntry) -> QPixmap:
         key = id(entry)
         pm = self._thumbs.get(key)
         if pm is None:
             img = to_qimage(entry.tile).scaled(
-                self.thumb, self.thumb, Qt.AspectRatioMode.KeepAspectRatio,
-                Qt.TransformationMode.SmoothTransformation)
+                self.thumb,
+                self.thumb,
+                Qt.AspectRatioMode.KeepAspectRatio,
+                Qt.TransformationMode.SmoothTransformation,
+            )
             pm = QPixmap.fromImage(img)
             self._thumbs[key] = pm
         return pm
@@ -209,9 +215,11 @@ class CandidateView(QListView):
         self.selectionModel().currentChanged.connect(self._on_current)
         self._anchor: int | None = None
         self.setToolTip("")
-        self.setWhatsThis("Click: pick / unpick · Shift+click: pick a range · Space: pick the "
-                          "current tile · Ctrl+A: pick all · Enter or double-click: open large · "
-                          "L: lock · R: re-roll")
+        self.setWhatsThis(
+            "Click: pick / unpick · Shift+click: pick a range · Space: pick the "
+            "current tile · Ctrl+A: pick all · Enter or double-click: open large · "
+            "L: lock · R: re-roll"
+        )
 
     def current_row(self) -> int:
         ix = self.currentIndex()
@@ -310,4 +318,3 @@ class CandidateView(QListView):
             a.setChecked(abs(entry.weight - w) < 1e-9)
             a.triggered.connect(partial(self._set_weight, row, w))
         menu.popup(self.viewport().mapToGlobal(pos))
-

@@ -57,8 +57,10 @@ class OverlapView(ImageCanvas):
         self.labels: list[QGraphicsSimpleTextItem] = []
         self.waypoints: list[tuple[int, int]] = []
         self._wp_items: list[WaypointItem] = []
-        self.setToolTip("Click: add a waypoint the seam must pass through\n"
-                        "Right-click: remove the nearest waypoint")
+        self.setToolTip(
+            "Click: add a waypoint the seam must pass through\n"
+            "Right-click: remove the nearest waypoint"
+        )
 
     def show_overlap(self, r1, r2, error, *, stacked: bool, names=("R1", "R2", "error")) -> None:
         """Show the regions and the error map; ``stacked`` puts them one above the other."""
@@ -72,7 +74,7 @@ class OverlapView(ImageCanvas):
             canvas = np.zeros((h, 3 * w + 2 * GAP, 4), np.uint8)
             self.offsets = [(i * (w + GAP), 0) for i in range(3)]
         for (ox, oy), p in zip(self.offsets, panels, strict=True):
-            canvas[oy:oy + h, ox:ox + w] = p
+            canvas[oy : oy + h, ox : ox + w] = p
         refit = self.frame_shape != (h, w)
         self.frame_shape = (h, w)
         self.set_image(canvas, fit=refit)
@@ -169,14 +171,18 @@ class OverlapPanel(QWidget):
     def __init__(self, doc: Document, pipeline: Pipeline, parent=None) -> None:
         super().__init__(parent)
         self.doc = doc
-        self.views = {"horizontal": OverlapView(SEAM_COLORS["horizontal"]),
-                      "vertical": OverlapView(SEAM_COLORS["vertical"])}
+        self.views = {
+            "horizontal": OverlapView(SEAM_COLORS["horizontal"]),
+            "vertical": OverlapView(SEAM_COLORS["vertical"]),
+        }
         self.labels = {k: QLabel() for k in self.views}
         lay = QVBoxLayout(self)
         lay.setContentsMargins(4, 4, 4, 4)
         split = QSplitter(Qt.Orientation.Vertical)
-        for which, title in (("horizontal", "Left / right overlap (R_R over R_L)"),
-                             ("vertical", "Top / bottom overlap (R_B over R_T)")):
+        for which, title in (
+            ("horizontal", "Left / right overlap (R_R over R_L)"),
+            ("vertical", "Top / bottom overlap (R_B over R_T)"),
+        ):
             box = QWidget()
             bl = QVBoxLayout(box)
             bl.setContentsMargins(0, 0, 0, 0)
@@ -225,15 +231,18 @@ class OverlapPanel(QWidget):
                 self.labels[which].setText("No tile yet: draw a rectangle or Find best tile.")
             return
         reg = s.regions
-        self.views["horizontal"].show_overlap(reg["R_R"], reg["R_L"], s.errors["horizontal"],
-                                              stacked=False, names=("R_R", "R_L", "E"))
-        self.views["vertical"].show_overlap(reg["R_B"], reg["R_T"], s.errors["vertical"],
-                                            stacked=True, names=("R_B", "R_T", "E"))
+        self.views["horizontal"].show_overlap(
+            reg["R_R"], reg["R_L"], s.errors["horizontal"], stacked=False, names=("R_R", "R_L", "E")
+        )
+        self.views["vertical"].show_overlap(
+            reg["R_B"], reg["R_T"], s.errors["vertical"], stacked=True, names=("R_B", "R_T", "E")
+        )
         for which, v in self.views.items():
             v.set_path(s.paths[which])
             self.labels[which].setText(
                 f"seam criterion {s.criterion[which]:.3f}   peak {s.peak[which]:.3f}   "
-                f"({s.seams[which].method})")
+                f"({s.seams[which].method})"
+            )
         self._on_waypoints_changed()
 
     @Slot(object)
@@ -247,7 +256,8 @@ class OverlapPanel(QWidget):
             return  # a different rectangle: wait for its result
         v.set_path(path)
         self.labels[update.which].setText(
-            f"searching... criterion {update.seam.criterion:.3f}   peak {update.seam.peak:.3f}")
+            f"searching... criterion {update.seam.criterion:.3f}   peak {update.seam.peak:.3f}"
+        )
 
     @Slot()
     def _on_waypoints_changed(self) -> None:

@@ -32,8 +32,9 @@ from quilt_gui.commands import new_merge_id
 from quilt_gui.document import Document
 
 #: Integer parameters edited with a slider (the rest use spin boxes).
-SLIDERS = frozenset({"overlap", "o_max", "max_run", "width", "rho", "margin", "neighbourhood",
-                     "iterations"})
+SLIDERS = frozenset(
+    {"overlap", "o_max", "max_run", "width", "rho", "margin", "neighbourhood", "iterations"}
+)
 TILESET_GROUPS = ("Template", "Seam", "Candidates", "Preview")
 QUILT_GROUPS = ("Quilting", "Transfer")
 
@@ -41,8 +42,7 @@ QUILT_GROUPS = ("Quilting", "Transfer")
 class ParamsPanel(QScrollArea):
     """Group boxes of parameter widgets plus the actions of each step."""
 
-    def __init__(self, doc: Document, actions: dict[str, list] | None = None,
-                 parent=None) -> None:
+    def __init__(self, doc: Document, actions: dict[str, list] | None = None, parent=None) -> None:
         super().__init__(parent)
         self.doc = doc
         self.widgets: dict[str, QWidget] = {}

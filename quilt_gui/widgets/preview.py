@@ -41,8 +41,10 @@ class PreviewView(QWidget):
         self.grid_box.toggled.connect(self.set_grid)
         bar.addWidget(self.grid_box)
         self.info = QLabel()
-        self.info.setToolTip("Grid score: autocorrelation at one tile period minus the source's "
-                             "own (0 = no visible grid; one tile repeated scores about 1).")
+        self.info.setToolTip(
+            "Grid score: autocorrelation at one tile period minus the source's "
+            "own (0 = no visible grid; one tile repeated scores about 1)."
+        )
         bar.addWidget(self.info, 1)
         lay = QVBoxLayout(self)
         lay.setContentsMargins(0, 0, 0, 0)
@@ -74,8 +76,9 @@ class PreviewView(QWidget):
             score = self.doc.grid_score
             s = "n/a" if score is None else f"{score:.3f}"
             rows, cols = lay.shape if lay is not None else (0, 0)
-            self.info.setText(f"grid score {s} · {rows}×{cols} cells from {n} picked tile"
-                              f"{'s' if n != 1 else ''}")
+            self.info.setText(
+                f"grid score {s} · {rows}×{cols} cells from {n} picked tile{'s' if n != 1 else ''}"
+            )
         self._draw_grid()
 
     def _draw_grid(self) -> None:

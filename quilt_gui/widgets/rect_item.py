@@ -22,8 +22,9 @@ class EditableRect(QGraphicsObject):
     edited = Signal(object, int)
     drag_finished = Signal()
 
-    def __init__(self, color="#ffd23f", *, min_size: int = 4, resizable: bool = True,
-                 parent=None) -> None:
+    def __init__(
+        self, color="#ffd23f", *, min_size: int = 4, resizable: bool = True, parent=None
+    ) -> None:
         super().__init__(parent)
         self._rect = (0, 0, 1, 1)
         self._color = QColor(color)
@@ -109,7 +110,7 @@ class EditableRect(QGraphicsObject):
 
     # ------------------------------------------------------------------ interaction
     def hit(self, pos: QPointF) -> str | None:
-        """"move", a handle name ("tl", "cr", ...) or None."""
+        """ "move", a handle name ("tl", "cr", ...) or None."""
         for name, hr in self._handles().items():
             if hr.contains(pos):
                 return name
@@ -121,10 +122,14 @@ class EditableRect(QGraphicsObject):
         mode = self.hit(event.pos())
         cursors = {
             "move": Qt.CursorShape.SizeAllCursor,
-            "tl": Qt.CursorShape.SizeFDiagCursor, "br": Qt.CursorShape.SizeFDiagCursor,
-            "tr": Qt.CursorShape.SizeBDiagCursor, "bl": Qt.CursorShape.SizeBDiagCursor,
-            "tc": Qt.CursorShape.SizeVerCursor, "bc": Qt.CursorShape.SizeVerCursor,
-            "cl": Qt.CursorShape.SizeHorCursor, "cr": Qt.CursorShape.SizeHorCursor,
+            "tl": Qt.CursorShape.SizeFDiagCursor,
+            "br": Qt.CursorShape.SizeFDiagCursor,
+            "tr": Qt.CursorShape.SizeBDiagCursor,
+            "bl": Qt.CursorShape.SizeBDiagCursor,
+            "tc": Qt.CursorShape.SizeVerCursor,
+            "bc": Qt.CursorShape.SizeVerCursor,
+            "cl": Qt.CursorShape.SizeHorCursor,
+            "cr": Qt.CursorShape.SizeHorCursor,
         }
         if mode in cursors:
             self.setCursor(cursors[mode])
@@ -183,4 +188,3 @@ class EditableRect(QGraphicsObject):
         w, h = max(self.min_size, min(w, W - e)), max(self.min_size, min(h, H - e))
         x, y = min(max(0, x), W - e - w), min(max(0, y), H - e - h)
         return x, y, w, h
-

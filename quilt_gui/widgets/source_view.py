@@ -132,8 +132,11 @@ class SourceView(ImageCanvas):
 
     def seamless_is_current(self) -> bool:
         s = self.doc.seamless
-        return (s is not None and tuple(s.rect) == self.doc.template_rect
-                and s.overlap == self.doc.params["overlap"])
+        return (
+            s is not None
+            and tuple(s.rect) == self.doc.template_rect
+            and s.overlap == self.doc.params["overlap"]
+        )
 
     @Slot()
     def _on_seamless_changed(self) -> None:
@@ -220,12 +223,17 @@ class SourceView(ImageCanvas):
         if rect is None:
             return
         x, y, w, h = rect
-        self.doc.set_template_rect((x + dx, y + dy, w, h), merge_id=merge_id,
-                                   text="Nudge tile rectangle")
+        self.doc.set_template_rect(
+            (x + dx, y + dy, w, h), merge_id=merge_id, text="Nudge tile rectangle"
+        )
 
     def keyPressEvent(self, event) -> None:  # noqa: N802 - Qt API
-        steps = {Qt.Key.Key_Left: (-1, 0), Qt.Key.Key_Right: (1, 0), Qt.Key.Key_Up: (0, -1),
-                 Qt.Key.Key_Down: (0, 1)}
+        steps = {
+            Qt.Key.Key_Left: (-1, 0),
+            Qt.Key.Key_Right: (1, 0),
+            Qt.Key.Key_Up: (0, -1),
+            Qt.Key.Key_Down: (0, 1),
+        }
         if event.key() in steps and self.doc.template_rect is not None:
             dx, dy = steps[event.key()]
             n = 10 if event.modifiers() & Qt.KeyboardModifier.ShiftModifier else 1
@@ -277,4 +285,3 @@ def nearest_waypoint(points, pt, radius: float = 3.0):
         if d <= dist:
             best, dist = p, d
     return best
-

@@ -79,6 +79,10 @@ class MessageBar(QWidget):
         else:
             self._timer.stop()
 
+    def waiting_for_answer(self) -> bool:
+        """True while a message with action buttons is shown (info must not replace it)."""
+        return self.isVisibleTo(self.parentWidget()) and self._actions.count() > 0
+
     @Slot()
     def dismiss(self) -> None:
         self._timer.stop()

@@ -82,7 +82,7 @@ class TiledImageView(QWidget):
         self._redraw_lines()
 
     def set_tile(self, tile: np.ndarray | None) -> None:
-        refit = (self.tile is None or tile is None or self.tile.shape != tile.shape)
+        refit = self.tile is None or tile is None or self.tile.shape != tile.shape
         self.tile = tile
         self._redraw(fit=refit)
 
@@ -121,9 +121,11 @@ class TileView(TiledImageView):
         super().__init__(parent)
         self.doc = doc
         self.metrics: dict | None = None
-        self.info.setToolTip("Wrap border ratio: joint across the tile's wrap vs. the texture "
-                             "itself (1.0 = invisible).\nDetail ratio: Laplacian variance of the "
-                             "tile vs. the source (below 0.95 means blur).")
+        self.info.setToolTip(
+            "Wrap border ratio: joint across the tile's wrap vs. the texture "
+            "itself (1.0 = invisible).\nDetail ratio: Laplacian variance of the "
+            "tile vs. the source (below 0.95 means blur)."
+        )
         doc.seamless_changed.connect(self._on_seamless_changed)
         self._on_seamless_changed()
 
@@ -137,11 +139,18 @@ class TileView(TiledImageView):
             return
         h, w = s.tile.shape[:2]
         self.info.setText(f"{w}×{h} tile — measuring...")
-        jobs.start("tile_metrics", tile_metrics, np.asarray(s.tile), self.doc.source.main,
-                   label="Measuring the tile", on_done=self._on_metrics)
+        jobs.start(
+            "tile_metrics",
+            tile_metrics,
+            np.asarray(s.tile),
+            self.doc.source.main,
+            label="Measuring the tile",
+            on_done=self._on_metrics,
+        )
 
     def _on_metrics(self, m: dict) -> None:
         self.metrics = m
         h, w = self.tile.shape[:2] if self.tile is not None else (0, 0)
-        self.info.setText(f"{w}×{h} tile — wrap border ratio {m['wrap']:.2f} · "
-                          f"detail ratio {m['detail']:.2f}")
+        self.info.setText(
+            f"{w}×{h} tile — wrap border ratio {m['wrap']:.2f} · detail ratio {m['detail']:.2f}"
+        )

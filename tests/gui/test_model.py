@@ -83,8 +83,9 @@ def test_rect_drag_merges_and_is_clamped():
     mid = new_merge_id()
     doc.set_template_rect((0, 0, 30, 30), merge_id=mid)
     doc.set_template_rect((5, 5, 30, 30), merge_id=mid)
-    doc.set_template_rect((500, -3, 30, 30))  # clamped into the 80x64 source
-    assert doc.template_rect == (50, 0, 30, 30)
+    doc.set_template_rect((500, -3, 30, 30))  # footprint (rect + overlap) clamped into 80x64
+    ov = doc.params["overlap"]
+    assert doc.template_rect == (80 - ov - 30, 0, 30, 30)
     assert doc.undo_stack.count() == 2
     doc.undo_stack.undo()
     assert doc.template_rect == (5, 5, 30, 30)

@@ -1,15 +1,24 @@
-from quilt_gui.main_window import MainWindow
+import subprocess
+import sys
+
 from resources import SAMPLE_NAMES, sample_path
+from tests.gui.helpers import make_window, open_sample
 
 
 def test_main_window_shows_bundled_sample(qtbot):
-    w = MainWindow()
-    qtbot.addWidget(w)
-    w.open_initial(None)
-    assert w.image is not None
-    assert w.image.pixels.shape[:2] == (512, 512)
+    w = make_window(qtbot)
+    open_sample(qtbot, w)
+    assert w.doc.source.shape == (512, 512)
+    assert w.windowTitle().startswith("cobblestones")
 
 
 def test_samples_exist():
     for name in SAMPLE_NAMES:
         assert sample_path(name).is_file()
+
+
+def test_entry_point_sends_subcommands_to_the_cli():
+    out = subprocess.run(
+        [sys.executable, "-m", "quilt_gui", "--help"], capture_output=True, text=True, timeout=60
+    )
+    assert out.returncode == 0 and "SUBCOMMAND" in out.stdout

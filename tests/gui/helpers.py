@@ -1,0 +1,41 @@
+"""Shared helpers of the GUI tests."""
+
+from __future__ import annotations
+
+from PySide6.QtCore import QPoint, Qt
+
+from quilt_gui.main_window import MainWindow
+
+
+def wait_idle(qtbot, window: MainWindow, timeout: int = 20_000) -> None:
+    """Wait until no job runs and no recompute is scheduled."""
+    qtbot.waitUntil(lambda: not window.pipeline.busy(), timeout=timeout)
+
+
+def open_sample(qtbot, window: MainWindow, name: str | None = None) -> None:
+    from resources import sample_path
+
+    with qtbot.waitSignal(window.doc.source_changed, timeout=10_000):
+        if name is None:
+            window.open_initial(None)
+        else:
+            window.open_path(str(sample_path(name)), confirm=False)
+    wait_idle(qtbot, window)
+
+
+def click_candidate(qtbot, window: MainWindow, row: int, modifier=Qt.KeyboardModifier.NoModifier):
+    view = window.gallery
+    ix = view.model().index(row, 0)
+    view.scrollTo(ix)
+    pos: QPoint = view.visualRect(ix).center()
+    qtbot.mouseClick(view.viewport(), Qt.MouseButton.LeftButton, modifier, pos)
+
+
+def make_window(qtbot) -> MainWindow:
+    w = MainWindow()
+    qtbot.addWidget(w)
+    w.ask_save_changes = lambda: "discard"  # never a modal dialog in tests
+    w.resize(1400, 900)
+    w.show()
+    qtbot.waitExposed(w)
+    return w
