@@ -1042,7 +1042,7 @@ def _check_options(
         if not (math.isfinite(adaptive_threshold) and adaptive_threshold > 0):
             raise ValueError(f"adaptive_threshold must be > 0, got {adaptive_threshold}")
     if min_block is None:
-        min_block = max(overlap + 2, min(bh, bw) // 4)
+        min_block = max(2 * overlap + 1, min(bh, bw) // 4)
     min_block = positive_int(min_block, "min_block")
     if min_block <= overlap:
         raise ValueError(f"min_block must be larger than the overlap ({overlap}), got {min_block}")
