@@ -7,17 +7,26 @@ from collections.abc import Callable, Sequence
 
 
 def median_time(
-    fn: Callable[[], object], *, min_time: float = 0.2, min_repeats: int = 3, max_repeats: int = 50
+    fn: Callable[[], object],
+    *,
+    min_time: float = 0.2,
+    min_repeats: int = 3,
+    max_repeats: int = 50,
+    max_time: float = 20.0,
 ) -> tuple[float, object]:
     """Median wall time of ``fn()`` in seconds over repeats, and the last result.
 
-    Repeats until ``min_time`` seconds were spent and at least ``min_repeats`` runs were made
-    (at most ``max_repeats``); a call slower than ``min_time`` runs ``min_repeats`` times.
+    Repeats until ``min_time`` seconds were spent and at least ``min_repeats`` runs were made,
+    but at most ``max_repeats`` runs and no new run once ``max_time`` seconds were spent.
     """
     times = []
     result = None
     spent = 0.0
-    while len(times) < max_repeats and (len(times) < min_repeats or spent < min_time):
+    while (
+        len(times) < max_repeats
+        and (len(times) < min_repeats or spent < min_time)
+        and (not times or spent < max_time)
+    ):
         t0 = time.perf_counter()
         result = fn()
         dt = time.perf_counter() - t0

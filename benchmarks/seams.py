@@ -96,7 +96,8 @@ def sample_map(h: int, w: int, name: str, seed: int = 0) -> np.ndarray:
 
 def first_path_time(error: np.ndarray, **options) -> float:
     def first():
-        return next(iter_find_seam(error, method="oscillating", **options))
+        seam = next(iter_find_seam(error, method="oscillating", **options)).seam
+        return seam.path, seam.mask  # built, as a viewer would draw it
 
     return median_time(first, min_time=0.05, min_repeats=5)[0]
 

@@ -241,7 +241,7 @@ def _solve(e, method, pins, cyclic, opts, cancel) -> Seam:
         return dp_seam(e, *_intervals(pins, w), cyclic=cyclic)
     if method == "oscillating-optimal":
         c = optimal_controls(e, *_intervals(pins, w), cyclic=cyclic)
-        return controls_seam(e, c, cyclic, method)
+        return controls_seam(e, c, cyclic, method, lazy=False)
     if method == "resistance":
         path = resistance_path(e, pins, max_run=opts["max_run"], image=opts["image"])
         return make_seam(e, path, method)
@@ -256,15 +256,12 @@ def _iter_single(e, method, pins, cyclic, opts, cancel):
 
 
 def _iter_anytime(e, pins, cyclic, opts, cancel):
-    e = e.copy()  # streamed seams are built lazily from it: keep a private copy
     best = None
-    for seam in iter_oscillating(
+    for best in iter_oscillating(
         e, pins, o_max=opts["o_max"], variant=opts["variant"], cyclic=cyclic, cancel=cancel
     ):
-        if best is not None:
-            yield SeamUpdate(best, final=False)
-        best = seam
-    yield SeamUpdate(best, final=True)
+        yield SeamUpdate(best, final=False)
+    yield SeamUpdate(best, final=True)  # the search ended (converged or cancelled)
     return best
 
 
@@ -304,8 +301,8 @@ def iter_find_seam(
     Yields
     ------
     SeamUpdate
-        ``oscillating``: the initial (per-row argmin) path and every improvement, the last one
-        with ``final=True``; other methods: one final update.
+        ``oscillating``: the initial (per-row argmin) path and every improvement as they come,
+        then the best one again with ``final=True``; other methods: one final update.
     """
     e = np.ascontiguousarray(as_error_map(error))
     if not e.flags.writeable:  # numba compiles read-only arrays separately: avoid a recompile
@@ -322,7 +319,8 @@ def iter_find_seam(
             f"(use one of {', '.join(CYCLIC_METHODS)})"
         )
     if method == "oscillating":
-        return _iter_anytime(e, pins, cyclic, opts, cancel)
+        # streamed seams are built lazily from the map: keep a private copy
+        return _iter_anytime(e.copy(), pins, cyclic, opts, cancel)
     return _iter_single(e, method, pins, cyclic, opts, cancel)
 
 
@@ -339,12 +337,11 @@ def warmup() -> None:
     rng = np.random.default_rng(0)
     e = rng.random((4, 3))
     image = rng.random((4, 3, 3))
-    for method in METHODS:
-        find_seam(e, method=method)
-        find_seam(e, method=method, start=1, end=1, waypoints=[(2, 2)])
-    for method in CYCLIC_METHODS:
-        find_seam(e, method=method, cyclic=True)
-    for variant in _MINIMAX_METRIC:
-        find_seam(e, method="minimax", variant=variant, connectivity=4)
-    find_seam(e, method="oscillating", variant="faithful")
-    find_seam(e, method="resistance", image=image)
+    runs = [dict(method=m) for m in METHODS]
+    runs += [dict(method=m, start=1, end=1, waypoints=[(2, 2)]) for m in METHODS]
+    runs += [dict(method=m, cyclic=True) for m in CYCLIC_METHODS]
+    runs += [dict(method="minimax", variant=v, connectivity=4) for v in _MINIMAX_METRIC]
+    runs += [dict(method="oscillating", variant="faithful"), dict(method="resistance", image=image)]
+    for kw in runs:
+        for update in iter_find_seam(e, **kw):
+            update.seam.mask  # noqa: B018 (lazily built seams: compile their builder too)

@@ -99,11 +99,16 @@ def _seam_arrays(error, c, cyclic):
     return path, mask, total, peak
 
 
-def controls_seam(error: np.ndarray, c: np.ndarray, cyclic: bool, method: str) -> Seam:
-    """The :class:`Seam` of control points ``c`` (complementary points included), built lazily
-    from a private copy of ``c`` (``error`` must stay unchanged, as engine inputs do)."""
+def controls_seam(
+    error: np.ndarray, c: np.ndarray, cyclic: bool, method: str, *, lazy: bool = True
+) -> Seam:
+    """The :class:`Seam` of control points ``c`` (complementary points included); a lazy one
+    is built on first use from a private copy of ``c`` (``error`` must then stay unchanged)."""
     c = np.array(c, dtype=np.int64)
-    return Seam.lazy(lambda: _seam_arrays(error, c, cyclic), method)
+    seam = Seam.lazy(lambda: _seam_arrays(error, c, cyclic), method)
+    if not lazy:
+        seam.path  # noqa: B018 (build now)
+    return seam
 
 
 def _replayed_seam(error, base, moves, k, cyclic, method) -> Seam:

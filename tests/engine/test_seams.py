@@ -50,6 +50,16 @@ def controls_of(seam: Seam) -> np.ndarray:
     return c
 
 
+def run_stream(gen):
+    """All events left in an event generator, and its return value."""
+    events = []
+    while True:
+        try:
+            events.append(next(gen))
+        except StopIteration as stop:
+            return events, stop.value
+
+
 def assert_valid(seam: Seam, error, *, one_per_row=False):
     """Path from row 0 to row h-1, 8-connected in order (or row-wise for control points),
     criterion/peak consistent, mask True on every path pixel and left of row-wise cuts."""
@@ -191,6 +201,7 @@ def test_oscillating_monotone_and_locally_optimal(variant, cyclic, o_max):
         assert all(b <= a + 1e-12 for a, b in zip(crits, crits[1:], strict=False))
         assert len(updates) > 2, "the search never improved the initial path"
         assert [u.final for u in updates] == [False] * (len(updates) - 1) + [True]
+        assert updates[-1].seam is updates[-2].seam
         # the first path is the per-row argmin
         assert np.array_equal(controls_of(updates[0].seam), np.argmin(e, axis=1))
         final = updates[-1].seam
@@ -266,12 +277,7 @@ def test_oscillating_cancel_returns_valid_path_no_worse_than_initial():
     for _ in range(5):
         next(gen)
     token.cancel()
-    rest = []
-    try:
-        while True:
-            rest.append(next(gen))
-    except StopIteration as stop:
-        result = stop.value
+    rest, result = run_stream(gen)
     assert rest and rest[-1].final and rest[-1].seam is result
     assert_valid(result, e)
     assert result.criterion <= first.seam.criterion
@@ -532,13 +538,7 @@ def test_validation_messages():
 def test_input_untouched_float32_accepted(method):
     e = smooth_map((16, 6), 0).astype(np.float32)
     before = e.copy()
-    gen = iter_find_seam(e, method=method)
-    updates = []
-    try:
-        while True:
-            updates.append(next(gen))
-    except StopIteration as stop:
-        seam = stop.value
+    updates, seam = run_stream(iter_find_seam(e, method=method))
     assert np.array_equal(e, before)
     assert isinstance(updates[-1], SeamUpdate) and updates[-1].final
     assert updates[-1].seam is seam and seam.method == method
