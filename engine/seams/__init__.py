@@ -240,7 +240,7 @@ def _solve(e, method, pins, cyclic, opts, cancel) -> Seam:
     if method == "dp":
         return dp_seam(e, *_intervals(pins, w), cyclic=cyclic)
     if method == "oscillating-optimal":
-        c = optimal_controls(e, *_intervals(pins, w), cyclic=cyclic)
+        c = optimal_controls(e, *_intervals(pins, w), cyclic=cyclic, cancel=cancel)
         return controls_seam(e, c, cyclic, method, lazy=False)
     if method == "resistance":
         path = resistance_path(e, pins, max_run=opts["max_run"], image=opts["image"])

@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from engine.cancel import is_cancelled
+from engine.cancel import check, is_cancelled
 from engine.seams._result import Seam
 
 # kernel status codes
@@ -459,67 +459,50 @@ def _chain(p, lo, hi, first_cost, last_nb, back, backf, cols, want_path):
     return best
 
 
-@njit(cache=True, nogil=True)
-def _optimal_kernel(p, lo, hi, cyclic, cols):
-    """Exact optimum (see module docstring); writes ``cols``, returns the criterion."""
-    h = p.shape[0]
-    w = p.shape[1] - 1
+def optimal_controls(
+    error: np.ndarray, lo: np.ndarray, hi: np.ndarray, *, cyclic: bool, cancel=None
+):
+    """Control points of the exact optimum (row j limited to lo[j]..hi[j]).
+
+    Cyclic maps: for every allowed c_0 = s, the chain is solved with the bound
+    ``min(c_{h-1}, c_1) >= L`` for L = s-1, s-2, ... (row 0 charged ``R_{0,s}(L)``, exact at
+    the optimal L); an s or L whose lower bound cannot beat the best so far is skipped. The
+    cancel token is checked between chains.
+    """
+    h, w = error.shape
+    if w >= 32768:
+        raise ValueError(f"method 'oscillating-optimal' needs fewer than 32768 columns, got {w}")
+    p = prefix_sums(error)
+    cols = np.zeros(h, dtype=np.int64)
     if h == 1:
-        best = np.inf
-        for b in range(lo[0], hi[0] + 1):
-            v = p[0, b + 1] - p[0, b]
-            if v < best:
-                best = v
-                cols[0] = b
-        return best
-    back = np.zeros((h, w, w), dtype=np.int16)  # w < 32768 (checked by the caller)
+        cols[0] = lo[0] + int(np.argmin(error[0, lo[0] : hi[0] + 1]))
+        return cols
+    back = np.zeros((h, w, w), dtype=np.int16)
     backf = np.zeros(w, dtype=np.int64)
-    dummy = np.zeros((1, 1, 1), dtype=back.dtype)
     if not cyclic:
-        return _chain(p, lo, hi, -1.0, -1, back, backf, cols, True)
-    lo2 = lo.copy()
-    best = np.inf
-    best_s = -1
-    best_l = -1
+        _chain(p, lo, hi, -1.0, -1, back, backf, cols, True)
+        return cols
+    no_back = np.zeros((1, 1, 1), dtype=np.int16)
+    best, best_s, best_l = np.inf, -1, -1
+
+    def bounded(s, low):
+        lo2, hi2 = lo.copy(), hi.copy()
+        lo2[0] = hi2[0] = s
+        if low >= 0:
+            lo2[1] = max(lo[1], low)
+            lo2[h - 1] = max(lo[h - 1], low)
+        return lo2, hi2
+
     for s in range(lo[0], hi[0] + 1):
-        lo2[0] = s
-        hi_s = hi.copy()
-        hi_s[0] = s
-        # lower bound for this s: row 0 at its cheapest (E[0, s]) and no bound on c_1, c_{h-1}
-        lo2[1] = lo[1]
-        lo2[h - 1] = lo[h - 1]
-        e0 = p[0, s + 1] - p[0, s]
-        base = _chain(p, lo2, hi_s, 0.0, s, dummy, backf, cols, False)
-        if e0 + base >= best:
-            continue
-        for L in range(max(s - 1, 0), -1, -1):
-            r0 = p[0, s + 1] - p[0, min(s, L + 1)]
+        check(cancel)
+        # lower bound: row 0 at its cheapest (E[0, s]) and no bound on c_1, c_{h-1}
+        base = _chain(p, *bounded(s, -1), 0.0, s, no_back, backf, cols, False)
+        for low in range(max(s - 1, 0), -1, -1):
+            r0 = p[0, s + 1] - p[0, min(s, low + 1)]
             if r0 + base >= best:
-                break  # r0 only grows as L decreases
-            lo2[1] = max(lo[1], L)
-            lo2[h - 1] = max(lo[h - 1], L)
-            v = r0 + _chain(p, lo2, hi_s, 0.0, s, dummy, backf, cols, False)
+                break  # r0 only grows as the bound decreases
+            v = r0 + _chain(p, *bounded(s, low), 0.0, s, no_back, backf, cols, False)
             if v < best:
-                best = v
-                best_s = s
-                best_l = L
-    if best_s < 0:
-        return np.inf
-    lo2[0] = best_s
-    hi_s = hi.copy()
-    hi_s[0] = best_s
-    lo2[1] = max(lo[1], best_l)
-    lo2[h - 1] = max(lo[h - 1], best_l)
-    r0 = p[0, best_s + 1] - p[0, min(best_s, best_l + 1)]
-    return r0 + _chain(p, lo2, hi_s, 0.0, best_s, back, backf, cols, True)
-
-
-def optimal_controls(error: np.ndarray, lo: np.ndarray, hi: np.ndarray, *, cyclic: bool):
-    """Control points of the exact optimum (row j limited to lo[j]..hi[j])."""
-    if error.shape[1] >= 32768:
-        raise ValueError(
-            f"method 'oscillating-optimal' needs fewer than 32768 columns, got {error.shape[1]}"
-        )
-    cols = np.zeros(error.shape[0], dtype=np.int64)
-    _optimal_kernel(prefix_sums(error), lo, hi, bool(cyclic), cols)
+                best, best_s, best_l = v, s, low
+    _chain(p, *bounded(best_s, best_l), 0.0, best_s, back, backf, cols, True)
     return cols

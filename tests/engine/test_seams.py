@@ -580,3 +580,25 @@ def test_benchmark_runs_and_baseline_matches_dp(capsys):
     assert main(["--sizes", "32x6", "--min-time", "0"]) == 0
     out = capsys.readouterr().out
     assert "numpy row DP" in out and "oscillating o_max=3" in out
+
+
+class CountdownToken:
+    """A cancel token that becomes set after ``n`` polls (cancellation from "inside" a run)."""
+
+    def __init__(self, n):
+        self.n = n
+
+    @property
+    def cancelled(self):
+        self.n -= 1
+        return self.n < 0
+
+
+def test_optimal_cyclic_and_segmented_searches_poll_cancel_between_steps():
+    e = smooth_map((30, 12), 0)
+    with pytest.raises(Cancelled):
+        find_seam(e, method="oscillating-optimal", cyclic=True, cancel=CountdownToken(4))
+    with pytest.raises(Cancelled):
+        find_seam(e, method="minimax", waypoints=[(10, 3), (20, 5)], cancel=CountdownToken(3))
+    s = find_seam(e, method="oscillating", cancel=CountdownToken(2))  # anytime: no exception
+    assert_valid(s, e)
