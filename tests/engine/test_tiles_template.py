@@ -192,3 +192,29 @@ def test_default_overlap_is_a_tenth_of_the_tile():
         warnings.simplefilter("error")
         t = find_template(periodic(), tile_min=20, tile_max=30)
     assert t.overlap == 2 or t.overlap == default_overlap(20, 30)
+
+
+def test_coarse_to_fine_finds_the_period_and_is_chosen_by_size():
+    from engine.tiles.template import _coarse_factor
+
+    S = periodic(period=(46, 58), shape=(260, 280))
+    t = find_template(S, tile_min=(40, 50), tile_max=(60, 70), overlap=6, coarse=2)
+    assert t.rect[2:] == (58, 46) and t.cost == pytest.approx(0, abs=1e-6)
+    full = find_template(S, tile_min=(40, 50), tile_max=(60, 70), overlap=6, coarse=1)
+    assert full.rect[2:] == (58, 46)
+    assert _coarse_factor((512, 512), 257) == 1  # bundled samples: full resolution
+    assert _coarse_factor((4096, 4096), 257) >= 3  # a 4096 px photo with a wide range
+    with pytest.raises(ValueError, match="coarse"):
+        find_template(S, tile_min=40, coarse=0)
+
+
+def test_coarse_to_fine_cost_close_to_the_full_search_on_samples():
+    import resources
+    from engine.io import load_image
+
+    for name in resources.SAMPLE_NAMES:
+        S = load_image(resources.sample_path(name)).pixels
+        full = find_template(S, tile_min=128, tile_max=256, coarse=1)
+        for f in (2, 4):
+            c = find_template(S, tile_min=128, tile_max=256, coarse=f)
+            assert c.cost <= 1.15 * full.cost, (name, f, c.cost, full.cost)
