@@ -100,6 +100,9 @@ class Document(QObject):
     preview_changed = Signal()
     modified_changed = Signal(bool)
     path_changed = Signal()
+    quilt_reset = Signal()  # a synthesis started (or was cleared)
+    block_placed = Signal(int)  # index into quilt_blocks
+    quilt_finished = Signal()
 
     def __init__(self, parent=None) -> None:
         super().__init__(parent)
@@ -116,6 +119,9 @@ class Document(QObject):
         self.preview: np.ndarray | None = None  # derived
         self.grid_score: float | None = None
         self.project_path: str | None = None
+        self.quilt_output: np.ndarray | None = None  # being synthesized, (H, W, C)
+        self.quilt_blocks: list = []  # engine BlockRecord per placed block
+        self.quilt_result = None  # engine QuiltResult when finished
         self._dirty = False  # changes that are not undo steps (streamed results)
         self._was_modified = False
         self.undo_stack.cleanChanged.connect(self._on_clean_changed)
@@ -300,6 +306,47 @@ class Document(QObject):
         self.grid_score = grid_score
         self.preview_changed.emit()
 
+    # ------------------------------------------------------------------ quilting (streamed)
+    def start_quilt(self, shape: tuple[int, int] | None) -> None:
+        """Clear the quilting output (None) or start a new one of ``shape`` (H, W)."""
+        if shape is None or self.source is None:
+            self.quilt_output = None
+        else:
+            c = self.source.main.shape[2]
+            self.quilt_output = np.zeros((*shape, c), dtype=np.float32)
+        self.quilt_blocks = []
+        self.quilt_result = None
+        self.quilt_reset.emit()
+
+    def place_block(self, record, pixels: np.ndarray) -> int:
+        """Paste a placed block into the output (wrapping on a torus) and keep its record."""
+        H, W = self.quilt_output.shape[:2]
+        r, c = record.position
+        h, w = pixels.shape[:2]
+        rows, cols = (r + np.arange(h)) % H, (c + np.arange(w)) % W
+        self.quilt_output[np.ix_(rows, cols)] = pixels
+        self.quilt_blocks.append(record)
+        self.block_placed.emit(len(self.quilt_blocks) - 1)
+        return len(self.quilt_blocks) - 1
+
+    def finish_quilt(self, result) -> None:
+        self.quilt_result = result
+        self.quilt_output = np.array(result.image, dtype=np.float32)
+        self.quilt_blocks = list(result.blocks)
+        self.quilt_finished.emit()
+
+    def block_at(self, row: int, col: int) -> int | None:
+        """Index of the last placed block covering output pixel (row, col), or None."""
+        if self.quilt_output is None:
+            return None
+        H, W = self.quilt_output.shape[:2]
+        for i in range(len(self.quilt_blocks) - 1, -1, -1):
+            rec = self.quilt_blocks[i]
+            (r, c), (h, w) = rec.position, rec.size
+            if (row - r) % H < h and (col - c) % W < w:
+                return i
+        return None
+
     # ------------------------------------------------------------------ whole-document changes
     def clamp_rect(self, rect) -> tuple[int, int, int, int]:
         """``rect`` (x, y, w, h) moved and shrunk so its footprint (the rectangle plus the
@@ -335,6 +382,7 @@ class Document(QObject):
         self.layout_changed.emit()
         self.preview_changed.emit()
         self.path_changed.emit()
+        self.start_quilt(None)
         self._emit_modified()
 
     def attach_map(self, name: str, pixels: np.ndarray, path: str, kind: str) -> None:

@@ -45,8 +45,9 @@ from quilt_gui.widgets.candidate_dialog import CandidateDialog
 from quilt_gui.widgets.canvas import ImageCanvas
 from quilt_gui.widgets.gallery import CandidateView
 from quilt_gui.widgets.overlap_panel import OverlapPanel
-from quilt_gui.widgets.params_panel import TILESET_GROUPS, ParamsPanel
+from quilt_gui.widgets.params_panel import QUILT_GROUPS, TILESET_GROUPS, ParamsPanel
 from quilt_gui.widgets.preview import PreviewView
+from quilt_gui.widgets.quilt_view import QuiltView
 from quilt_gui.widgets.source_view import SourceView
 from quilt_gui.widgets.status import JobStatus, MessageBar
 from quilt_gui.widgets.tile_view import TileView
@@ -179,6 +180,12 @@ class MainWindow(QMainWindow):
             "Ctrl+R",
             "A new random arrangement of the picked tiles",
         )
+        self.act_quilt = A(
+            "&Synthesize",
+            self.run_quilt,
+            "Ctrl+Return",
+            "Quilt the source into a texture of the output size (Quilting tab)",
+        )
         self.act_cancel = A(
             "&Cancel running job", self.jobs.stop_all, "Esc", "Stop the running computation"
         )
@@ -197,6 +204,8 @@ class MainWindow(QMainWindow):
         self.tabs.setDocumentMode(True)
         self.tabs.addTab(self.source_view, "Source")
         self.tabs.addTab(self.preview_view, "Preview")
+        self.quilt_view = QuiltView(doc, self.act_quilt)
+        self.tabs.addTab(self.quilt_view, "Quilting")
         self.message_bar = MessageBar()
         central = QWidget()
         lay = QVBoxLayout(central)
@@ -211,6 +220,7 @@ class MainWindow(QMainWindow):
                 "Template": [self.act_find],
                 "Candidates": [self.act_generate],
                 "Preview": [self.act_reroll_layout],
+                "Quilting": [self.act_quilt],
             },
         )
         self.params_panel.show_groups(TILESET_GROUPS)
@@ -275,6 +285,8 @@ class MainWindow(QMainWindow):
         m.addActions([self.act_find, self.act_generate, self.act_reroll_layout])
         m.addSeparator()
         m.addAction(self.act_cancel)
+        m = mb.addMenu("&Quilting")
+        m.addAction(self.act_quilt)
         m = mb.addMenu("&Help")
         m.addAction("&Keyboard and mouse", self.show_help)
 
@@ -309,6 +321,7 @@ class MainWindow(QMainWindow):
         self.gallery.reroll_requested.connect(self.reroll_candidate)
         self.gallery.current_changed.connect(self._on_gallery_current)
         self.source_view.patch_moved.connect(self._on_patch_moved)
+        self.tabs.currentChanged.connect(self._on_tab_changed)
         for canvas in self.canvases():
             canvas.hovered.connect(partial(self._on_hover, canvas))
         self.source_view.set_heat_visible(self.act_heat.isChecked())
@@ -319,6 +332,9 @@ class MainWindow(QMainWindow):
             self.preview_view.canvas,
             self.tile_view.canvas,
             *self.overlap_panel.views.values(),
+            self.quilt_view.sample,
+            self.quilt_view.output,
+            self.quilt_view.inspector,
         ]
 
     # ------------------------------------------------------------------ messages
@@ -697,6 +713,18 @@ class MainWindow(QMainWindow):
     def _on_patch_moved(self, index: int, origin) -> None:
         self.pipeline.remake_candidate(index, origin=origin)
 
+    # ------------------------------------------------------------------ quilting
+    def run_quilt(self, *_args) -> None:
+        self.tabs.setCurrentWidget(self.quilt_view)
+        self.pipeline.run_quilt()
+
+    @Slot(int)
+    def _on_tab_changed(self, _index: int) -> None:
+        quilting = self.tabs.currentWidget() is self.quilt_view
+        self.params_panel.show_groups(QUILT_GROUPS if quilting else TILESET_GROUPS)
+        for key in ("overlaps", "tile", "gallery"):
+            self.docks[key].setVisible(not quilting)
+
     # ------------------------------------------------------------------ view actions
     def current_canvas(self) -> ImageCanvas:
         w = QApplication.focusWidget()
@@ -774,7 +802,7 @@ class MainWindow(QMainWindow):
     @Slot()
     def _update_actions(self, *_args) -> None:
         has = self.doc.has_source
-        for a in (self.act_find, self.act_save, self.act_save_as, self.act_attach):
+        for a in (self.act_find, self.act_save, self.act_save_as, self.act_attach, self.act_quilt):
             a.setEnabled(has)
         self.act_generate.setEnabled(has and self.doc.seamless is not None)
         self.act_export.setEnabled(bool(self.doc.candidates))

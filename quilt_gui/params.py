@@ -8,12 +8,15 @@ engine calls. Keeping the table here means a new option is one line, not three w
 from __future__ import annotations
 
 import contextlib
+import re
 from dataclasses import dataclass
 from typing import Any
 
 SEAM_METHODS = ("dp", "dijkstra", "minimax", "oscillating", "oscillating-optimal", "resistance")
 METRICS = ("euclid", "ssd", "lab")
 BLENDS = ("none", "feather", "adaptive")
+QUILT_SELECTIONS = ("best", "sampled", "random", "bhatia")
+QUILT_SEAMS = ("straight", *SEAM_METHODS)
 
 
 @dataclass(frozen=True)
@@ -43,6 +46,11 @@ class Param:
             return value
         if isinstance(self.default, bool):
             return bool(value)
+        if isinstance(self.default, str):
+            text = str(value).strip()
+            if text and not re.fullmatch(r"#[0-9a-fA-F]{6}", text):
+                raise ValueError(f"{self.key} must be a colour like #336699, got {value!r}")
+            return text.lower()
         v = self.kind(value)
         if self.minimum is not None:
             v = max(self.kind(self.minimum), v)
@@ -216,6 +224,7 @@ PARAMS: tuple[Param, ...] = (
         2**31 - 1,
     ),
     # -- quilting / transfer
+    # fmt: off
     _P(
         "out_width",
         384,
@@ -244,57 +253,153 @@ PARAMS: tuple[Param, ...] = (
         1024,
     ),
     _P(
-        "q_overlap", 0, "Overlap", "Overlap between blocks (px); 0 = block / 6.", "Quilting", 0, 512
+        "q_overlap",
+        0,
+        "Overlap",
+        "Overlap between blocks (px); 0 = the method's default "
+        "(block / 6; block / 2 for minimax; block / 4 as Bhatia's cut band).",
+        "Quilting",
+        0,
+        512,
     ),
     _P(
         "select",
         "best",
         "Selection",
-        "random: any block; best: among blocks within the tolerance "
-        "of the best match (Efros & Freeman); bhatia: random with extension (Bhatia).",
+        "best: among the blocks within the tolerance of the best "
+        "overlap match (Efros & Freeman, exhaustive FFT search)\nsampled: best of N random "
+        "blocks (CS194, Core S2)\nrandom: any block\nbhatia: random blocks with extensions cut "
+        "by minimum resistance lines (Bhatia)",
         "Quilting",
-        choices=("random", "best", "bhatia"),
+        choices=QUILT_SELECTIONS,
     ),
     _P(
         "tolerance",
         0.1,
         "Tolerance",
-        "Best-match selection: accept blocks whose error is within (1 + tolerance) of the best.",
+        "best: draw among blocks whose overlap error is within (1 + tolerance) of the best.",
         "Quilting",
         0.0,
         2.0,
         step=0.05,
     ),
     _P(
+        "q_candidates",
+        0,
+        "Candidates",
+        "sampled: random blocks tried per position; fast mode: "
+        "blocks re-ranked exactly (0 = default: 200 / 32).",
+        "Quilting",
+        0,
+        100_000,
+    ),
+    _P(
+        "q_mode",
+        "exact",
+        "Search",
+        "exact: exhaustive FFT search; fast: principal-component "
+        "ranking, exact re-ranking of the best candidates.",
+        "Quilting",
+        choices=("exact", "fast"),
+    ),
+    _P(
         "q_method",
         "dp",
         "Seam method",
-        "Seam method between blocks.",
+        "The cut between blocks: straight (no cut) or a seam method.",
         "Quilting",
-        choices=SEAM_METHODS,
+        choices=QUILT_SEAMS,
+    ),
+    _P(
+        "q_metric",
+        "ssd",
+        "Error metric",
+        "Error map the cut runs on (the block search always uses the SSD).",
+        "Quilting",
+        choices=METRICS,
+    ),
+    _P(
+        "q_o_max",
+        8,
+        "o_max",
+        "Oscillating seams: largest block of control points moved at once.",
+        "Quilting",
+        1,
+        64,
+    ),
+    _P(
+        "q_max_run",
+        8,
+        "Max run",
+        "Resistance seams: longest straight run (px).",
+        "Quilting",
+        1,
+        256,
     ),
     _P(
         "q_blend",
         "none",
         "Blending",
-        "Blending across the block seams.",
+        "Softening of the cut: none, feather (fixed width) or adaptive (rho).",
         "Quilting",
         choices=BLENDS,
+    ),
+    _P("q_width", 4, "Feather width", "Feather width across block seams (px).", "Quilting", 0, 64),
+    _P("q_rho", 3, "rho", "Adaptive blending strength across block seams.", "Quilting", 0, 16),
+    _P(
+        "adaptive_threshold",
+        0.0,
+        "Split above",
+        "Split a block in four when its best overlap "
+        "error (mean squared difference per pixel and channel) exceeds this; 0 = never.",
+        "Quilting",
+        0.0,
+        1.0,
+        step=0.005,
+        decimals=3,
+    ),
+    _P(
+        "min_block",
+        0,
+        "Min block",
+        "Smallest block when splitting (0 = default).",
+        "Quilting",
+        0,
+        1024,
     ),
     _P(
         "tileable",
         False,
         "Tileable output",
-        "Make the synthesized texture wrap around.",
+        "Wrap-around overlaps on the last column and row: the output tiles seamlessly.",
         "Quilting",
+    ),
+    _P(
+        "exclude_color",
+        "",
+        "Excluded colour",
+        "#rrggbb of the sample colour never to copy "
+        "(Ctrl+click the sample in the Quilting tab to pick it); empty = none.",
+        "Quilting",
+    ),
+    _P(
+        "exclude_tolerance",
+        0.0,
+        "Exclude colour ±",
+        "Never copy sample pixels within this "
+        "distance of the picked colour (Ctrl+click the sample to pick it); 0 = off.",
+        "Quilting",
+        0.0,
+        0.5,
+        step=0.01,
     ),
     _P("q_seed", 1, "Seed", "Random seed of the synthesis.", "Quilting", 0, 2**31 - 1),
     _P(
         "alpha",
         0.5,
         "Transfer alpha",
-        "Texture transfer: weight of the texture match against the "
-        "target correspondence (the first pass; iterations raise it).",
+        "Texture transfer: weight of the texture match against "
+        "the target correspondence (the first pass; iterations raise it).",
         "Transfer",
         0.0,
         1.0,
@@ -309,6 +414,7 @@ PARAMS: tuple[Param, ...] = (
         1,
         8,
     ),
+    # fmt: on
 )
 
 BY_KEY: dict[str, Param] = {p.key: p for p in PARAMS}
@@ -336,11 +442,11 @@ def coerce_all(values: dict) -> dict:
     return out
 
 
-def seam_options(p: dict, *, method_key: str = "method") -> dict:
-    """Options of the seam method ``p[method_key]`` (only those the method takes)."""
-    method = p[method_key]
+def seam_options(p: dict, *, prefix: str = "") -> dict:
+    """Options of the seam method ``p[prefix + "method"]`` (only those the method takes)."""
+    method = p[prefix + "method"]
     if method.startswith("oscillating"):
-        return {"o_max": p["o_max"]}
+        return {"o_max": p[prefix + "o_max"]}
     if method == "resistance":
-        return {"max_run": p["max_run"]}
+        return {"max_run": p[prefix + "max_run"]}
     return {}

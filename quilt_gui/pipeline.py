@@ -61,6 +61,10 @@ class Pipeline(QObject):
         doc.picks_changed.connect(self.schedule_preview)
         doc.candidates_reset.connect(self.schedule_preview)
         doc.candidate_changed.connect(self._on_candidate_changed)
+        self._quilt_timer = QTimer(self)
+        self._quilt_timer.setSingleShot(True)
+        self._quilt_timer.setInterval(0)
+        self._quilt_timer.timeout.connect(self._restart_quilt)
         self._gen_old = ([], [])
         self._remake_text = ""
 
@@ -73,7 +77,7 @@ class Pipeline(QObject):
 
     @Slot()
     def _on_source_changed(self) -> None:
-        for key in ("template", "seamless", "candidates", "preview", "tile_metrics"):
+        for key in ("template", "seamless", "candidates", "preview", "tile_metrics", "quilt"):
             self.jobs.abort(key)
         self.jobs.abort_matching("candidate:")
         self.seamless_inputs = None
@@ -89,6 +93,11 @@ class Pipeline(QObject):
             self.schedule_seamless()
         if keys & params.PREVIEW_KEYS:
             self.schedule_preview()
+        if keys & params.QUILT_KEYS and (
+            self.jobs.get("quilt") is not None or self.doc.quilt_result is not None
+        ):
+            self.jobs.abort("quilt")  # its blocks are stale now
+            self._quilt_timer.start()
 
     @Slot(int)
     def _on_candidate_changed(self, index: int) -> None:
@@ -100,9 +109,8 @@ class Pipeline(QObject):
 
     def busy(self) -> bool:
         """True while a job runs or a recompute is scheduled (tests wait for False)."""
-        return bool(
-            self.jobs.running() or self._seamless_timer.isActive() or self._preview_timer.isActive()
-        )
+        timers = (self._seamless_timer, self._preview_timer, self._quilt_timer)
+        return bool(self.jobs.running() or any(t.isActive() for t in timers))
 
     # ------------------------------------------------------------------ template search
     def find_template(self) -> jobs.Job | None:
@@ -433,6 +441,58 @@ class Pipeline(QObject):
         self.doc.apply_layout(layout)
         self.doc.apply_preview(image, score)
 
+    # ------------------------------------------------------------------ quilting
+    def run_quilt(self) -> jobs.Job | None:
+        """Synthesize ``out_height`` x ``out_width`` from the source; blocks stream in."""
+        doc = self.doc
+        if doc.source is None:
+            self.message.emit("warning", "Open a sample image first.")
+            return None
+        p = doc.params
+        shape = (int(p["out_height"]), int(p["out_width"]))
+        doc.start_quilt(shape)
+        return self.jobs.start(
+            "quilt",
+            quilt_job,
+            doc.source.main,
+            shape,
+            label="Quilting",
+            exclude_color=p["exclude_color"],
+            exclude_tolerance=p["exclude_tolerance"],
+            on_event=self._on_quilt_event,
+            on_done=self._on_quilt_done,
+            on_error=self._on_quilt_error,
+            on_cancel=self._on_quilt_cancel,
+            **quilt_options(p),
+        )
+
+    def _on_quilt_event(self, event) -> None:
+        if (
+            hasattr(event, "record")
+            and hasattr(event, "pixels")
+            and self.doc.quilt_output is not None
+        ):
+            self.doc.place_block(event.record, np.asarray(event.pixels))
+
+    def _on_quilt_done(self, result) -> None:
+        self.doc.finish_quilt(result)
+        h, w = result.image.shape[:2]
+        self.message.emit(
+            "info",
+            f"Synthesized {w}×{h} from {len(result.blocks)} blocks. Click a "
+            "block to see its overlap, error map and seam.",
+        )
+
+    def _on_quilt_error(self, exc) -> None:
+        self._error(exc)
+
+    def _on_quilt_cancel(self) -> None:
+        self.message.emit("info", f"Quilting cancelled after {len(self.doc.quilt_blocks)} blocks.")
+
+    @Slot()
+    def _restart_quilt(self) -> None:
+        self.run_quilt()
+
     def reroll_layout(self) -> None:
         """A new random layout for the preview (one undo step: the layout seed changes)."""
         seed = int(np.random.default_rng().integers(2**31 - 1))
@@ -466,3 +526,56 @@ def _same_border(a: np.ndarray, b: np.ndarray, m: int) -> bool:
         and np.array_equal(a[:, :m], b[:, :m])
         and np.array_equal(a[:, -m:], b[:, -m:])
     )
+
+
+def parse_color(text: str) -> tuple[float, float, float] | None:
+    """ "#rrggbb" -> (r, g, b) in [0, 1]; "" -> None."""
+    if not text:
+        return None
+    return tuple(int(text[i : i + 2], 16) / 255.0 for i in (1, 3, 5))
+
+
+def quilt_options(p: dict) -> dict:
+    """Keyword options of :func:`engine.quilting.iter_quilt` from the parameters."""
+    return dict(
+        block=p["block"],
+        overlap=p["q_overlap"] or None,
+        select=p["select"],
+        tolerance=p["tolerance"],
+        candidates=p["q_candidates"] or None,
+        seam=p["q_method"],
+        blend=p["q_blend"],
+        blend_width=p["q_width"],
+        rho=p["q_rho"],
+        metric=p["q_metric"],
+        tileable=p["tileable"],
+        adaptive_threshold=p["adaptive_threshold"] or None,
+        min_block=p["min_block"] or None,
+        mode=p["q_mode"],
+        rng=p["q_seed"],
+        **(params.seam_options(p, prefix="q_") if p["q_method"] != "straight" else {}),
+    )
+
+
+def excluded_mask(sample: np.ndarray, color: str, tolerance: float):
+    """The sample pixels within ``tolerance`` of ``color`` (per channel), or None."""
+    from engine.exclusion import exclusion_mask
+
+    rgb = parse_color(color)
+    if rgb is None or tolerance <= 0:
+        return None
+    lo = [max(0.0, v - tolerance) for v in rgb]
+    hi = [min(1.0, v + tolerance) for v in rgb]
+    return exclusion_mask(sample, color_range=(lo, hi))
+
+
+def quilt_job(
+    sample, out_shape, *, exclude_color: str, exclude_tolerance: float, cancel=None, **options
+):
+    """Worker body of a quilting run: exclusion mask, then the engine's event generator."""
+    from engine.quilting import iter_quilt
+
+    mask = excluded_mask(sample, exclude_color, exclude_tolerance)
+    if mask is not None and mask.all():
+        raise ValueError("the excluded colour range covers the whole sample; lower the tolerance")
+    return iter_quilt(sample, out_shape, excluded=mask, cancel=cancel, threads=2, **options)

@@ -134,6 +134,7 @@ class ImageCanvas(QGraphicsView):
 
     zoom_changed = Signal(float)
     hovered = Signal(object)  # (row, col) inside the image, or None
+    pixel_clicked = Signal(object, object)  # (row, col), Qt.KeyboardModifiers: a click, no drag
 
     def __init__(self, parent=None) -> None:
         super().__init__(parent)
@@ -150,6 +151,7 @@ class ImageCanvas(QGraphicsView):
         self.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
         self._zoom = 1.0
         self._fit_pending = True
+        self._press_pos = None
         self._apply_zoom_hints()
 
     # ------------------------------------------------------------------ image
@@ -262,6 +264,21 @@ class ImageCanvas(QGraphicsView):
         super().resizeEvent(event)
         if self._fit_pending:
             self.fit()
+
+    def mousePressEvent(self, event) -> None:  # noqa: N802 - Qt API
+        self._press_pos = event.position() if event.button() == Qt.MouseButton.LeftButton else None
+        super().mousePressEvent(event)
+
+    def mouseReleaseEvent(self, event) -> None:  # noqa: N802 - Qt API
+        super().mouseReleaseEvent(event)
+        start, self._press_pos = self._press_pos, None
+        if start is None or event.button() != Qt.MouseButton.LeftButton:
+            return
+        d = event.position() - start
+        if abs(d.x()) + abs(d.y()) <= 4:
+            px = self.pixel_at(event.position())
+            if px is not None:
+                self.pixel_clicked.emit(px, event.modifiers())
 
     def mouseMoveEvent(self, event) -> None:  # noqa: N802 - Qt API
         super().mouseMoveEvent(event)

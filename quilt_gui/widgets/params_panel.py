@@ -17,6 +17,7 @@ from PySide6.QtWidgets import (
     QGroupBox,
     QHBoxLayout,
     QLabel,
+    QLineEdit,
     QScrollArea,
     QSizePolicy,
     QSpinBox,
@@ -33,10 +34,23 @@ from quilt_gui.document import Document
 
 #: Integer parameters edited with a slider (the rest use spin boxes).
 SLIDERS = frozenset(
-    {"overlap", "o_max", "max_run", "width", "rho", "margin", "neighbourhood", "iterations"}
+    {
+        "overlap",
+        "o_max",
+        "max_run",
+        "width",
+        "rho",
+        "margin",
+        "neighbourhood",
+        "iterations",
+        "q_o_max",
+        "q_max_run",
+        "q_width",
+        "q_rho",
+    }
 )
 TILESET_GROUPS = ("Template", "Seam", "Candidates", "Preview")
-QUILT_GROUPS = ("Quilting", "Transfer")
+QUILT_GROUPS = ("Quilting",)  # "Transfer" joins when engine.transfer lands
 
 
 class ParamsPanel(QScrollArea):
@@ -102,6 +116,11 @@ class ParamsPanel(QScrollArea):
             w = QCheckBox()
             w.toggled.connect(partial(self._edit, key))
             return w
+        if isinstance(p.default, str):
+            w = QLineEdit()
+            w.setPlaceholderText("none")
+            w.editingFinished.connect(partial(self._edit_text, key, w))
+            return w
         if isinstance(p.default, float):
             w = QLabeledDoubleSlider(Qt.Orientation.Horizontal)
             w.setRange(p.minimum, p.maximum)
@@ -128,6 +147,12 @@ class ParamsPanel(QScrollArea):
     def _drag_ended(self, key: str) -> None:
         self._merge.pop(key, None)
 
+    def _edit_text(self, key: str, widget) -> None:
+        try:
+            self._edit(key, widget.text())
+        except ValueError:
+            widget.setText(self.doc.params[key])  # not a colour: back to the valid value
+
     def _edit(self, key: str, value) -> None:
         self.doc.set_param(key, value, merge_id=self._merge.get(key))
 
@@ -138,6 +163,8 @@ class ParamsPanel(QScrollArea):
             return w.currentText()
         if isinstance(w, QCheckBox):
             return w.isChecked()
+        if isinstance(w, QLineEdit):
+            return w.text()
         return w.value()
 
     @Slot(object)
@@ -152,5 +179,7 @@ class ParamsPanel(QScrollArea):
                     w.setCurrentText(str(v))
                 elif isinstance(w, QCheckBox):
                     w.setChecked(bool(v))
+                elif isinstance(w, QLineEdit):
+                    w.setText(str(v))
                 else:
                     w.setValue(v)

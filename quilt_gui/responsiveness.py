@@ -1,0 +1,150 @@
+"""Measure how responsive the editor stays while background jobs run.
+
+A precise QTimer on the GUI thread ticks every few milliseconds; the gaps between its ticks
+show how long the event loop was blocked (by our own slots, or by a worker holding the GIL).
+Used by ``tests/gui/test_responsiveness.py`` and ``benchmarks/gui_responsiveness.py``.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+
+import numpy as np
+from PySide6.QtCore import QEventLoop, QObject, Qt, QTimer, Slot
+
+TICK_MS = 5
+
+
+class GapMeter(QObject):
+    """Records the time between ticks of a GUI-thread timer."""
+
+    def __init__(self, interval_ms: int = TICK_MS, parent=None) -> None:
+        super().__init__(parent)
+        self.timer = QTimer(self)
+        self.timer.setTimerType(Qt.TimerType.PreciseTimer)
+        self.timer.setInterval(interval_ms)
+        self.timer.timeout.connect(self._tick)
+        self.ticks: list[float] = []
+
+    def start(self) -> None:
+        self.ticks = [time.perf_counter()]
+        self.timer.start()
+
+    def stop(self) -> np.ndarray:
+        """Stop; the gaps (ms) between consecutive ticks."""
+        self.timer.stop()
+        self._tick()
+        return np.diff(np.asarray(self.ticks)) * 1000.0
+
+    @Slot()
+    def _tick(self) -> None:
+        self.ticks.append(time.perf_counter())
+
+
+def gap_stats(gaps) -> dict:
+    """Count, p50 / p99 / max (ms) of tick gaps, and their total duration (s)."""
+    gaps = np.asarray(gaps, dtype=np.float64)
+    if gaps.size == 0:
+        return {"n": 0, "p50": 0.0, "p99": 0.0, "max": 0.0, "seconds": 0.0}
+    return {
+        "n": int(gaps.size),
+        "p50": float(np.percentile(gaps, 50)),
+        "p99": float(np.percentile(gaps, 99)),
+        "max": float(gaps.max()),
+        "seconds": float(gaps.sum() / 1000.0),
+    }
+
+
+def wait_until(cond: Callable[[], bool], timeout_s: float = 120.0) -> bool:
+    """Run the event loop (without spinning) until ``cond()`` or the timeout."""
+    if cond():
+        return True
+    loop = QEventLoop()
+    poll = QTimer()
+    poll.setInterval(10)
+    deadline = time.perf_counter() + timeout_s
+
+    def check() -> None:
+        if cond() or time.perf_counter() > deadline:
+            loop.quit()
+
+    poll.timeout.connect(check)
+    poll.start()
+    loop.exec()
+    poll.stop()
+    return cond()
+
+
+def gaps_during(window, start: Callable[[], object], timeout_s: float = 120.0) -> np.ndarray:
+    """Tick gaps (ms) from ``start()`` until the pipeline is idle again."""
+    meter = GapMeter()
+    meter.start()
+    start()
+    if not wait_until(lambda: not window.pipeline.busy(), timeout_s):
+        raise TimeoutError(f"the job did not finish within {timeout_s} s")
+    return meter.stop()
+
+
+def measure_candidates(window, repeats: int = 3) -> dict:
+    """Gap statistics while ``n_candidates`` candidates generate, ``repeats`` runs pooled."""
+    runs = []
+    for k in range(repeats):
+        window.doc.set_param("seed", 1000 + k)
+        runs.append(gaps_during(window, window.pipeline.generate_candidates))
+    return gap_stats(np.concatenate(runs))
+
+
+def measure_quilting(window) -> dict:
+    """Gap statistics while the quilting job runs with the current parameters."""
+    return gap_stats(gaps_during(window, window.run_quilt))
+
+
+def cancel_latency(
+    window, start: Callable[[], object], started: Callable[[], bool], timeout_s: float = 60.0
+) -> float:
+    """Milliseconds from Cancel until every job has ended, once ``started()`` is true."""
+    start()
+    wait_until(started, timeout_s)
+    t0 = time.perf_counter()
+    window.job_status.cancel()
+    wait_until(lambda: not window.jobs.busy(), timeout_s)
+    return (time.perf_counter() - t0) * 1000.0
+
+
+def measure_all(window, *, repeats: int = 3) -> dict[str, dict]:
+    """The figures of the benchmark table (the window must have the sample open)."""
+    doc = window.doc
+    window.pipeline.find_template()
+    wait_until(lambda: not window.pipeline.busy())
+    rows = {f"{doc.params['n_candidates']} candidates": measure_candidates(window, repeats)}
+    rows["quilting (best match)"] = measure_quilting(window)
+    n = doc.params["n_candidates"]
+    doc.set_param("n_candidates", 400)
+    rows["cancel candidates"] = {
+        "ms": cancel_latency(
+            window, window.pipeline.generate_candidates, lambda: len(doc.candidates) >= 3
+        )
+    }
+    doc.set_param("n_candidates", n)
+    rows["cancel quilting"] = {
+        "ms": cancel_latency(window, window.run_quilt, lambda: len(doc.quilt_blocks) >= 3)
+    }
+    return rows
+
+
+def format_table(rows: dict[str, dict]) -> str:
+    lines = [
+        "| job | duration (s) | ticks | gap p50 (ms) | gap p99 (ms) | gap max (ms) |",
+        "|---|---|---|---|---|---|",
+    ]
+    for name, s in rows.items():
+        if "ms" in s:
+            continue
+        lines.append(
+            f"| {name} | {s['seconds']:.2f} | {s['n']} | {s['p50']:.1f} | "
+            f"{s['p99']:.1f} | {s['max']:.1f} |"
+        )
+    lines += ["", "| cancel | latency (ms) |", "|---|---|"]
+    lines += [f"| {name} | {s['ms']:.0f} |" for name, s in rows.items() if "ms" in s]
+    return "\n".join(lines)

@@ -1,0 +1,80 @@
+"""Quilting mode: blocks stream onto the canvas, inspection, supersede, exclusion."""
+
+from __future__ import annotations
+
+import numpy as np
+from PySide6.QtCore import QPointF, Qt
+
+from tests.gui.helpers import make_window, open_sample, wait_idle
+
+
+def small(w, **extra):
+    w.doc.set_params({"out_width": 160, "out_height": 128, "block": 32, **extra})
+
+
+def test_blocks_stream_in_and_a_click_inspects_one(qtbot):
+    w = make_window(qtbot)
+    open_sample(qtbot, w)
+    small(w)
+    placed = []
+    w.doc.block_placed.connect(placed.append)
+    w.act_quilt.trigger()
+    assert w.tabs.currentWidget() is w.quilt_view
+    assert w.params_panel.groups["Quilting"].isVisible()
+    assert not w.params_panel.groups["Template"].isVisible()
+    wait_idle(qtbot, w)
+    res = w.doc.quilt_result
+    assert res is not None and res.image.shape[:2] == (128, 160)
+    assert placed == list(range(len(res.blocks)))  # one event per block, in order
+    assert np.array_equal(w.quilt_view.output.array, res.image)
+    # click on a block of the output (a click, not a drag)
+    rec = res.blocks[7]
+    (r, c), (h, wd) = rec.position, rec.size
+    out = w.quilt_view.output
+    out.fit()
+    pos = out.mapFromScene(QPointF(c + wd - 3.5, r + h - 3.5))
+    qtbot.mouseClick(out.viewport(), Qt.MouseButton.LeftButton, pos=pos)
+    assert w.quilt_view.selected == w.doc.block_at(r + h - 4, c + wd - 4)
+    sel = res.blocks[w.quilt_view.selected]
+    assert w.quilt_view.inspector.frame_shape == tuple(sel.size)
+    assert f"Block #{sel.index + 1}" in w.quilt_view.info.text()
+    assert w.quilt_view.source_rect.rect().getRect() == tuple(float(v) for v in sel.source)
+
+
+def test_parameter_change_restarts_quilting_without_stale_blocks(qtbot):
+    w = make_window(qtbot)
+    open_sample(qtbot, w)
+    small(w, out_width=256, out_height=256)
+    w.act_quilt.trigger()
+    qtbot.waitUntil(lambda: len(w.doc.quilt_blocks) >= 2, timeout=10_000)
+    first = w.jobs.get("quilt")
+    w.doc.set_param("block", 24)
+    assert not first.alive
+    wait_idle(qtbot, w)
+    res = w.doc.quilt_result
+    assert res.block == (24, 24)
+    assert all(max(b.size) <= 24 for b in w.doc.quilt_blocks)
+    assert np.array_equal(w.doc.quilt_output, res.image)
+
+
+def test_excluded_colour_is_never_copied(qtbot):
+    w = make_window(qtbot)
+    open_sample(qtbot, w)
+    small(w, select="random")
+    w.act_quilt.trigger()
+    wait_idle(qtbot, w)
+    sample = w.quilt_view.sample
+    src = w.doc.source.main
+    row, col = np.unravel_index(np.argmin(src.sum(axis=2)), src.shape[:2])  # the darkest pixel
+    w.quilt_view._on_sample_clicked((int(row), int(col)), Qt.KeyboardModifier.ControlModifier)
+    assert w.doc.params["exclude_color"].startswith("#") and w.doc.params["exclude_tolerance"] > 0
+    assert w.quilt_view.excluded.isVisible()
+    wait_idle(qtbot, w)  # the change restarted the synthesis
+    from quilt_gui.pipeline import excluded_mask
+
+    mask = excluded_mask(src, w.doc.params["exclude_color"], w.doc.params["exclude_tolerance"])
+    assert mask.any()
+    for b in w.doc.quilt_result.blocks:
+        x, y, bw, bh = b.source
+        assert not mask[y : y + bh, x : x + bw].any()
+    assert sample.array is src
