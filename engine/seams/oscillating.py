@@ -6,15 +6,16 @@ with ``cyclic`` rows 0 and h-1 are neighbours). Criterion
 ``eps(c) = sum_j P[j, c_j + 1] - P[j, mu_j]`` with row prefix sums ``P``.
 
 * :func:`iter_oscillating` — the anytime oscillating search (§1.2): block moves of up to
-  ``o_max`` consecutive control points, first improvement in loop order, incremental O(o)
-  evaluation per trial, ``faithful`` (restart at o = 1, j = 0) or ``resume`` (o = 1 at the current
-  j, stop after a full cycle without improvement) variants, frozen control points.
+  ``o_max`` consecutive control points, first improvement in loop order, incremental
+  evaluation (O(1) per candidate column: only rows j-1..j+o change), ``faithful`` (restart at
+  o = 1, j = 0) or ``resume`` (o = 1 at the current j, stop after a full cycle without
+  improvement) variants, frozen control points.
 * :func:`optimal_controls` — the exact optimum of the same model. Row j's cost depends on its
   neighbours only through ``m = min(c_{j-1}, c_{j+1})``: ``r_j = R_{j,b}(m) = P[j,b+1] -
   P[j, min(b, m+1)]`` with ``b = c_j``. The second-order DP over pairs (c_j, c_{j+1}) therefore
   needs only a prefix minimum and a suffix minimum per (row, b): O(h w²) instead of O(h w³).
   Cyclic maps fix c_0 = s and bound ``min(c_{h-1}, c_1) >= L`` (charging row 0 ``R_{0,s}(L)``,
-  exact at the optimal L), pruned by a lower bound.
+  exact at the optimal L), pruned by a lower bound: O(h w^4) worst case, ~1 s at 512x64.
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ from engine.cancel import check, is_cancelled
 from engine.seams._result import Seam
 
 # kernel status codes
-_IMPROVED, _BUDGET, _CONVERGED = 1, 0, 2
+_BUDGET, _CONVERGED = 0, 2
 
 
 def prefix_sums(error: np.ndarray) -> np.ndarray:
