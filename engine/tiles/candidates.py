@@ -192,9 +192,9 @@ class _Setup:
             raise ValueError(f"patch_size {(ph, pw)} must not exceed the tile size {(th, tw)}")
         if ph > H or pw > W:
             raise ValueError(f"patch_size {(ph, pw)} does not fit the {W}x{H} source")
-        if min(ph, pw) < 3 * self.ring:
+        if min(ph, pw) < 2 * self.ring:
             raise ValueError(
-                f"patch_size {(ph, pw)} must be at least 3 * patch_overlap = {3 * self.ring} px "
+                f"patch_size {(ph, pw)} must be at least 2 * patch_overlap = {2 * self.ring} px "
                 "per side"
             )
         self.ph, self.pw = ph, pw

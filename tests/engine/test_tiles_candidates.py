@@ -198,8 +198,8 @@ def test_bad_input(small):
         candidates(S, st.tile, 2)
     with pytest.raises(ValueError, match="patch_size"):
         candidates(S, st, 2, patch_size=100)
-    with pytest.raises(ValueError, match="3 \\* patch_overlap"):
-        candidates(S, st, 2, patch_size=20)
+    with pytest.raises(ValueError, match="2 \\* patch_overlap"):
+        candidates(S, st, 2, patch_size=15)
     with pytest.raises(ValueError, match="margin"):
         candidates(S, st, 2, margin=8)
     with pytest.raises(ValueError, match="excluded"):
