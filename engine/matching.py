@@ -124,22 +124,39 @@ class SampleSpectrum:
         wts = np.asarray(weights, dtype=np.float32)
         if wts.ndim == 3:
             wts = wts[:, None]
-        n, bh, bw, c = t.shape
-        h, w = self.shape
+        c = t.shape[3]
         if c != self.channels:
             raise ValueError(f"targets must have {self.channels} channels, got {c}")
+        tt = np.moveaxis(t, 3, 1)  # (n, C, bh, bw)
+        k = wts[:, self.group_of] * tt
+        const = np.einsum("nchw,nchw->n", k, tt, dtype=np.float64)
+        return self.ssd_terms(k, wts, const, workers=workers)
+
+    def ssd_terms(self, kernels, weights, const, *, workers: int | None = None) -> np.ndarray:
+        """``const − 2 Σ_c corr(S_c, K_c) + Σ_g corr(Σ_{c∈g} S_c², W_g)`` at every position.
+
+        The general form behind :meth:`ssd`: any weighted sum of squared differences against
+        several targets expands into it (texture transfer mixes the overlap, the previous
+        iteration and the correspondence map). ``kernels`` (n, C, bh, bw), ``weights``
+        (n, G, bh, bw), ``const`` (n,). Clipped at 0 against float round-off.
+        """
+        k = np.asarray(kernels, dtype=np.float32)
+        wts = np.asarray(weights, dtype=np.float32)
+        n, c, bh, bw = k.shape
+        h, w = self.shape
+        if c != self.channels or wts.shape != (n, len(self.groups), bh, bw):
+            raise ValueError(
+                f"kernels must be (n, {self.channels}, bh, bw) and weights "
+                f"(n, {len(self.groups)}, bh, bw), got {k.shape} and {wts.shape}"
+            )
         if bh > h or bw > w:
             raise ValueError(f"block {bw}x{bh} is larger than the sample {w}x{h}")
-        tt = np.moveaxis(t, 3, 1)  # (n, C, bh, bw)
-        wc = wts[:, self.group_of]  # weight of each channel
-        k = wc * tt
-        const = np.einsum("nchw,nchw->n", k, tt, dtype=np.float64)
         fk = self._forward(k, workers)
         fw = self._forward(wts, workers)
         x = _channel_sum(fw, self._fsq)
         x -= 2 * _channel_sum(fk, self._fs)
         e = self._inverse(x, h - bh + 1, w - bw + 1, workers)
-        e += const.astype(np.float32)[:, None, None]
+        e += np.asarray(const, dtype=np.float64).astype(np.float32)[:, None, None]
         np.maximum(e, 0, out=e)
         return e
 

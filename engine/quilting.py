@@ -254,6 +254,19 @@ def axis_positions(n_out: int, block: int, overlap: int, tileable: bool) -> list
     return [(i * n_out) // n for i in range(n)]
 
 
+def grid_rects(out_shape, block, overlap: int, tileable: bool) -> list[tuple[int, int, int, int]]:
+    """(y, x, h, w) of every block of the quilting grid in raster order (cropped at the
+    output's edges unless ``tileable``)."""
+    (ho, wo), (bh, bw) = out_shape, block
+    rects = []
+    for y in axis_positions(ho, bh, overlap, tileable):
+        for x in axis_positions(wo, bw, overlap, tileable):
+            h = bh if tileable else min(bh, ho - y)
+            w = bw if tileable else min(bw, wo - x)
+            rects.append((y, x, h, w))
+    return rects
+
+
 def _check_torus_axis(n_out: int, block: int, overlap: int, axis: str) -> None:
     pos = axis_positions(n_out, block, overlap, True)
     spacing = np.diff([*pos, n_out])
@@ -450,6 +463,7 @@ class _Work:
     filled: np.ndarray | None = None
     arms: tuple[int, int, int, int] = (0, 0, 0, 0)
     found: tuple | None = None  # search result: ("map", e) | ("list", anchors, errors) | None
+    extra: dict = field(default_factory=dict)  # per-algorithm data (texture transfer)
 
 
 class _Quilter:
@@ -515,8 +529,11 @@ class _Quilter:
     @property
     def spectrum(self) -> SampleSpectrum:
         if self._spectrum is None:
-            self._spectrum = SampleSpectrum(self.match_sample, workers=self.threads)
+            self._spectrum = self.make_spectrum()
         return self._spectrum
+
+    def make_spectrum(self) -> SampleSpectrum:
+        return SampleSpectrum(self.match_sample, workers=self.threads)
 
     def valid(self, h: int, w: int):
         """(valid anchor map or None if all valid, flat indices of valid anchors)."""
@@ -539,6 +556,10 @@ class _Quilter:
             else int(flat[rng.integers(flat.size)])
         )
         return divmod(k, nx)
+
+    def zero_level_for(self, wk: _Work) -> float:
+        """Error below which a candidate counts as an exact copy (see ``tolerance``)."""
+        return self.zero_level(int(wk.filled.sum()))
 
     def zero_level(self, overlap_pixels: int) -> float:
         return ZERO_ERROR_FRACTION * self.floor * overlap_pixels * self.match_sample.shape[2]
@@ -638,7 +659,7 @@ class _Quilter:
                 return (y, x), math.nan, math.nan, 1
             e = float(ssd_at(self.match_sample, np.array([[y, x]]), wk.old, wk.filled)[0])
             return (y, x), e, math.nan, 1
-        zero = self.zero_level(int(wk.filled.sum()))
+        zero = self.zero_level_for(wk)
         if wk.found[0] == "map":
             e = wk.found[1]
             k, e_min, n = select_within_tolerance(
@@ -744,9 +765,9 @@ class _Quilter:
         return rec, _ro(pixels)
 
 
-def _run_levels(q: _Quilter, rects, total_label: str, prepare=None):
+def _run_levels(q: _Quilter, rects, total_label: str):
     """Place ``rects`` (top-level blocks in raster order) level by level; yields events and
-    returns the records. ``prepare(work)`` may load extra per-block data before the search."""
+    returns the records."""
     if q.select == "best":
         _ = q.spectrum  # built once, before any thread reads it
         if q.mode == "fast":
@@ -764,8 +785,6 @@ def _run_levels(q: _Quilter, rects, total_label: str, prepare=None):
             works = [_Work(i, *rects[i], rng=np.random.default_rng([q.seed, i])) for i in order[lv]]
             for wk in works:
                 q.load(wk)
-                if prepare is not None:
-                    prepare(wk)
             _parallel(pool, q.search, works)
             placed = (
                 list(pool.map(q.place, works))
@@ -1187,14 +1206,7 @@ def _iter_quilt(q: _Quilter):
         records = yield from _iter_bhatia(q, q.overlap)
         step, band = (bh, bw), q.overlap
     else:
-        ys = axis_positions(Ho, bh, q.overlap, q.tileable)
-        xs = axis_positions(Wo, bw, q.overlap, q.tileable)
-        rects = []
-        for y in ys:
-            for x in xs:
-                h = bh if q.tileable else min(bh, Ho - y)
-                w = bw if q.tileable else min(bw, Wo - x)
-                rects.append((y, x, h, w))
+        rects = grid_rects(q.out_shape, q.block, q.overlap, q.tileable)
         records = yield from _run_levels(q, rects, "blocks")
         step, band = (bh - q.overlap, bw - q.overlap), q.overlap
     image = q.canvas
