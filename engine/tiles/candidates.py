@@ -171,7 +171,6 @@ class _Setup:
             )
         self.S = as_image(source, "source")
         H, W = self.S.shape[:2]
-        self.T = template
         th, tw = template.tile.shape[:2]
         if self.S.shape[2] != template.tile.shape[2]:
             raise ValueError(
@@ -235,6 +234,11 @@ class _Setup:
                 "exclusion or use a smaller patch_size"
             )
         self.notes = []
+        if self.margin == 0 and (ph, pw) == (th, tw):
+            self.notes.append(
+                "margin 0 with a patch as large as the tile: cuts may reach the tile border, "
+                "so candidates may not connect to each other"
+            )
         flat = flat_warning(self.S)
         if flat:
             self.notes.append(flat)
@@ -246,16 +250,6 @@ class _Setup:
         self.cc = np.ascontiguousarray(c[band], dtype=np.int64)
         self.Sc = np.ascontiguousarray(colour_channels(self.S))
         self.Uc = np.ascontiguousarray(colour_channels(self.U[MAIN]))
-
-    def parameters(self) -> dict:
-        p = {k: v for k, v in self.opts.items() if isinstance(v, (int, float, str, bool))}
-        p.update(
-            patch_size=[self.ph, self.pw],
-            patch_overlap=self.ring,
-            margin=self.margin,
-            neighbourhood=self.n,
-        )
-        return p
 
     # ---- positions
     def random_origin(self, gen: np.random.Generator) -> tuple[int, int]:

@@ -212,6 +212,8 @@ def test_bad_input(small):
         candidates(S[:, :, :1], st, 2)
     with pytest.raises(ValueError, match="method"):
         candidates(S, st, 2, method="magic")
+    with pytest.warns(UserWarning, match="margin 0"):
+        iter_candidates(S, st, 1, margin=0)
     with pytest.raises(TypeError, match="rng"):
         candidates(S, st, 2, rng="seed")
     flat = np.full((100, 100, 3), 0.3, np.float32)
