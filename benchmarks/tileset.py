@@ -3,13 +3,13 @@
 Run ``python -m benchmarks.tileset`` (or ``python benchmarks/tileset.py``); ``--help`` for
 options. Three tables:
 
-1. **Quality** (each bundled 512x512 sample, 256x256 tiles, default parameters): the wrap
-   border ratio and detail ratio of a naive crop (the top-left 256x256), a cross-fade "make
-   seamless" (the same rectangle and overlap as ours, linear ramps instead of cuts) and our
-   template tile; then for 30 candidates the median and max border ratio over all ordered
-   pairs (horizontal and vertical), the mean share of pixels changed vs the template, and the
-   grid score of an 8x8 preview of 8 picked tiles (lowest seam criterion, no equal
-   neighbours) over that of the template repeated.
+1. **Quality** (each bundled 512x512 sample, 256x256 tiles, default parameters): wrap
+   border ratio / detail ratio of a naive crop (the top-left 256x256), of a cross-fade "make
+   seamless" of that crop (footprint at the top-left corner, our overlap w_T, linear ramps
+   instead of cuts, no search) and of our template tile; then, for 30 candidates, the median
+   and max border ratio over all ordered pairs (horizontal and vertical), the mean share of
+   pixels changed vs the template, and the grid score of an 8x8 preview of 8 picked tiles
+   (lowest seam criterion, no equal neighbours) over that of the template repeated.
 2. **Speed** at 512x512 -> 256x256 (cobblestones): template search + seamless tile (first
    call in the process, i.e. with numba's cache load, and warm), first candidate, 30
    candidates wall time with 1 and 2 workers, peak traced memory (tracemalloc) and the
@@ -88,7 +88,7 @@ def quality(tile: int, n: int, seed: int) -> str:
         st = make_seamless(S, tmpl)
         a, b = tmpl.rect[2:]
         naive = S[:b, :a]
-        fade = crossfade_tile(S, tmpl.rect, tmpl.overlap)
+        fade = crossfade_tile(S, (0, 0, a, b), tmpl.overlap)
         cands = candidates(S, st, n, rng=seed, workers=2)
         ratios = pair_ratios([c.tile for c in cands])
         changed = np.mean([c.scores["changed"] for c in cands])
