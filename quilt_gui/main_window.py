@@ -244,6 +244,9 @@ class MainWindow(QMainWindow):
             dock.setWidget(widget)
             self.addDockWidget(area, dock)
             self.docks[key] = dock
+        # side docks run the full height; the gallery sits under the canvas only
+        self.setCorner(Qt.Corner.BottomRightCorner, Qt.DockWidgetArea.RightDockWidgetArea)
+        self.setCorner(Qt.Corner.BottomLeftCorner, Qt.DockWidgetArea.LeftDockWidgetArea)
         self.resizeDocks([self.docks["params"]], [300], Qt.Orientation.Horizontal)
         self.resizeDocks([self.docks["overlaps"]], [360], Qt.Orientation.Horizontal)
         self.resizeDocks([self.docks["gallery"]], [260], Qt.Orientation.Vertical)
@@ -807,6 +810,10 @@ class MainWindow(QMainWindow):
         self.act_generate.setEnabled(has and self.doc.seamless is not None)
         self.act_export.setEnabled(bool(self.doc.candidates))
         self.act_reroll_layout.setEnabled(bool(self.doc.picks))
+        n = len(self.doc.candidates)
+        self.docks["gallery"].setWindowTitle(
+            f"Candidates — {len(self.doc.picks)} of {n} picked" if n else "Candidates"
+        )
 
     # ------------------------------------------------------------------ closing
     def closeEvent(self, event) -> None:  # noqa: N802 - Qt API

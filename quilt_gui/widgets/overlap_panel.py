@@ -9,10 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 from PySide6.QtCore import Qt, Signal, Slot
-from PySide6.QtGui import QColor, QFont
 from PySide6.QtWidgets import (
-    QGraphicsItem,
-    QGraphicsSimpleTextItem,
     QHBoxLayout,
     QLabel,
     QPushButton,
@@ -54,7 +51,6 @@ class OverlapView(ImageCanvas):
         self.paths = [PixelSetItem(color) for _ in range(3)]
         for p in self.paths:
             self.add_item(p)
-        self.labels: list[QGraphicsSimpleTextItem] = []
         self.waypoints: list[tuple[int, int]] = []
         self._wp_items: list[WaypointItem] = []
         self.setToolTip(
@@ -62,7 +58,7 @@ class OverlapView(ImageCanvas):
             "Right-click: remove the nearest waypoint"
         )
 
-    def show_overlap(self, r1, r2, error, *, stacked: bool, names=("R1", "R2", "error")) -> None:
+    def show_overlap(self, r1, r2, error, *, stacked: bool) -> None:
         """Show the regions and the error map; ``stacked`` puts them one above the other."""
         error = np.asarray(error)
         h, w = error.shape
@@ -78,43 +74,12 @@ class OverlapView(ImageCanvas):
         refit = self.frame_shape != (h, w)
         self.frame_shape = (h, w)
         self.set_image(canvas, fit=refit)
-        for item in self.labels:
-            self.scene().removeItem(item)
-        self.labels = []
-        font = QFont()
-        font.setPointSize(8)
-        for (ox, oy), name in zip(self.offsets, names, strict=True):
-            t = QGraphicsSimpleTextItem(name)
-            t.setFont(font)
-            t.setBrush(QColor(230, 230, 230))
-            t.setFlag(QGraphicsItem.GraphicsItemFlag.ItemIgnoresTransformations)
-            t.setPos(ox, oy - 0.5)
-            t.setZValue(50)
-            self.scene().addItem(t)
-            self.labels.append(t)
-        self._layout_labels()
-
-    def _layout_labels(self) -> None:
-        # labels sit above each panel, in screen pixels
-        for t, (ox, oy) in zip(self.labels, self.offsets, strict=False):
-            t.setPos(ox, oy - 14.0 / max(self.zoom, 1e-6))
-
-    def set_zoom(self, zoom, anchor=None) -> None:
-        super().set_zoom(zoom, anchor)
-        self._layout_labels()
-
-    def fit(self) -> None:
-        super().fit()
-        self._layout_labels()
 
     def clear(self) -> None:
         self.frame_shape = None
         self.set_image(None)
         for p in self.paths:
             p.hide()
-        for item in self.labels:
-            self.scene().removeItem(item)
-        self.labels = []
         self.set_waypoints([])
 
     def set_path(self, path) -> None:
@@ -180,8 +145,8 @@ class OverlapPanel(QWidget):
         lay.setContentsMargins(4, 4, 4, 4)
         split = QSplitter(Qt.Orientation.Vertical)
         for which, title in (
-            ("horizontal", "Left / right overlap (R_R over R_L)"),
-            ("vertical", "Top / bottom overlap (R_B over R_T)"),
+            ("horizontal", "Left / right overlap</b> — R_R | R_L | error map<b>"),
+            ("vertical", "Top / bottom overlap</b> — R_B / R_T / error map<b>"),
         ):
             box = QWidget()
             bl = QVBoxLayout(box)
@@ -193,6 +158,8 @@ class OverlapPanel(QWidget):
             split.addWidget(box)
             self.views[which].waypoint_added.connect(getattr(self, f"_add_{which}"))
             self.views[which].waypoint_removed.connect(getattr(self, f"_remove_{which}"))
+        split.setStretchFactor(0, 3)  # the left/right overlap is tall and narrow
+        split.setStretchFactor(1, 2)
         lay.addWidget(split, 1)
         row = QHBoxLayout()
         self.clear_button = QPushButton("Clear waypoints")
@@ -232,10 +199,10 @@ class OverlapPanel(QWidget):
             return
         reg = s.regions
         self.views["horizontal"].show_overlap(
-            reg["R_R"], reg["R_L"], s.errors["horizontal"], stacked=False, names=("R_R", "R_L", "E")
+            reg["R_R"], reg["R_L"], s.errors["horizontal"], stacked=False
         )
         self.views["vertical"].show_overlap(
-            reg["R_B"], reg["R_T"], s.errors["vertical"], stacked=True, names=("R_B", "R_T", "E")
+            reg["R_B"], reg["R_T"], s.errors["vertical"], stacked=True
         )
         for which, v in self.views.items():
             v.set_path(s.paths[which])

@@ -9,7 +9,7 @@ block's sample window, its placed pixels and its overlap error map, with the sea
 from __future__ import annotations
 
 import numpy as np
-from PySide6.QtCore import QRectF, Qt, Slot
+from PySide6.QtCore import QRectF, Qt, QTimer, Slot
 from PySide6.QtGui import QColor, QImage, QPainter
 from PySide6.QtWidgets import (
     QGraphicsItem,
@@ -95,6 +95,10 @@ class QuiltView(QWidget):
         )
         self.info.setWordWrap(True)
         self.selected: int | None = None
+        self._inspect_timer = QTimer(self)
+        self._inspect_timer.setSingleShot(True)
+        self._inspect_timer.setInterval(0)
+        self._inspect_timer.timeout.connect(self._inspect_newest)
         bar = QHBoxLayout()
         bar.setContentsMargins(4, 2, 4, 2)
         if run_action is not None:
@@ -194,6 +198,7 @@ class QuiltView(QWidget):
         self.block_rect.set_rect(c, r, w, h)  # the newest block
         self.block_rect.show()
         self.counter.setText(f"{index + 1} blocks placed")
+        self._inspect_timer.start()  # the inspector follows the newest block, once per frame
 
     @Slot()
     def _on_finished(self) -> None:
@@ -209,6 +214,11 @@ class QuiltView(QWidget):
         self.select(len(self.doc.quilt_blocks) - 1 if self.doc.quilt_blocks else None)
 
     # ------------------------------------------------------------------ inspection
+    @Slot()
+    def _inspect_newest(self) -> None:
+        if self.doc.quilt_blocks and self.doc.quilt_result is None:
+            self.select(len(self.doc.quilt_blocks) - 1)
+
     @Slot(object, object)
     def _on_output_clicked(self, px, _modifiers) -> None:
         self.select(self.doc.block_at(*px))
@@ -241,9 +251,7 @@ class QuiltView(QWidget):
         window = self.doc.source.main[y : y + sh, x : x + sw][:h, :w]
         placed = out[np.ix_((r + np.arange(h)) % H, (c + np.arange(w)) % W)]
         error = np.zeros((h, w), np.float32) if rec.error is None else np.asarray(rec.error)
-        self.inspector.show_overlap(
-            window, placed, error, stacked=False, names=("sample", "placed", "error")
-        )
+        self.inspector.show_overlap(window, placed, error, stacked=False)
         self.inspector.set_path(np.asarray(rec.path) if len(rec.path) else None)
         self.source_rect.set_rect(x, y, sw, sh)
         self.source_rect.show()

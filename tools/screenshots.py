@@ -1,0 +1,114 @@
+"""Drive the editor through the tile-set workflow and quilting, saving screenshots to docs/.
+
+Run under Xvfb so real window-system rendering is used:
+
+    xvfb-run -s "-screen 0 1600x1000x24" python tools/screenshots.py
+
+Writes docs/template.png, docs/template_400.png, docs/candidates.png, docs/preview.png,
+docs/quilting.png and docs/export.png.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+
+def main() -> int:
+    from PySide6.QtCore import QSettings
+
+    from quilt_gui.app import make_app
+
+    app = make_app(theme="dark")
+    QSettings.setDefaultFormat(QSettings.Format.IniFormat)
+    QSettings.setPath(
+        QSettings.Format.IniFormat,
+        QSettings.Scope.UserScope,
+        tempfile.mkdtemp(prefix="quilt_shots_"),
+    )
+    from quilt_gui.main_window import MainWindow
+    from quilt_gui.responsiveness import wait_until
+
+    out = ROOT / "docs"
+    out.mkdir(exist_ok=True)
+    w = MainWindow()
+    w.ask_save_changes = lambda: "discard"
+    w.resize(1600, 1000)
+    w.show()
+    w.open_initial(None)
+    idle = lambda: w.doc.has_source and not w.pipeline.busy()  # noqa: E731
+    wait_until(idle)
+    doc = w.doc
+
+    def shot(widget, name: str) -> None:
+        app.processEvents()
+        widget.grab().save(str(out / name))
+        print("wrote", out / name)
+
+    # -- template step: rectangle, shaded overlaps, heat overlays, seams, a waypoint
+    w.act_find.trigger()
+    wait_until(idle)
+    x, y, tw, th = doc.template_rect
+    ov = doc.params["overlap"]
+    doc.add_waypoint("horizontal", (th // 2, ov // 2))
+    wait_until(idle)
+    w.message_bar.dismiss()
+    v = w.source_view
+    v.set_zoom(2.0)
+    v.center_on_pixel(y + th / 2 + ov / 2, x + tw / 2 + ov / 2)
+    w.overlap_panel.views["horizontal"].fit()
+    w.overlap_panel.views["vertical"].fit()
+    shot(w, "template.png")
+    v.set_zoom(4.0)  # pixel alignment of the overlays at 400 %
+    v.center_on_pixel(y + th // 2, x + ov // 2)
+    shot(v.viewport(), "template_400.png")
+    v.fit()
+
+    # -- candidates gallery with picks
+    w.act_generate.trigger()
+    wait_until(idle)
+    doc.set_picks([1, 4, 6, 9, 13])
+    w.gallery.setCurrentIndex(w.gallery.model().index(4))
+    w.open_candidate(4).move(w.geometry().right() - 660, w.geometry().top() + 60)
+    wait_until(idle)
+    w.message_bar.dismiss()
+    shot(w, "candidates.png")
+    shot(w._dialogs[4], "candidate.png")
+    w._dialogs[4].close()
+
+    # -- preview
+    w.tabs.setCurrentWidget(w.preview_view)
+    w.preview_view.set_grid(True)
+    wait_until(idle)
+    w.preview_view.canvas.fit()
+    shot(w, "preview.png")
+    w.preview_view.set_grid(False)
+
+    # -- quilting, caught in progress
+    doc.set_params({"out_width": 768, "out_height": 512, "block": 48})
+    w.act_quilt.trigger()
+    wait_until(lambda: len(doc.quilt_blocks) >= 60)
+    shot(w, "quilting.png")
+    wait_until(idle)
+    w.quilt_view.select(min(57, len(doc.quilt_blocks) - 1))
+    w.message_bar.dismiss()
+    shot(w, "quilting_inspect.png")
+
+    # -- export dialog
+    w.tabs.setCurrentWidget(w.source_view)
+    w.export_dialog()
+    dlg = w._export_dialog
+    dlg.folder.setText(os.path.join(tempfile.gettempdir(), "cobblestones_export"))
+    shot(dlg, "export.png")
+    dlg.close()
+    w.close()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
