@@ -138,7 +138,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         type=_size,
         default=None,
         metavar="N|HxW",
-        help="largest tile (default: half the source's shorter side)",
+        help="largest tile (default: --tile-min if given, else half the source's shorter side)",
     )
     p.add_argument(
         "--rect",

@@ -208,3 +208,39 @@ def test_installed_command_runs(src, tmp_path):
     )
     assert r.returncode == 0, r.stderr
     assert "candidate" in r.stderr and (out / "tile_001.png").exists()
+
+
+def test_fixed_rect_and_colour_exclusion(src, tmp_path):
+    out = tmp_path / "rect"
+    assert (
+        main(
+            [
+                "tileset",
+                str(src["rgb8"]),
+                "--out",
+                str(out),
+                "--candidates",
+                "2",
+                "--rect",
+                "10,12,50,48",
+                "--overlap",
+                "6",
+                "--patch-overlap",
+                "5",
+                "--exclude-color",
+                "0:0.15",
+            ]
+        )
+        == 0
+    )
+    man = json.loads((out / "manifest.json").read_text())
+    assert man["template"]["rect"] == [10, 12, 50, 48] and man["template"]["cost"] is None
+    assert man["parameters"]["patch_overlap"] == 5
+    assert png(out / "template.png").shape == (48, 50, 3)
+    S = png(src["rgb8"]).astype(np.float32) / 255
+    dark = np.all(S <= 0.15, axis=2)
+    assert dark.sum() > 100
+    for t in man["tiles"]:
+        x, y, w, h = t["source_rect"]
+        assert not dark[y : y + h, x : x + w].any()
+    assert main(["tileset", str(src["rgb8"]), "--out", str(out), "--rect", "1,2,3"]) == 1
