@@ -36,7 +36,7 @@ from engine.project import (
     recovery_path,
     save_project,
 )
-from quilt_gui import jobs, settings
+from quilt_gui import jobs, params, settings
 from quilt_gui.app import APP_NAME, apply_theme
 from quilt_gui.document import Document, Source, safe_name
 from quilt_gui.imaging import pixel_text
@@ -73,6 +73,7 @@ class MainWindow(QMainWindow):
         self.setObjectName("MainWindow")
         self.setAcceptDrops(True)
         self.doc = Document(self)
+        self.doc.params = params.coerce_all(settings.get("parameters"))  # the last used options
         self.jobs = jobs.manager()
         self.pipeline = Pipeline(self.doc, self.jobs, self)
         self.messages: list[tuple[str, str]] = []  # (level, text) log, newest last
@@ -826,6 +827,7 @@ class MainWindow(QMainWindow):
         self.recovery_file().unlink(missing_ok=True)
         settings.set("window_geometry", self.saveGeometry())
         settings.set("window_state", self.saveState())
+        settings.set("parameters", self.doc.params)
         for dlg in self._dialogs.values():
             dlg.close()
         event.accept()

@@ -19,7 +19,7 @@ from PySide6.QtCore import (
     Signal,
     Slot,
 )
-from PySide6.QtGui import QAction, QColor, QFont, QPainter, QPen, QPixmap
+from PySide6.QtGui import QAction, QColor, QFont, QGuiApplication, QPainter, QPen, QPixmap
 from PySide6.QtWidgets import QListView, QMenu, QStyle, QStyledItemDelegate
 
 from quilt_gui import settings
@@ -100,13 +100,16 @@ class CandidateModel(QAbstractListModel):
         key = id(entry)
         pm = self._thumbs.get(key)
         if pm is None:
+            dpr = QGuiApplication.instance().devicePixelRatio()  # crisp on high-DPI screens
+            side = int(round(self.thumb * dpr))
             img = to_qimage(entry.tile).scaled(
-                self.thumb,
-                self.thumb,
+                side,
+                side,
                 Qt.AspectRatioMode.KeepAspectRatio,
                 Qt.TransformationMode.SmoothTransformation,
             )
             pm = QPixmap.fromImage(img)
+            pm.setDevicePixelRatio(dpr)
             self._thumbs[key] = pm
         return pm
 
@@ -164,7 +167,8 @@ class CandidateDelegate(QStyledItemDelegate):
         painter.fillRect(r, pal.highlight() if selected else pal.base())
         pm = index.data(Qt.ItemDataRole.DecorationRole)
         if isinstance(pm, QPixmap):
-            x = r.x() + (r.width() - pm.width()) // 2
+            size = pm.deviceIndependentSize()
+            x = r.x() + int(r.width() - size.width()) // 2
             painter.drawPixmap(x, r.y() + 3, pm)
         text_rect = QRect(r.x(), r.bottom() - 20, r.width(), 20)
         painter.setPen(pal.highlightedText().color() if selected else pal.text().color())

@@ -1,0 +1,82 @@
+"""Material maps through the editor, per-tile preview weights, persisted options."""
+
+from __future__ import annotations
+
+import numpy as np
+from PIL import Image
+
+from engine.materials import decode_normals
+from quilt_gui import settings
+from tests.gui.helpers import make_window, open_sample, wait_idle
+
+
+def normal_map_of(gray: np.ndarray) -> np.ndarray:
+    """A plausible tangent-space normal map (uint8 RGB) from a height field."""
+    gy, gx = np.gradient(gray.astype(np.float64) * 4.0)
+    n = np.stack([-gx, -gy, np.ones_like(gx)], axis=2)
+    n /= np.linalg.norm(n, axis=2, keepdims=True)
+    return np.round((n * 0.5 + 0.5) * 255).astype(np.uint8)
+
+
+def test_attached_normal_map_follows_every_cut_and_exports(qtbot, tmp_path):
+    w = make_window(qtbot)
+    open_sample(qtbot, w)
+    src = w.doc.source.main
+    path = tmp_path / "cobbles_normal.png"
+    Image.fromarray(normal_map_of(src.mean(axis=2))).save(path)
+    with qtbot.waitSignal(w.doc.maps_changed, timeout=5000):
+        w.attach_map(str(path))
+    assert list(w.doc.source.maps) == ["albedo", "normal"]
+    assert w.doc.source.kinds["normal"] == "normal"
+    w.doc.set_template_rect((150, 120, 128, 112))
+    wait_idle(qtbot, w)
+    s = w.doc.seamless
+    assert "normal" in s.maps and s.maps["normal"].shape == s.tile.shape
+    w.doc.set_param("n_candidates", 4)
+    w.act_generate.trigger()
+    wait_idle(qtbot, w)
+    for e in w.doc.candidates:
+        assert set(e.maps) == {"albedo", "normal"}
+        v = decode_normals(e.maps["normal"])
+        assert np.allclose(np.linalg.norm(v, axis=2), 1.0, atol=0.02)
+    w.doc.set_picks([0, 2])
+    wait_idle(qtbot, w)
+    w.export_dialog()
+    dlg = w._export_dialog
+    assert dlg.normal.isEnabled()
+    dlg.folder.setText(str(tmp_path / "out"))
+    with qtbot.waitSignal(dlg.exported, timeout=20_000):
+        dlg.export()
+    assert len(list((tmp_path / "out").glob("*_normal.png"))) >= 2
+    # a map of the wrong size is refused with a message naming it
+    wrong = tmp_path / "wrong_roughness.png"
+    Image.fromarray(np.zeros((10, 12), np.uint8)).save(wrong)
+    w.attach_map(str(wrong))
+    qtbot.waitUntil(lambda: "wrong_roughness.png" in w.last_message("error"), timeout=5000)
+    assert list(w.doc.source.maps) == ["albedo", "normal"]
+
+
+def test_preview_weight_zero_removes_a_tile_from_the_layout(qtbot):
+    w = make_window(qtbot)
+    open_sample(qtbot, w)
+    w.doc.set_template_rect((150, 120, 128, 112))
+    w.doc.set_param("n_candidates", 4)
+    wait_idle(qtbot, w)
+    w.act_generate.trigger()
+    wait_idle(qtbot, w)
+    w.doc.set_picks([0, 1, 2])
+    wait_idle(qtbot, w)
+    assert set(np.unique(w.doc.layout)) == {0, 1, 2}
+    w.doc.set_weight(1, 0.0)  # candidate 1 is the second picked tile (id 1)
+    wait_idle(qtbot, w)
+    assert 1 not in set(np.unique(w.doc.layout))
+
+
+def test_options_persist_between_sessions(qtbot):
+    w = make_window(qtbot)
+    w.doc.set_param("overlap", 21)
+    w.doc.mark_saved()
+    w.close()
+    assert settings.get("parameters")["overlap"] == 21
+    w2 = make_window(qtbot)
+    assert w2.doc.params["overlap"] == 21 and w2.params_panel.value("overlap") == 21
