@@ -237,8 +237,11 @@ def error_floor(sample: np.ndarray) -> float:
     return float(max((dx + dy) / 2, 1e-12))
 
 
-ZERO_ERROR_FRACTION = 0.01
-"""An overlap error below this fraction of ``error_floor · |M| · C`` counts as an exact copy."""
+ZERO_ERROR_FRACTION = 0.5
+"""δ of ALGORITHMS §2.2 ("if e_min ≈ 0 use e_min + δ") as a fraction of ``error_floor · |M| · C``:
+a window whose overlap differs per pixel by half the texture's own adjacent-pixel variation is as
+good as an exact copy. (On the bundled samples the best non-copy window of a 32 px block scores
+about 1–4 × ``error_floor`` per pixel; 8–38 % of the blocks have an exact copy.)"""
 
 
 def select_within_tolerance(errors: np.ndarray, *, tolerance: float, zero_level: float, rng):

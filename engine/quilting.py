@@ -1138,8 +1138,9 @@ def iter_quilt(
         See the module docstring.
     tolerance : float
         ``"best"``: draw among windows within ``(1 + tolerance) × e_min`` (0.1 in §2.2). When
-        ``e_min`` is about 0 (an exact copy exists), ``e_min`` is replaced by a small floor
-        (1 % of the sample's adjacent-pixel squared difference per overlap pixel and channel).
+        ``e_min`` is about 0 (an exact copy exists), ``e_min`` is replaced by a floor δ:
+        half the sample's mean squared adjacent-pixel difference per overlap pixel and channel
+        (:data:`engine.matching.ZERO_ERROR_FRACTION`).
     candidates : int, optional
         ``"sampled"``: windows drawn per block (default 200); ``mode="fast"``: windows re-ranked
         exactly (default 32).

@@ -1,0 +1,343 @@
+"""``quilt-studio synth SAMPLE --size WxH --block B -o OUT.png``: image quilting from a sample.
+
+Selection (``--select``), boundary (``--seam``), blending, exclusion, tileable output and the
+fast search all map onto :func:`engine.quilting.iter_quilt`. Progress goes to stderr; the output
+keeps the sample's bit depth (16-bit in, 16-bit out). ``--save-seams F`` writes the cuts: a JSON
+record of every block for ``.json``, otherwise the output with every cut drawn in red.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from engine.cli.tileset import _colour_range, load_source
+
+
+def parse_wxh(text: str) -> tuple[int, int]:
+    """``WxH`` (width x height) -> (height, width)."""
+    m = re.fullmatch(r"\s*(\d+)\s*[xX]\s*(\d+)\s*", text)
+    if not m:
+        raise argparse.ArgumentTypeError(f"expected WxH like 512x384, got {text!r}")
+    w, h = int(m.group(1)), int(m.group(2))
+    if w < 1 or h < 1:
+        raise argparse.ArgumentTypeError(f"width and height must be >= 1, got {text!r}")
+    return h, w
+
+
+def int_at_least(minimum: int):
+    def parse(text: str) -> int:
+        try:
+            v = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
+        if v < minimum:
+            raise argparse.ArgumentTypeError(f"must be >= {minimum}, got {v}")
+        return v
+
+    return parse
+
+
+def non_negative_float(text: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not v >= 0:
+        raise argparse.ArgumentTypeError(f"must be >= 0, got {text!r}")
+    return v
+
+
+def seam_option(text: str):
+    """``KEY=VALUE``; the value is read as an int, a float, or kept as text."""
+    key, sep, value = text.partition("=")
+    if not sep or not re.fullmatch(r"[a-z_]+", key):
+        raise argparse.ArgumentTypeError(f"expected KEY=VALUE like o_max=5, got {text!r}")
+    for cast in (int, float):
+        try:
+            return key, cast(value)
+        except ValueError:
+            pass
+    return key, value
+
+
+def add_cut_arguments(p: argparse.ArgumentParser, *, seam_default: str = "dp") -> None:
+    """Options shared by ``synth`` and ``transfer``: the cut, blending, search, seed, threads."""
+    from engine.blend import BLEND_MODES
+    from engine.errormap import METRICS
+    from engine.quilting import SEAMS
+
+    p.add_argument(
+        "--seam",
+        choices=SEAMS,
+        default=seam_default,
+        help=f"boundary: straight overlap or a seam method (default {seam_default})",
+    )
+    p.add_argument(
+        "--seam-option",
+        type=seam_option,
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="option of the seam method, e.g. o_max=5, max_run=3, variant=lm",
+    )
+    p.add_argument(
+        "--blend", choices=BLEND_MODES, default="none", help="softening of the cut (default none)"
+    )
+    p.add_argument(
+        "--blend-width",
+        type=non_negative_float,
+        default=4.0,
+        metavar="PX",
+        help="feather width in pixels (default 4)",
+    )
+    p.add_argument("--rho", type=int_at_least(0), default=3, help="adaptive blending ρ (default 3)")
+    p.add_argument(
+        "--metric", choices=METRICS, default="ssd", help="error map the cut runs on (default ssd)"
+    )
+    p.add_argument(
+        "--tolerance",
+        type=non_negative_float,
+        default=0.1,
+        help="draw among windows within 1+T of the best (default 0.1)",
+    )
+    p.add_argument(
+        "--exclude-color",
+        type=_colour_range,
+        default=None,
+        metavar="LO:HI",
+        help="never copy sample colours in [LO, HI] per channel, e.g. 0,0,0:0.2,0.2,0.3",
+    )
+    p.add_argument(
+        "--exclude-mask",
+        default=None,
+        metavar="FILE",
+        help="image whose non-black pixels mark sample pixels not to copy",
+    )
+    p.add_argument("--seed", type=int_at_least(0), default=0, help="random seed (default 0)")
+    p.add_argument(
+        "--threads", type=int_at_least(1), default=None, help="worker threads (default: every core)"
+    )
+    p.add_argument("-o", "--output", required=True, metavar="OUT.png", help="output image")
+
+
+def add_parser(subparsers) -> argparse.ArgumentParser:
+    from engine.quilting import MODES, SELECTIONS
+
+    p = subparsers.add_parser(
+        "synth",
+        help="synthesize a larger texture from a sample by image quilting",
+        description="Image quilting (Efros & Freeman; Long & Mould; Bhatia; CS194; Core S2): "
+        "blocks of SAMPLE placed with overlaps and cut along minimum-error seams.",
+    )
+    p.add_argument("sample", metavar="SAMPLE", help="sample texture (PNG, JPEG, TIFF, BMP, WebP)")
+    p.add_argument("--size", type=parse_wxh, required=True, metavar="WxH", help="output size")
+    p.add_argument("--block", type=int_at_least(2), required=True, metavar="B", help="block size")
+    p.add_argument(
+        "--overlap",
+        type=int_at_least(0),
+        default=None,
+        metavar="O",
+        help="overlap (default B/6; B/2 for minimax; Bhatia's cut band B/4)",
+    )
+    p.add_argument(
+        "--select", choices=SELECTIONS, default="best", help="block selection (default best)"
+    )
+    p.add_argument(
+        "--candidates",
+        type=int_at_least(1),
+        default=None,
+        metavar="K",
+        help="windows per block for --select sampled (default 200), or re-ranked "
+        "exactly in --mode fast (default 32)",
+    )
+    p.add_argument(
+        "--mode",
+        choices=MODES,
+        default="exact",
+        help="exhaustive FFT search or the fast approximate one (default exact)",
+    )
+    p.add_argument(
+        "--tileable", action="store_true", help="wrap-around overlaps: the output tiles seamlessly"
+    )
+    p.add_argument(
+        "--adaptive-threshold",
+        type=non_negative_float,
+        default=None,
+        metavar="T",
+        help="split blocks whose best overlap error per pixel and channel exceeds T",
+    )
+    p.add_argument(
+        "--min-block",
+        type=int_at_least(2),
+        default=None,
+        metavar="B",
+        help="smallest block of adaptive splitting",
+    )
+    add_cut_arguments(p)
+    p.add_argument(
+        "--save-seams",
+        default=None,
+        metavar="F",
+        help="write the cuts: F.json (every block's record) or an image (cuts in red)",
+    )
+    p.set_defaults(func=run)
+    return p
+
+
+class ProgressPrinter:
+    """Progress events as stderr lines, at most a few per second (and the last one)."""
+
+    def __init__(self, command: str):
+        self.command = command
+        self.t0 = time.perf_counter()
+        self.last = -1.0
+
+    def __call__(self, ev) -> None:
+        now = time.perf_counter() - self.t0
+        if ev.done < ev.total and now - self.last < 0.25:
+            return
+        self.last = now
+        print(
+            f"[{now:7.2f}s] {self.command}: {ev.done}/{ev.total} {ev.message}",
+            file=sys.stderr,
+            flush=True,
+        )
+
+
+def drive(gen, printer):
+    """Run an engine generator, printing its Progress events; returns its value."""
+    from engine.events import Progress
+
+    while True:
+        try:
+            ev = next(gen)
+        except StopIteration as stop:
+            return stop.value
+        if isinstance(ev, Progress):
+            printer(ev)
+
+
+def load_sample_and_exclusion(args):
+    """(pixels, bit depth, excluded mask or None) from SAMPLE, --exclude-color/--exclude-mask."""
+    from engine.exclusion import exclusion_mask
+    from engine.io import load_image
+
+    pixels, depth = load_source(args.sample)
+    excluded = None
+    if args.exclude_color is not None or args.exclude_mask:
+        painted = None
+        if args.exclude_mask:
+            m = load_image(args.exclude_mask).pixels
+            if m.shape[:2] != pixels.shape[:2]:
+                raise ValueError(
+                    f"{args.exclude_mask}: the mask is {m.shape[1]}x{m.shape[0]}, the sample "
+                    f"{pixels.shape[1]}x{pixels.shape[0]}"
+                )
+            painted = m.max(axis=2) > 0
+        excluded = exclusion_mask(pixels, color_range=args.exclude_color, painted=painted)
+    return pixels, depth, excluded
+
+
+def start(iter_fn, *args, **kwargs):
+    """Call an engine ``iter_*`` function; a bad ``--seam-option`` (TypeError there) becomes a
+    one-line ValueError for the CLI."""
+    try:
+        return iter_fn(*args, **kwargs)
+    except TypeError as exc:
+        raise ValueError(str(exc)) from None
+
+
+def cut_options(args) -> dict:
+    return dict(
+        seam=args.seam,
+        blend=args.blend,
+        blend_width=args.blend_width,
+        rho=args.rho,
+        metric=args.metric,
+        tolerance=args.tolerance,
+        rng=args.seed,
+        threads=args.threads,
+        **dict(args.seam_option),
+    )
+
+
+def run(args) -> int:
+    from engine.io import save_image
+    from engine.quilting import grid_border_ratio, iter_quilt
+
+    sample, depth, excluded = load_sample_and_exclusion(args)
+    gen = start(
+        iter_quilt,
+        sample,
+        args.size,
+        block=args.block,
+        overlap=args.overlap,
+        select=args.select,
+        candidates=args.candidates,
+        mode=args.mode,
+        tileable=args.tileable,
+        adaptive_threshold=args.adaptive_threshold,
+        min_block=args.min_block,
+        excluded=excluded,
+        **cut_options(args),
+    )
+    res = drive(gen, ProgressPrinter("synth"))
+    save_image(args.output, res.image, bit_depth=depth)
+    if args.save_seams:
+        save_seams(args.save_seams, res)
+    ratio = grid_border_ratio(res) if min(res.image.shape[:2]) > max(res.step) else float("nan")
+    print(
+        f"quilt-studio synth: wrote {args.output} ({res.image.shape[1]}x{res.image.shape[0]}, "
+        f"{depth}-bit, {len(res.blocks)} blocks, grid border ratio {ratio:.3f})",
+        file=sys.stderr,
+    )
+    return 0
+
+
+def save_seams(path: str, res) -> None:
+    """Every block's cut: JSON records, or the output with the cut pixels in red."""
+    from engine.io import save_image
+
+    p = Path(path)
+    if p.suffix.lower() == ".json":
+        blocks = [
+            {
+                "index": r.index,
+                "position": list(r.position),
+                "size": list(r.size),
+                "source": list(r.source),
+                "arms": list(r.arms),
+                "criterion": None if np.isnan(r.criterion) else r.criterion,
+                "peak": None if np.isnan(r.peak) else r.peak,
+                "match_error": None if np.isnan(r.match_error) else r.match_error,
+                "depth": r.depth,
+                "path": np.asarray(r.path).tolist(),
+            }
+            for r in res.blocks
+        ]
+        doc = {
+            "block": list(res.block),
+            "overlap": res.overlap,
+            "select": res.select,
+            "seam": res.seam,
+            "blocks": blocks,
+        }
+        p.parent.mkdir(parents=True, exist_ok=True)
+        p.write_text(json.dumps(doc))
+        return
+    img = np.repeat(res.image[..., :1], 3, axis=2) if res.image.shape[2] < 3 else res.image[..., :3]
+    img = img.copy()
+    h, w = img.shape[:2]
+    for r in res.blocks:
+        if len(r.path):
+            rows = (r.path[:, 0] + r.position[0]) % h
+            cols = (r.path[:, 1] + r.position[1]) % w
+            img[rows, cols] = (1.0, 0.0, 0.0)
+    save_image(p, img)
