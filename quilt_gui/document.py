@@ -103,6 +103,8 @@ class Document(QObject):
     quilt_reset = Signal()  # a synthesis started (or was cleared)
     block_placed = Signal(int)  # index into quilt_blocks
     quilt_finished = Signal()
+    quilt_iteration = Signal(int)  # a texture-transfer pass finished (its number)
+    target_changed = Signal()
 
     def __init__(self, parent=None) -> None:
         super().__init__(parent)
@@ -121,7 +123,9 @@ class Document(QObject):
         self.project_path: str | None = None
         self.quilt_output: np.ndarray | None = None  # being synthesized, (H, W, C)
         self.quilt_blocks: list = []  # engine BlockRecord per placed block
-        self.quilt_result = None  # engine QuiltResult when finished
+        self.quilt_result = None  # engine QuiltResult / TransferResult when finished
+        self.transfer_target: np.ndarray | None = None  # the image a transfer imitates
+        self.transfer_target_path = ""
         self._dirty = False  # changes that are not undo steps (streamed results)
         self._was_modified = False
         self.undo_stack.cleanChanged.connect(self._on_clean_changed)
@@ -328,6 +332,17 @@ class Document(QObject):
         self.quilt_blocks.append(record)
         self.block_placed.emit(len(self.quilt_blocks) - 1)
         return len(self.quilt_blocks) - 1
+
+    def finish_iteration(self, event) -> None:
+        """A transfer pass ended: the output is its image; the next pass places new blocks."""
+        self.quilt_output = np.array(event.image, dtype=np.float32)
+        self.quilt_blocks = []
+        self.quilt_iteration.emit(int(event.iteration))
+
+    def set_transfer_target(self, pixels: np.ndarray | None, path: str = "") -> None:
+        self.transfer_target = pixels
+        self.transfer_target_path = path
+        self.target_changed.emit()
 
     def finish_quilt(self, result) -> None:
         self.quilt_result = result

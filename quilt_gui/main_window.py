@@ -187,6 +187,18 @@ class MainWindow(QMainWindow):
             "Ctrl+Return",
             "Quilt the source into a texture of the output size (Quilting tab)",
         )
+        self.act_load_target = A(
+            "Load transfer &target…",
+            self.target_dialog,
+            None,
+            "Open the image whose layout texture transfer imitates",
+        )
+        self.act_transfer = A(
+            "Texture &transfer",
+            self.run_transfer,
+            "Ctrl+Shift+Return",
+            "Re-create the target image with the source's texture",
+        )
         self.act_cancel = A(
             "&Cancel running job", self.jobs.stop_all, "Esc", "Stop the running computation"
         )
@@ -205,7 +217,7 @@ class MainWindow(QMainWindow):
         self.tabs.setDocumentMode(True)
         self.tabs.addTab(self.source_view, "Source")
         self.tabs.addTab(self.preview_view, "Preview")
-        self.quilt_view = QuiltView(doc, self.act_quilt)
+        self.quilt_view = QuiltView(doc, (self.act_quilt, self.act_load_target, self.act_transfer))
         self.tabs.addTab(self.quilt_view, "Quilting")
         self.message_bar = MessageBar()
         central = QWidget()
@@ -222,6 +234,7 @@ class MainWindow(QMainWindow):
                 "Candidates": [self.act_generate],
                 "Preview": [self.act_reroll_layout],
                 "Quilting": [self.act_quilt],
+                "Transfer": [self.act_load_target, self.act_transfer],
             },
         )
         self.params_panel.show_groups(TILESET_GROUPS)
@@ -290,7 +303,7 @@ class MainWindow(QMainWindow):
         m.addSeparator()
         m.addAction(self.act_cancel)
         m = mb.addMenu("&Quilting")
-        m.addAction(self.act_quilt)
+        m.addActions([self.act_quilt, self.act_load_target, self.act_transfer])
         m = mb.addMenu("&Help")
         m.addAction("&Keyboard and mouse", self.show_help)
 
@@ -337,6 +350,7 @@ class MainWindow(QMainWindow):
             self.tile_view.canvas,
             *self.overlap_panel.views.values(),
             self.quilt_view.sample,
+            self.quilt_view.target,
             self.quilt_view.output,
             self.quilt_view.inspector,
         ]
@@ -722,6 +736,36 @@ class MainWindow(QMainWindow):
         self.tabs.setCurrentWidget(self.quilt_view)
         self.pipeline.run_quilt()
 
+    def run_transfer(self, *_args) -> None:
+        self.tabs.setCurrentWidget(self.quilt_view)
+        self.pipeline.run_transfer()
+
+    def target_dialog(self, *_args) -> None:
+        path = self.ask_open_path("Load transfer target", IMAGE_FILTER, "last_open_dir")
+        if path:
+            self.load_target(path)
+
+    def load_target(self, path: str) -> None:
+        """Load the texture-transfer target in the background."""
+        self.jobs.start(
+            "open_target",
+            load_image,
+            path,
+            label=f"Opening {Path(path).name}",
+            pass_cancel=False,
+            on_done=partial(self._on_target_loaded, path),
+            on_error=partial(self._on_open_error, path),
+        )
+
+    def _on_target_loaded(self, path: str, loaded) -> None:
+        self.doc.set_transfer_target(loaded.pixels, path)
+        h, w = loaded.pixels.shape[:2]
+        self.show_message(
+            "info",
+            f"Transfer target {Path(path).name} ({w}×{h}) loaded. Texture "
+            "transfer (Ctrl+Shift+Return) re-creates it with the source.",
+        )
+
     @Slot(int)
     def _on_tab_changed(self, _index: int) -> None:
         quilting = self.tabs.currentWidget() is self.quilt_view
@@ -806,7 +850,15 @@ class MainWindow(QMainWindow):
     @Slot()
     def _update_actions(self, *_args) -> None:
         has = self.doc.has_source
-        for a in (self.act_find, self.act_save, self.act_save_as, self.act_attach, self.act_quilt):
+        for a in (
+            self.act_find,
+            self.act_save,
+            self.act_save_as,
+            self.act_attach,
+            self.act_quilt,
+            self.act_load_target,
+            self.act_transfer,
+        ):
             a.setEnabled(has)
         self.act_generate.setEnabled(has and self.doc.seamless is not None)
         self.act_export.setEnabled(bool(self.doc.candidates))

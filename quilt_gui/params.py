@@ -395,11 +395,19 @@ PARAMS: tuple[Param, ...] = (
     ),
     _P("q_seed", 1, "Seed", "Random seed of the synthesis.", "Quilting", 0, 2**31 - 1),
     _P(
+        "alpha_ramp",
+        True,
+        "Ramp alpha",
+        "Texture transfer: alpha rises from 0.1 to 0.9 over the iterations (Efros & Freeman); "
+        "off: the fixed alpha below in every iteration.",
+        "Transfer",
+    ),
+    _P(
         "alpha",
         0.5,
-        "Transfer alpha",
-        "Texture transfer: weight of the texture match against "
-        "the target correspondence (the first pass; iterations raise it).",
+        "Alpha",
+        "Texture transfer: weight of the texture match (overlap and previous iteration) against "
+        "the target correspondence (1 = plain quilting, 0 = only follow the target).",
         "Transfer",
         0.0,
         1.0,
@@ -413,6 +421,25 @@ PARAMS: tuple[Param, ...] = (
         "Transfer",
         1,
         8,
+    ),
+    _P(
+        "correspondence",
+        "luminance",
+        "Correspondence",
+        "What is matched against the target: its luminance, or its luminance blurred by sigma.",
+        "Transfer",
+        choices=("luminance", "blurred"),
+    ),
+    _P(
+        "sigma",
+        2.0,
+        "Blur sigma",
+        "Gaussian blur of the blurred correspondence map (px).",
+        "Transfer",
+        0.5,
+        16.0,
+        step=0.5,
+        decimals=1,
     ),
     # fmt: on
 )

@@ -66,6 +66,7 @@ class Pipeline(QObject):
         self._quilt_timer.setInterval(0)
         self._quilt_timer.timeout.connect(self._restart_quilt)
         self._gen_old = ([], [])
+        self._quilt_mode = "quilt"  # what a parameter change restarts: "quilt" or "transfer"
         self._remake_text = ""
 
     # ------------------------------------------------------------------ helpers
@@ -448,6 +449,7 @@ class Pipeline(QObject):
         if doc.source is None:
             self.message.emit("warning", "Open a sample image first.")
             return None
+        self._quilt_mode = "quilt"
         p = doc.params
         shape = (int(p["out_height"]), int(p["out_width"]))
         doc.start_quilt(shape)
@@ -466,21 +468,58 @@ class Pipeline(QObject):
             **quilt_options(p),
         )
 
+    def run_transfer(self) -> jobs.Job | None:
+        """Texture transfer of the source onto the target's layout; passes stream in."""
+        doc = self.doc
+        if doc.source is None:
+            self.message.emit("warning", "Open a sample image first.")
+            return None
+        if doc.transfer_target is None:
+            self.message.emit("warning", "Load a target image first (Quilting ▸ Load target).")
+            return None
+        self._quilt_mode = "transfer"
+        p = doc.params
+        doc.start_quilt(doc.transfer_target.shape[:2])
+        opts = quilt_options(p)
+        for key in ("select", "candidates", "tileable", "adaptive_threshold", "min_block", "mode"):
+            opts.pop(key)
+        return self.jobs.start(
+            "quilt",
+            transfer_job,
+            doc.source.main,
+            doc.transfer_target,
+            label="Texture transfer",
+            exclude_color=p["exclude_color"],
+            exclude_tolerance=p["exclude_tolerance"],
+            alpha=None if p["alpha_ramp"] else p["alpha"],
+            iterations=p["iterations"],
+            correspondence=p["correspondence"],
+            sigma=p["sigma"],
+            on_event=self._on_quilt_event,
+            on_done=self._on_quilt_done,
+            on_error=self._on_quilt_error,
+            on_cancel=self._on_quilt_cancel,
+            **opts,
+        )
+
     def _on_quilt_event(self, event) -> None:
-        if (
-            hasattr(event, "record")
-            and hasattr(event, "pixels")
-            and self.doc.quilt_output is not None
-        ):
+        if self.doc.quilt_output is None:
+            return
+        if hasattr(event, "record") and hasattr(event, "pixels"):
             self.doc.place_block(event.record, np.asarray(event.pixels))
+        elif hasattr(event, "iteration") and hasattr(event, "image"):
+            self.doc.finish_iteration(event)
 
     def _on_quilt_done(self, result) -> None:
         self.doc.finish_quilt(result)
         h, w = result.image.shape[:2]
+        passes = getattr(result, "iterations", ())
+        what = (
+            f"in {len(passes)} transfer passes" if passes else f"from {len(result.blocks)} blocks"
+        )
         self.message.emit(
             "info",
-            f"Synthesized {w}×{h} from {len(result.blocks)} blocks. Click a "
-            "block to see its overlap, error map and seam.",
+            f"Synthesized {w}×{h} {what}. Click a block to see its overlap, error map and seam.",
         )
 
     def _on_quilt_error(self, exc) -> None:
@@ -491,7 +530,10 @@ class Pipeline(QObject):
 
     @Slot()
     def _restart_quilt(self) -> None:
-        self.run_quilt()
+        if self._quilt_mode == "transfer":
+            self.run_transfer()
+        else:
+            self.run_quilt()
 
     def reroll_layout(self) -> None:
         """A new random layout for the preview (one undo step: the layout seed changes)."""
@@ -569,13 +611,28 @@ def excluded_mask(sample: np.ndarray, color: str, tolerance: float):
     return exclusion_mask(sample, color_range=(lo, hi))
 
 
+def _job_mask(sample, color: str, tolerance: float):
+    mask = excluded_mask(sample, color, tolerance)
+    if mask is not None and mask.all():
+        raise ValueError("the excluded colour range covers the whole sample; lower the tolerance")
+    return mask
+
+
 def quilt_job(
     sample, out_shape, *, exclude_color: str, exclude_tolerance: float, cancel=None, **options
 ):
     """Worker body of a quilting run: exclusion mask, then the engine's event generator."""
     from engine.quilting import iter_quilt
 
-    mask = excluded_mask(sample, exclude_color, exclude_tolerance)
-    if mask is not None and mask.all():
-        raise ValueError("the excluded colour range covers the whole sample; lower the tolerance")
+    mask = _job_mask(sample, exclude_color, exclude_tolerance)
     return iter_quilt(sample, out_shape, excluded=mask, cancel=cancel, threads=2, **options)
+
+
+def transfer_job(
+    sample, target, *, exclude_color: str, exclude_tolerance: float, cancel=None, **options
+):
+    """Worker body of a texture transfer: exclusion mask, then the engine's generator."""
+    from engine.transfer import iter_transfer
+
+    mask = _job_mask(sample, exclude_color, exclude_tolerance)
+    return iter_transfer(sample, target, excluded=mask, cancel=cancel, threads=2, **options)

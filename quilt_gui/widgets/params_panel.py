@@ -50,7 +50,7 @@ SLIDERS = frozenset(
     }
 )
 TILESET_GROUPS = ("Template", "Seam", "Candidates", "Preview")
-QUILT_GROUPS = ("Quilting",)  # "Transfer" joins when engine.transfer lands
+QUILT_GROUPS = ("Quilting", "Transfer")
 
 
 class ParamsPanel(QScrollArea):

@@ -16,6 +16,7 @@ from PySide6.QtWidgets import (
     QHBoxLayout,
     QLabel,
     QSplitter,
+    QTabWidget,
     QToolButton,
     QVBoxLayout,
     QWidget,
@@ -67,10 +68,11 @@ def wrapped_pieces(start: int, size: int, total: int) -> list[tuple[int, int]]:
 class QuiltView(QWidget):
     """Sample | output, and the block inspector."""
 
-    def __init__(self, doc: Document, run_action=None, parent=None) -> None:
+    def __init__(self, doc: Document, actions=(), parent=None) -> None:
         super().__init__(parent)
         self.doc = doc
         self.sample = ImageCanvas()
+        self.target = ImageCanvas()
         self.output = ImageCanvas()
         self.raster = RasterItem()
         self.output.add_item(self.raster)
@@ -101,24 +103,29 @@ class QuiltView(QWidget):
         self._inspect_timer.timeout.connect(self._inspect_newest)
         bar = QHBoxLayout()
         bar.setContentsMargins(4, 2, 4, 2)
-        if run_action is not None:
+        for action in actions:
             b = QToolButton()
-            b.setDefaultAction(run_action)
+            b.setDefaultAction(action)
             b.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextOnly)
             bar.addWidget(b)
         self.counter = QLabel()
         bar.addWidget(self.counter, 1)
         top = QSplitter(Qt.Orientation.Horizontal)
-        for title, canvas in (
-            ("Sample (Ctrl+click: exclude a colour)", self.sample),
-            ("Output", self.output),
-        ):
-            box = QWidget()
-            bl = QVBoxLayout(box)
-            bl.setContentsMargins(0, 0, 0, 0)
-            bl.addWidget(QLabel(f"<b>{title}</b>"))
-            bl.addWidget(canvas, 1)
-            top.addWidget(box)
+        self.inputs = QTabWidget()
+        self.inputs.setDocumentMode(True)
+        self.inputs.addTab(self.sample, "Sample")
+        self.inputs.addTab(self.target, "Transfer target")
+        self.inputs.setTabToolTip(
+            0, "The texture blocks are copied from (Ctrl+click: exclude a colour)"
+        )
+        self.inputs.setTabToolTip(1, "Texture transfer imitates this image's layout")
+        top.addWidget(self.inputs)
+        box = QWidget()
+        bl = QVBoxLayout(box)
+        bl.setContentsMargins(0, 0, 0, 0)
+        bl.addWidget(QLabel("<b>Output</b>"))
+        bl.addWidget(self.output, 1)
+        top.addWidget(box)
         top.setSizes([350, 650])
         bottom = QWidget()
         bb = QVBoxLayout(bottom)
@@ -140,6 +147,8 @@ class QuiltView(QWidget):
         doc.quilt_reset.connect(self._on_reset)
         doc.block_placed.connect(self._on_block_placed)
         doc.quilt_finished.connect(self._on_finished)
+        doc.quilt_iteration.connect(self._on_iteration)
+        doc.target_changed.connect(self._on_target_changed)
         doc.params_changed.connect(self._on_params_changed)
         self._on_source_changed()
 
@@ -208,10 +217,29 @@ class QuiltView(QWidget):
         self.block_rect.hide()
         res = self.doc.quilt_result
         h, w = out.shape[:2]
-        self.counter.setText(
-            f"{w}×{h} from {len(res.blocks)} blocks ({res.select}, {res.seam} seams)"
+        passes = getattr(res, "iterations", ())
+        how = (
+            f"{len(passes)} transfer passes, correspondence error "
+            f"{passes[-1].correspondence_error:.4f}"
+            if passes
+            else f"{res.select}, {res.seam} seams"
         )
+        self.counter.setText(f"{w}×{h} from {len(res.blocks)} blocks ({how})")
         self.select(len(self.doc.quilt_blocks) - 1 if self.doc.quilt_blocks else None)
+
+    @Slot(int)
+    def _on_iteration(self, iteration: int) -> None:
+        """A transfer pass ended: show its image; the next pass paints over it."""
+        self.output.set_image(self.doc.quilt_output)
+        self.raster.reset(*self.doc.quilt_output.shape[:2])
+        self.select(None)
+        self.counter.setText(f"transfer pass {iteration} of {self.doc.params['iterations']} done")
+
+    @Slot()
+    def _on_target_changed(self) -> None:
+        self.target.set_image(self.doc.transfer_target, fit=True)
+        if self.doc.transfer_target is not None:
+            self.inputs.setCurrentWidget(self.target)
 
     # ------------------------------------------------------------------ inspection
     @Slot()

@@ -78,3 +78,33 @@ def test_excluded_colour_is_never_copied(qtbot):
         x, y, bw, bh = b.source
         assert not mask[y : y + bh, x : x + bw].any()
     assert sample.array is src
+
+
+def test_texture_transfer_streams_passes_and_follows_the_target(qtbot, tmp_path):
+    from PIL import Image
+
+    w = make_window(qtbot)
+    open_sample(qtbot, w)
+    yy, xx = np.mgrid[0:96, 0:128]
+    target = np.where((xx - 64) ** 2 + (yy - 48) ** 2 < 30**2, 230, 25).astype(np.uint8)
+    path = tmp_path / "disc.png"
+    Image.fromarray(target).save(path)
+    with qtbot.waitSignal(w.doc.target_changed, timeout=5000):
+        w.load_target(str(path))
+    assert w.quilt_view.target.array.shape[:2] == (96, 128)
+    w.doc.set_params({"block": 24, "iterations": 2})
+    passes = []
+    w.doc.quilt_iteration.connect(passes.append)
+    w.act_transfer.trigger()
+    wait_idle(qtbot, w)
+    res = w.doc.quilt_result
+    assert passes == [1, 2] and len(res.iterations) == 2
+    assert res.image.shape[:2] == (96, 128)
+    lum = res.image[:, :, :3].mean(axis=2)
+    inside = (xx - 64) ** 2 + (yy - 48) ** 2 < 20**2
+    outside = (xx - 64) ** 2 + (yy - 48) ** 2 > 40**2
+    assert lum[inside].mean() > lum[outside].mean() + 0.1  # the disc shows through
+    assert "transfer passes" in w.quilt_view.counter.text()
+    w.doc.set_param("alpha_ramp", False)  # a parameter change re-runs the transfer
+    wait_idle(qtbot, w)
+    assert w.doc.quilt_result is not res and len(w.doc.quilt_result.iterations) == 2
