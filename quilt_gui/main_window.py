@@ -441,27 +441,23 @@ class MainWindow(QMainWindow):
         if confirm and not self._confirm_discard():
             return
         if path.lower().endswith(PROJECT_SUFFIX):
-            self.jobs.start(
-                "open",
-                load_project,
-                path,
-                label=f"Opening {Path(path).name}",
-                pass_cancel=False,
-                on_done=partial(self._on_project_loaded, path),
-                on_error=partial(self._on_open_error, path),
-            )
+            self._read("open", load_project, path, self._on_project_loaded)
         else:
-            self.jobs.start(
-                "open",
-                load_image,
-                path,
-                label=f"Opening {Path(path).name}",
-                pass_cancel=False,
-                on_done=partial(self._on_image_loaded, path, remember),
-                on_error=partial(self._on_open_error, path),
-            )
+            self._read("open", load_image, path, partial(self._on_image_loaded, remember=remember))
 
-    def _on_image_loaded(self, path: str, remember: bool, loaded) -> None:
+    def _read(self, key: str, reader, path: str, on_done) -> None:
+        """Run ``reader(path)`` in the background; ``on_done(path, result)``; errors -> message."""
+        self.jobs.start(
+            key,
+            reader,
+            path,
+            label=f"Opening {Path(path).name}",
+            pass_cancel=False,
+            on_done=partial(on_done, path),
+            on_error=partial(self._on_open_error, path),
+        )
+
+    def _on_image_loaded(self, path: str, loaded, *, remember: bool) -> None:
         source = Source(
             maps={MAIN_MAP: loaded.pixels},
             paths={MAIN_MAP: loaded.path},
@@ -536,15 +532,7 @@ class MainWindow(QMainWindow):
         if not self.doc.has_source:
             self.show_message("warning", "Open a source image before attaching material maps.")
             return
-        self.jobs.start(
-            "attach",
-            load_image,
-            path,
-            label=f"Opening {Path(path).name}",
-            pass_cancel=False,
-            on_done=partial(self._on_map_loaded, path),
-            on_error=partial(self._on_open_error, path),
-        )
+        self._read("attach", load_image, path, self._on_map_loaded)
 
     def _on_map_loaded(self, path: str, loaded) -> None:
         kind = infer_kind(Path(path).stem)
@@ -747,15 +735,7 @@ class MainWindow(QMainWindow):
 
     def load_target(self, path: str) -> None:
         """Load the texture-transfer target in the background."""
-        self.jobs.start(
-            "open_target",
-            load_image,
-            path,
-            label=f"Opening {Path(path).name}",
-            pass_cancel=False,
-            on_done=partial(self._on_target_loaded, path),
-            on_error=partial(self._on_open_error, path),
-        )
+        self._read("open_target", load_image, path, self._on_target_loaded)
 
     def _on_target_loaded(self, path: str, loaded) -> None:
         self.doc.set_transfer_target(loaded.pixels, path)

@@ -24,6 +24,15 @@ log = logging.getLogger(__name__)
 __all__ = ["Pipeline", "error_text"]
 
 
+def _soon(parent: QObject, slot) -> QTimer:
+    """A single-shot 0 ms timer: several triggers in one event-loop cycle run ``slot`` once."""
+    timer = QTimer(parent)
+    timer.setSingleShot(True)
+    timer.setInterval(0)
+    timer.timeout.connect(slot)
+    return timer
+
+
 def error_text(exc: BaseException) -> str:
     """A one-line message for the user (no traceback)."""
     cause = exc.__cause__ if isinstance(exc, jobs.JobError) and exc.__cause__ else exc
@@ -45,26 +54,17 @@ class Pipeline(QObject):
         self.seamless_inputs = None  # the inputs doc.seamless was computed from
         self._seamless_pending = None
         self._template_old_rect = None
-        self._seamless_timer = QTimer(self)
-        self._seamless_timer.setSingleShot(True)
-        self._seamless_timer.setInterval(0)
-        self._seamless_timer.timeout.connect(self._start_seamless)
+        self._seamless_timer = _soon(self, self._start_seamless)
         doc.source_changed.connect(self._on_source_changed)
         doc.maps_changed.connect(self.schedule_seamless)
         doc.template_changed.connect(self.schedule_seamless)
         doc.waypoints_changed.connect(self.schedule_seamless)
         doc.params_changed.connect(self._on_params_changed)
-        self._preview_timer = QTimer(self)
-        self._preview_timer.setSingleShot(True)
-        self._preview_timer.setInterval(0)
-        self._preview_timer.timeout.connect(self._start_preview)
+        self._preview_timer = _soon(self, self._start_preview)
         doc.picks_changed.connect(self.schedule_preview)
         doc.candidates_reset.connect(self.schedule_preview)
         doc.candidate_changed.connect(self._on_candidate_changed)
-        self._quilt_timer = QTimer(self)
-        self._quilt_timer.setSingleShot(True)
-        self._quilt_timer.setInterval(0)
-        self._quilt_timer.timeout.connect(self._restart_quilt)
+        self._quilt_timer = _soon(self, self._restart_quilt)
         self._gen_old = ([], [])
         self._quilt_mode = "quilt"  # what a parameter change restarts: "quilt" or "transfer"
         self._remake_text = ""
