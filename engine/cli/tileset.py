@@ -107,6 +107,7 @@ def _colour_range(text: str):
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
     from engine.blend import BLEND_MODES
+    from engine.cli.synth import seam_option  # imported here: synth imports this module
     from engine.errormap import METRICS
     from engine.seams import METHODS
 
@@ -182,6 +183,14 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         help="refine each random patch position within +-N px (default 5)",
     )
     p.add_argument("--seam", choices=METHODS, default="dp", help="seam method (default dp)")
+    p.add_argument(
+        "--seam-option",
+        type=seam_option,
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="option of the seam method, e.g. o_max=5, max_run=3, variant=lm",
+    )
     p.add_argument("--metric", choices=METRICS, default="euclid", help="error metric")
     p.add_argument(
         "--blend",
@@ -310,7 +319,10 @@ def run(args) -> int:
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        code = _run(args)
+        try:
+            code = _run(args)
+        except TypeError as exc:  # a bad --seam-option, named by the engine
+            raise ValueError(str(exc)) from None
     for w in caught:
         print(f"quilt-studio tileset: warning: {w.message}", file=sys.stderr)
     return code
@@ -394,6 +406,7 @@ def _run(args) -> int:
             rect,
             overlap=overlap,
             method=args.seam,
+            **dict(args.seam_option),
             metric=args.metric,
             blend=tmpl_blend,
             width=args.width,
@@ -433,6 +446,7 @@ def _run(args) -> int:
             margin=args.margin,
             neighbourhood=args.neighbourhood,
             method=args.seam,
+            **dict(args.seam_option),
             metric=args.metric,
             blend=cand_blend,
             width=args.width,

@@ -34,9 +34,15 @@ from engine.errormap import METRICS, colour_channels
 from engine.events import Item, Progress, drain, frozen_array
 from engine.exclusion import valid_anchors
 from engine.materials import apply_cut
-from engine.seams import METHODS
 from engine.stitch import BLEND_MODES, patch_cut
-from engine.tiles.seamless import MAIN, SeamlessTile, as_maps, check_weights, seam_error
+from engine.tiles.seamless import (
+    MAIN,
+    SeamlessTile,
+    as_maps,
+    check_seam_options,
+    check_weights,
+    seam_error,
+)
 from engine.tiles.template import _excluded_mask, as_size, flat_warning
 
 __all__ = ["CandidateTile", "candidate_seed", "candidates", "iter_candidates", "make_candidate"]
@@ -200,7 +206,7 @@ class _Setup:
         self.ty, self.tx = (th - ph) // 2, (tw - pw) // 2
         self.n = positive_int(neighbourhood, "neighbourhood", minimum=0)
         choice(blend, "blend", BLEND_MODES)
-        choice(method, "method", METHODS)
+        check_seam_options(method, seam_options)
         choice(metric, "metric", METRICS)
         self.opts = dict(
             method=method,

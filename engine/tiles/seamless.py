@@ -181,6 +181,15 @@ def iter_seam(error, *, method, cyclic=False, waypoints=(), cancel=None, **optio
     )
 
 
+def check_seam_options(method: str, options: dict) -> None:
+    """Validate a seam method and its options now (not in a worker), as
+    :func:`engine.seams.iter_find_seam` does; options that depend on the overlap's shape
+    (``image``) are left to the search itself."""
+    choice(method, "method", METHODS)
+    opts = {k: v for k, v in options.items() if k != "image"}
+    iter_find_seam(np.zeros((4, 4)), method=method, **opts).close()
+
+
 def _restrict(error: np.ndarray, lo: int, hi: int) -> np.ndarray:
     """Make columns outside [lo, hi] prohibitively expensive (finite, for every method)."""
     out = error.copy()
@@ -260,7 +269,7 @@ def iter_make_seamless(
         raise TypeError("overlap is required when rect is a plain (x, y, w, h) rectangle")
     x, y, a, b = _check_rect(rect, overlap, (H, W))
     choice(blend, "blend", BLEND_MODES)
-    choice(method, "method", METHODS)
+    check_seam_options(method, seam_options)
     positive_int(width, "width", minimum=0)
     positive_int(rho, "rho", minimum=0)
     extra = as_maps(maps, (H, W))

@@ -176,6 +176,8 @@ def test_bad_input_gives_clear_errors(src, tmp_path, capsys):
     assert "no such file" in capsys.readouterr().err
     assert main(["tileset", str(src["rgb8"]), "--out", out, *ARGS, "--pick", "9"]) == 1
     assert "out of range" in capsys.readouterr().err
+    assert main(["tileset", str(src["rgb8"]), "--out", out, *ARGS, "--seam-option", "bogus=1"]) == 1
+    assert "bogus" in capsys.readouterr().err
     with pytest.raises(SystemExit):
         main(["tileset", str(src["rgb8"]), "--out", out, "--tile-min", "big"])
     flat = tmp_path / "flat.png"

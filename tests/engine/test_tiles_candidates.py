@@ -212,6 +212,8 @@ def test_bad_input(small):
         candidates(S[:, :, :1], st, 2)
     with pytest.raises(ValueError, match="method"):
         candidates(S, st, 2, method="magic")
+    with pytest.raises(TypeError, match="bogus"):
+        iter_candidates(S, st, 2, bogus=3)
     with pytest.warns(UserWarning, match="margin 0"):
         iter_candidates(S, st, 1, margin=0)
     with pytest.raises(TypeError, match="rng"):

@@ -198,6 +198,10 @@ def test_bad_input():
         make_seamless(S, RECT, overlap=8, weights={"normal": 1})
     with pytest.raises(ValueError, match="blend"):
         make_seamless(S, RECT, overlap=8, blend="smudge")
+    with pytest.raises(TypeError, match="bogus"):  # eager: at the call, not in a worker
+        iter_make_seamless(S, RECT, overlap=8, method="oscillating", bogus=1)
+    with pytest.raises(ValueError, match="method"):
+        iter_make_seamless(S, RECT, overlap=8, method="magic")
     token = CancelToken()
     token.cancel()
     with pytest.raises(Cancelled):
