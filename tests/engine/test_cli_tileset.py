@@ -145,6 +145,8 @@ def test_picks_maps_exclusion_and_options(src, tmp_path):
                 str(src["mask"]),
                 "--seam",
                 "oscillating",
+                "--seam-option",
+                "o_max=2",
                 "--blend",
                 "feather",
                 "--workers",
