@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import logging
 from dataclasses import replace
+from functools import partial
 
 import numpy as np
 from PySide6.QtCore import QObject, QTimer, Signal, Slot
@@ -46,6 +47,7 @@ class Pipeline(QObject):
     message = Signal(str, str)  # level ("info" | "warning" | "error"), text
     seam_updated = Signal(object)  # engine.tiles.seamless.SeamlessUpdate, live
     template_searching = Signal(bool)
+    candidate_failed = Signal(int)  # a re-roll / patch move of this candidate failed
 
     def __init__(self, doc: Document, manager: jobs.JobManager | None = None, parent=None) -> None:
         super().__init__(parent)
@@ -67,7 +69,6 @@ class Pipeline(QObject):
         self._quilt_timer = _soon(self, self._restart_quilt)
         self._gen_old = ([], [])
         self._quilt_mode = "quilt"  # what a parameter change restarts: "quilt" or "transfer"
-        self._remake_text = ""
 
     # ------------------------------------------------------------------ helpers
     def _error(self, exc: BaseException) -> None:
@@ -82,6 +83,7 @@ class Pipeline(QObject):
             self.jobs.abort(key)
         self.jobs.abort_matching("candidate:")
         self.seamless_inputs = None
+        self.template_searching.emit(False)
 
     @Slot(object)
     def _on_params_changed(self, keys) -> None:
@@ -380,7 +382,6 @@ class Pipeline(QObject):
         else:
             kw.update(patch_origin=(int(origin[0]), int(origin[1])))
             text = f"Move patch of candidate #{index + 1}"
-        self._remake_text = text
         return self.jobs.start(
             f"candidate:{index}",
             make_candidate,
@@ -388,21 +389,21 @@ class Pipeline(QObject):
             doc.seamless,
             index=index,
             label=text,
-            on_done=self._on_remade,
-            on_error=self._on_remake_error,
+            on_done=partial(self._on_remade, text),
+            on_error=partial(self._on_remake_error, index),
             **kw,
         )
 
-    def _on_remade(self, c) -> None:
+    def _on_remade(self, text: str, c) -> None:
         index = int(c.index)
         if index >= len(self.doc.candidates):
             return
         entry = replace(self.entry_from(c), weight=self.doc.candidates[index].weight)
-        self.doc.replace_candidate(index, entry, text=self._remake_text)
+        self.doc.replace_candidate(index, entry, text=text)
 
-    def _on_remake_error(self, exc) -> None:
+    def _on_remake_error(self, index: int, exc) -> None:
         self._error(exc)
-        self.doc.candidate_changed.emit(-1)  # views put the patch rectangle back
+        self.candidate_failed.emit(index)
 
     # ------------------------------------------------------------------ preview
     @Slot()

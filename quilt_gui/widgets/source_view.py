@@ -87,6 +87,8 @@ class SourceView(ImageCanvas):
         doc.candidate_changed.connect(self._on_candidate_changed)
         doc.candidates_reset.connect(self._on_candidates_reset)
         pipeline.seam_updated.connect(self._on_seam_updated)
+        pipeline.candidate_failed.connect(self._on_candidate_changed)  # the patch snaps back
+        pipeline.template_searching.connect(self._on_searching)
 
     # ------------------------------------------------------------------ document -> view
     @Slot()
@@ -98,6 +100,11 @@ class SourceView(ImageCanvas):
             self.patch_item.bounds = src.shape
         self.show_patch(None)
         self._on_template_changed()
+
+    @Slot(bool)
+    def _on_searching(self, searching: bool) -> None:
+        """The rectangle animates while the search runs; it is not draggable meanwhile."""
+        self.rect_item.setEnabled(not searching)
 
     @Slot(object)
     def _on_zoom(self, zoom: float) -> None:
