@@ -530,6 +530,7 @@ def _run(args) -> int:
         "margin": args.margin,
         "neighbourhood": args.neighbourhood,
         "seam": args.seam,
+        "seam_options": dict(args.seam_option),
         "metric": args.metric,
         "template_blend": tmpl_blend,
         "candidate_blend": cand_blend,

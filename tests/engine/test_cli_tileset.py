@@ -167,6 +167,7 @@ def test_picks_maps_exclusion_and_options(src, tmp_path):
         tx, ty, tw, th = t["source_rect"]
         assert tx + tw <= 140
     assert man["parameters"]["seam"] == "oscillating"
+    assert man["parameters"]["seam_options"] == {"o_max": 2}
     assert man["parameters"]["template_blend"] == "feather"
 
 
