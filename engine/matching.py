@@ -33,6 +33,7 @@ __all__ = [
     "PCAMatcher",
     "SampleSpectrum",
     "box_sums_float",
+    "summed_area",
     "check_block",
     "error_floor",
     "masked_ssd",
@@ -264,7 +265,7 @@ def select_within_tolerance(errors: np.ndarray, *, tolerance: float, zero_level:
 
 
 # ---------------------------------------------------------------------------- fast mode
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, fastmath=True)
 def _estimates(q, features, base, invalid, out):  # pragma: no cover - compiled
     """out[i, j] = base[i, j] - 2 Σ_k q[i, k] features[k, j]; inf where invalid[j].
 
@@ -286,28 +287,45 @@ def _estimates(q, features, base, invalid, out):  # pragma: no cover - compiled
                 out[i, j] = np.inf
 
 
+@njit(cache=True, nogil=True, fastmath=True)
+def _matmul(a, b):  # pragma: no cover - compiled
+    """``a @ b`` on one thread. The PCA's products are a few million multiply-adds; a threaded
+    BLAS spends longer waking its helper thread than computing them when the machine is busy."""
+    n, d = a.shape
+    r = b.shape[1]
+    out = np.zeros((n, r))
+    for i in range(n):
+        for k in range(d):
+            aik = a[i, k]
+            for j in range(r):
+                out[i, j] += aik * b[k, j]
+    return out
+
+
 def _orthonormal(y: np.ndarray) -> np.ndarray:
     """Orthonormal basis of the columns of ``y`` (n, r) via the tiny r×r Gram matrix."""
-    lam, v = np.linalg.eigh(y.T @ y)
+    lam, v = np.linalg.eigh(_matmul(np.ascontiguousarray(y.T), y))
     keep = lam > lam.max() * 1e-10
-    return y @ (v[:, keep] / np.sqrt(lam[keep]))
+    return _matmul(y, np.ascontiguousarray(v[:, keep] / np.sqrt(lam[keep])))
 
 
 def _randomized_pca(x: np.ndarray, k: int, rng, *, power: int = 1) -> np.ndarray:
     """Top ``k`` principal directions (k, d) of the rows of ``x`` (Halko et al. range finder).
 
-    Only products with ``x`` and eigen-decompositions of r×r matrices (r = k + 8): LAPACK's QR
-    and SVD of the tall matrices are needlessly slow when threaded on a small machine.
+    Only products with ``x`` (single-threaded, :func:`_matmul`) and eigen-decompositions of
+    r×r matrices (r = k + 8).
     """
-    x = (x - x.mean(axis=0)).astype(np.float64)
+    x = np.ascontiguousarray(x - x.mean(axis=0), dtype=np.float64)
+    xt = np.ascontiguousarray(x.T)
     r = min(k + 8, min(x.shape))
-    y = x @ rng.standard_normal((x.shape[1], r))
+    y = _matmul(x, rng.standard_normal((x.shape[1], r)))
     for _ in range(power):
-        y = x @ (x.T @ _orthonormal(y))
-    b = _orthonormal(y).T @ x  # (r', d)
-    lam, u = np.linalg.eigh(b @ b.T)
+        y = _matmul(x, _matmul(xt, _orthonormal(y)))
+    b = _matmul(np.ascontiguousarray(_orthonormal(y).T), x)  # (r', d)
+    lam, u = np.linalg.eigh(_matmul(b, np.ascontiguousarray(b.T)))
     order = np.argsort(lam)[::-1][:k]
-    comps = (u[:, order].T @ b) / np.sqrt(np.maximum(lam[order], 1e-30))[:, None]
+    comps = _matmul(np.ascontiguousarray(u[:, order].T), b)
+    comps /= np.sqrt(np.maximum(lam[order], 1e-30))[:, None]
     return np.ascontiguousarray(comps, dtype=np.float32)
 
 
@@ -316,7 +334,7 @@ class PCAMatcher:
 
     The overlap of a ``block`` = (bh, bw) block with arms ``top`` rows and ``left`` columns is cut
     into three disjoint parts: the corner (top × left), the rest of the left arm and the rest of
-    the top arm. Each part gets ``components`` principal components (randomized PCA of ≤ 256
+    the top arm. Each part gets ``components`` principal components (randomized PCA of ≤ 128
     random sample windows); the projections of every sample window on them are computed by FFT
     correlation. A query with the parts it has (left arm only, top arm only, or both) ranks all
     windows by ``‖f‖² − 2·proj(f)·proj(T)`` (``‖f‖²`` exact, from a summed-area table; the
@@ -341,9 +359,9 @@ class PCAMatcher:
         }
         self.rects = {k: r for k, r in rects.items() if r[2] > 0 and r[3] > 0}
         na = self.anchor_shape[0] * self.anchor_shape[1]
-        picks = rng.choice(na, size=min(na, 256), replace=False)
+        picks = rng.choice(na, size=min(na, 128), replace=False)
         py, px = np.divmod(picks, self.anchor_shape[1])
-        sq = np.sum(s.astype(np.float64) ** 2, axis=2)
+        sat = summed_area(np.sum(s.astype(np.float64) ** 2, axis=2))
         self.bases: dict[str, np.ndarray] = {}
         self.norms: dict[str, np.ndarray] = {}
         self.offsets: dict[str, tuple[int, int]] = {}
@@ -363,9 +381,9 @@ class PCAMatcher:
             kern = np.zeros((k, c, bh, bw), np.float32)
             kern[:, :, y0 : y0 + rh, x0 : x0 + rw] = np.moveaxis(basis.reshape(k, rh, rw, c), 3, 1)
             kernels.append(kern)
-            self.norms[name] = box_sums_float(sq, (rh, rw))[
-                y0 : y0 + self.anchor_shape[0], x0 : x0 + self.anchor_shape[1]
-            ].astype(np.float32)
+            self.norms[name] = box_sums_float(sat, (rh, rw), (y0, x0), self.anchor_shape).astype(
+                np.float32
+            )
         proj = spectrum.correlate(np.concatenate(kernels))
         self.features = np.ascontiguousarray(proj.reshape(i, -1))  # (K, N)
 
@@ -412,13 +430,24 @@ class PCAMatcher:
         return out
 
 
-def box_sums_float(values: np.ndarray, box) -> np.ndarray:
-    """Sum of ``values`` over every ``box`` window (float64 summed-area table)."""
-    bh, bw = box
+def summed_area(values: np.ndarray) -> np.ndarray:
+    """Summed-area table (H + 1, W + 1) float64 of a 2-D array."""
     h, w = values.shape
     sat = np.zeros((h + 1, w + 1), np.float64)
     np.cumsum(np.cumsum(values, axis=0), axis=1, out=sat[1:, 1:])
-    return sat[bh:, bw:] - sat[:-bh, bw:] - sat[bh:, :-bw] + sat[:-bh, :-bw]
+    return sat
+
+
+def box_sums_float(sat: np.ndarray, box, offset=(0, 0), shape=None) -> np.ndarray:
+    """Sums over ``box`` = (bh, bw) windows from a summed-area table, for the windows whose
+    top-left corners are ``offset + (0..shape)`` (default: every window that fits)."""
+    bh, bw = box
+    y0, x0 = offset
+    if shape is None:
+        shape = (sat.shape[0] - bh - y0, sat.shape[1] - bw - x0)
+    ys, xs = slice(y0, y0 + shape[0]), slice(x0, x0 + shape[1])
+    ye, xe = slice(y0 + bh, y0 + bh + shape[0]), slice(x0 + bw, x0 + bw + shape[1])
+    return sat[ye, xe] - sat[ys, xe] - sat[ye, xs] + sat[ys, xs]
 
 
 def check_block(block, name: str = "block") -> tuple[int, int]:

@@ -38,6 +38,7 @@ Determinism and threads
 
 from __future__ import annotations
 
+import inspect
 import math
 import numbers
 import os
@@ -524,6 +525,7 @@ class _Quilter:
         self._pca = None
         self.l_cut = _l_cut_function()
         self.fft_workers = 1 if threads > 1 else threads  # the pool already uses every thread
+        self.stream = True  # False: no events (the benchmark's streaming-overhead reference)
 
     # ---------------------------------------------------------------- sample helpers
     @property
@@ -716,14 +718,17 @@ class _Quilter:
         if wk.old is None:
             pixels = new.copy()
         else:
-            ix = self.idx(wk.y, wk.x, h, w)
-            old_full = self.canvas[ix]
+            old_full = self.canvas[self.idx(wk.y, wk.x, h, w)]
             overlap = wk.filled
             err = error_map(wk.old, colour_channels(new), metric=self.metric)
             err[~overlap] = 0
             if self.seam == "straight":
-                alpha = _straight_alpha(wk.arms, (h, w), self.blend)
                 keep = np.zeros((h, w), dtype=bool)
+                alpha = _straight_alpha(wk.arms, (h, w), self.blend)
+            elif not err.any():
+                # old and new agree exactly over the overlap (a continued copy of the sample):
+                # every cut gives the same pixels, so none is searched
+                keep, crit, peak, alpha = overlap.copy(), 0.0, 0.0, None
             else:
                 cut = cut_overlap(
                     err,
@@ -734,12 +739,17 @@ class _Quilter:
                     **self.seam_options,
                 )
                 keep, path, crit, peak = cut.keep_old, _ro(cut.path), cut.criterion, cut.peak
-                alpha = blend_alpha(
-                    cut, err, overlap, blend=self.blend, width=self.blend_width, rho=self.rho
-                )
-            a = alpha[:, :, None]
-            pixels = a * old_full + (1 - a) * new
-            keep &= overlap
+                keep &= overlap
+                alpha = None
+                if self.blend != "none":
+                    alpha = blend_alpha(
+                        cut, err, overlap, blend=self.blend, width=self.blend_width, rho=self.rho
+                    )
+            if alpha is None:  # hard cut: exact copies of old and new
+                pixels = np.where(keep[:, :, None], old_full, new)
+            else:
+                a = alpha[:, :, None]
+                pixels = a * old_full + (1 - a) * new
             _ro(err)
             _ro(keep)
         ix = self.idx(wk.y, wk.x, h, w)
@@ -785,39 +795,42 @@ def _run_levels(q: _Quilter, rects, total_label: str):
             works = [_Work(i, *rects[i], rng=np.random.default_rng([q.seed, i])) for i in order[lv]]
             for wk in works:
                 q.load(wk)
-            _parallel(pool, q.search, works)
-            placed = (
-                list(pool.map(q.place, works))
-                if pool and PARALLEL_PLACE
-                else [q.place(wk) for wk in works]
-            )
+            placed = list(_search_and_place(q, pool, works))
             for group in placed:
                 for rec, pixels in group:
                     rec = _renumber(rec, len(records))
                     records.append(rec)
-                    yield BlockPlaced(rec, pixels)
+                    if q.stream:
+                        yield BlockPlaced(rec, pixels)
             done += len(works)
-            yield Progress(done, len(rects), total_label)
+            if q.stream:
+                yield Progress(done, len(rects), total_label)
     finally:
         if pool is not None:
             pool.shutdown(wait=True, cancel_futures=True)
     return records
 
 
-PARALLEL_PLACE = True
 SEARCH_CHUNK = 4
 """Blocks searched in one batch. Fixed, so that batches (and any float round-off in them) do not
 depend on the number of threads."""
 
 
-def _parallel(pool, fn, works: list) -> None:
-    """Run ``fn`` on fixed-size chunks of ``works`` (results land in the works)."""
+def _search_and_place(q: _Quilter, pool, works: list[_Work]):
+    """Search the blocks of one level in fixed chunks and place them in order.
+
+    With a pool, every chunk's search runs on the pool (FFTs and numba kernels release the GIL)
+    while this thread places the blocks of the chunks already searched; the results do not depend
+    on the number of threads (same chunks, same order)."""
     chunks = [works[i : i + SEARCH_CHUNK] for i in range(0, len(works), SEARCH_CHUNK)]
-    if pool is None or len(chunks) < 2:
-        for c in chunks:
-            fn(c)
-        return
-    list(pool.map(fn, chunks))
+    futures = [pool.submit(q.search, c) for c in chunks] if pool is not None else None
+    for i, chunk in enumerate(chunks):
+        if futures is None:
+            q.search(chunk)
+        else:
+            futures[i].result()
+        for wk in chunk:
+            yield q.place(wk)
 
 
 def _renumber(rec: BlockRecord, index: int) -> BlockRecord:
@@ -834,14 +847,9 @@ def _iter_bhatia(q: _Quilter, band: int):
     Ho, Wo = q.out_shape
     # reflection padding where an extension runs out of the sample
     Sp = np.pad(S, ((0, band), (0, band), (0, 0)), mode="reflect")
-    if q.excluded is not None:
-        exp = np.pad(q.excluded, ((0, band), (0, band)), mode="reflect")
-        v = valid_anchors(exp, (bh, bw), extension=(band, band))[: H - bh + 1, : W - bw + 1]
-        flat = np.flatnonzero(v)
-        if flat.size == 0:
-            raise ValueError("every block position (with its extension) contains an excluded pixel")
-    else:
-        flat = None
+    flat = (
+        None if q.excluded is None else np.flatnonzero(_bhatia_anchors(q.excluded, q.block, band))
+    )
     nx = W - bw + 1
     ys = list(range(0, Ho, bh))
     xs = list(range(0, Wo, bw))
@@ -945,12 +953,22 @@ def _iter_bhatia(q: _Quilter, band: int):
                 q.canvas[ys[i] : ys[i] + h, xs[j] : xs[j] + w] = pixels
                 rec = _renumber(rec, len(records))
                 records.append(rec)
-                yield BlockPlaced(rec, _ro(pixels))
-            yield Progress(len(records), len(cells), "blocks")
+                if q.stream:
+                    yield BlockPlaced(rec, _ro(pixels))
+            if q.stream:
+                yield Progress(len(records), len(cells), "blocks")
     finally:
         if pool is not None:
             pool.shutdown(wait=True, cancel_futures=True)
     return records
+
+
+def _bhatia_anchors(excluded: np.ndarray, block, band: int) -> np.ndarray:
+    """Valid anchors of Bhatia's blocks: block plus its right/bottom extension clean, in the
+    sample reflected where the extension runs out (the padding the synthesis reads)."""
+    (H, W), (bh, bw) = excluded.shape, block
+    padded = np.pad(excluded, ((0, band), (0, band)), mode="reflect")
+    return valid_anchors(padded, block, extension=(band, band))[: H - bh + 1, : W - bw + 1]
 
 
 def _bhatia_seam(q: _Quilter, e: np.ndarray, own_band: np.ndarray):
@@ -1053,7 +1071,13 @@ def _check_options(
         if ex.shape != (H, W):
             raise ValueError(f"excluded must be shaped {(H, W)} like the sample, got {ex.shape}")
         ex = ex.astype(bool)
-        if select != "bhatia" and not valid_anchors(ex, (bh, bw)).any():
+        if select == "bhatia":
+            if not _bhatia_anchors(ex, (bh, bw), overlap).any():
+                raise ValueError(
+                    "every block position (with its extension) in the sample contains an "
+                    "excluded pixel"
+                )
+        elif not valid_anchors(ex, (bh, bw)).any():
             raise ValueError("every block position in the sample contains an excluded pixel")
     if adaptive_threshold is not None:
         if isinstance(adaptive_threshold, bool) or not isinstance(adaptive_threshold, numbers.Real):
@@ -1174,30 +1198,47 @@ def iter_quilt(
         Yields :class:`BlockPlaced` and :class:`~engine.events.Progress`; returns a
         :class:`QuiltResult`.
     """
-    opts = _check_options(
-        sample,
-        out_shape,
-        block,
-        overlap,
-        select,
-        tolerance,
-        candidates,
-        seam,
-        blend,
-        blend_width,
-        rho,
-        metric,
-        excluded,
-        tileable,
-        adaptive_threshold,
-        min_block,
-        mode,
-        seam_options,
+    return _iter_quilt(
+        _build_quilter(
+            sample,
+            out_shape,
+            block=block,
+            overlap=overlap,
+            select=select,
+            tolerance=tolerance,
+            candidates=candidates,
+            seam=seam,
+            blend=blend,
+            blend_width=blend_width,
+            rho=rho,
+            metric=metric,
+            excluded=excluded,
+            tileable=tileable,
+            adaptive_threshold=adaptive_threshold,
+            min_block=min_block,
+            mode=mode,
+            rng=rng,
+            cancel=cancel,
+            threads=threads,
+            seam_options=seam_options,
+        )
     )
-    gen = as_rng(rng)
-    seed = int(gen.integers(2**63))
-    q = _Quilter(seed=seed, cancel=cancel, threads=_resolve_threads(threads), **opts)
-    return _iter_quilt(q)
+
+
+def _build_quilter(sample, out_shape, *, rng, cancel, threads, seam_options, **options):
+    opts = _check_options(sample, out_shape, seam_options=seam_options, **options)
+    seed = int(as_rng(rng).integers(2**63))
+    return _Quilter(seed=seed, cancel=cancel, threads=_resolve_threads(threads), **opts)
+
+
+def _quilt_unstreamed(sample, out_shape, **options) -> QuiltResult:
+    """:func:`quilt` without creating any event: the benchmark's reference for the streaming
+    overhead (same blocks, same records, same image)."""
+    bound = inspect.signature(iter_quilt).bind(sample, out_shape, **options)
+    bound.apply_defaults()
+    q = _build_quilter(**bound.arguments)
+    q.stream = False
+    return drain(_iter_quilt(q))
 
 
 def _iter_quilt(q: _Quilter):

@@ -263,6 +263,12 @@ def test_cancel_raises_cleanly(cobbles):
             "excluded",
         ),
         ((np.zeros((40, 40, 3)), (50, 50)), {"block": 16, "min_block": 2}, ValueError, "min_block"),
+        (
+            (np.zeros((40, 40, 3)), (50, 50)),
+            {"block": 16, "select": "bhatia", "excluded": np.eye(40, dtype=bool)},
+            ValueError,
+            "excluded",
+        ),
     ],
 )
 def test_bad_input_is_refused_eagerly(args, kw, err, match):

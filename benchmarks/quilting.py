@@ -1,0 +1,268 @@
+"""Image quilting benchmark: speed of the candidate search, streaming overhead, output quality.
+
+Run ``python -m benchmarks.quilting`` (``--help`` for options). Jobs (issue 4), on a 3-channel
+sample (``resources/samples/cobblestones.png`` by default):
+
+* A — 512×512 from a 128×128 sample, block 32, overlap 6, best match (tolerance 0.1), dp cut;
+* B — 1024×1024 from a 256×256 sample, block 48, overlap 8, same settings.
+
+Rows: a straightforward baseline (numpy: ``scipy.signal.fftconvolve`` per channel and block in
+float64, union L mask, the compiled dp L-cut, single thread), the exact FFT search and the fast
+(principal components + exact re-ranking) search, on 1 and 2 threads. Every time is the median
+of repeats. Each output's border ratio along the block grid (max over the offsets the cuts run
+in, :func:`engine.quilting.grid_border_ratio`) is shown beside it. Then: the streaming overhead
+(``quilt`` draining every event vs the same run creating none), and the quality figures: grid
+border ratio of best+dp vs best+straight vs random on every bundled sample, and the mean seam
+peak of Long & Mould's minimax at half-block overlap vs dp at the same overlap.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+
+import numpy as np
+from scipy import signal
+
+if __package__ in (None, ""):  # run as a script: make the repository importable
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from benchmarks._util import format_table, median_time  # noqa: E402
+from engine.errormap import error_map  # noqa: E402
+from engine.io import load_image  # noqa: E402
+from engine.matching import ZERO_ERROR_FRACTION, error_floor, select_within_tolerance  # noqa: E402
+from engine.quilting import _quilt_unstreamed, grid_border_ratio, quilt  # noqa: E402
+from engine.stitch import l_cut  # noqa: E402
+from resources import SAMPLE_NAMES, sample_path  # noqa: E402
+
+JOBS = {
+    "A": dict(crop=128, out=(512, 512), block=32, overlap=6),
+    "B": dict(crop=256, out=(1024, 1024), block=48, overlap=8),
+}
+TARGETS = {("A", "exact"): 0.25, ("B", "exact"): 1.2, ("B", "fast"): 0.36}
+
+
+def baseline_quilt(sample, out_shape, *, block, overlap, tolerance=0.1, rng=0):
+    """The straightforward implementation the issue measures against: for every block, the
+    masked SSD of every sample position by ``fftconvolve`` per channel (float64, no reuse of the
+    sample's spectrum), selection within the tolerance, the compiled dp L-cut, a hard paste."""
+    rng = np.random.default_rng(rng)
+    s = np.asarray(sample, np.float64)
+    h, w, c = s.shape
+    sq = (s**2).sum(axis=2)
+    floor = error_floor(sample)
+    ho, wo = out_shape
+    step = block - overlap
+    out = np.zeros((ho, wo, c))
+    for y in range(0, max(1, -(-(ho - overlap) // step)) * step, step):
+        for x in range(0, max(1, -(-(wo - overlap) // step)) * step, step):
+            bh, bw = min(block, ho - y), min(block, wo - x)
+            ot, ol = (overlap if y else 0), (overlap if x else 0)
+            if not (ot or ol):
+                ay, ax = rng.integers(h - bh + 1), rng.integers(w - bw + 1)
+                out[y : y + bh, x : x + bw] = s[ay : ay + bh, ax : ax + bw]
+                continue
+            m = np.zeros((bh, bw))
+            m[:ot] = 1
+            m[:, :ol] = 1
+            old = out[y : y + bh, x : x + bw]
+            e = signal.fftconvolve(sq, m[::-1, ::-1], mode="valid") + (m[:, :, None] * old**2).sum()
+            for k in range(c):
+                e -= 2 * signal.fftconvolve(s[:, :, k], (m * old[:, :, k])[::-1, ::-1], "valid")
+            zero = ZERO_ERROR_FRACTION * floor * m.sum() * c
+            i, _, _ = select_within_tolerance(e, tolerance=tolerance, zero_level=zero, rng=rng)
+            ay, ax = divmod(i, e.shape[1])
+            new = s[ay : ay + bh, ax : ax + bw]
+            cut = l_cut(error_map(old, new, metric="ssd"), overlap_left=ol, overlap_top=ot)
+            out[y : y + bh, x : x + bw] = np.where(cut.mask[:, :, None], old, new)
+    return out.astype(np.float32)
+
+
+class _Grid:
+    """What :func:`engine.quilting.grid_border_ratio` needs from a result."""
+
+    def __init__(self, image, block, overlap):
+        self.image, self.step, self.band = image, (block - overlap,) * 2, overlap
+
+
+def load_sample(name: str, crop: int) -> np.ndarray:
+    px = load_image(sample_path(name)).pixels
+    if px.shape[2] == 1:
+        px = np.repeat(px, 3, axis=2)
+    return np.ascontiguousarray(px[:crop, :crop, :3])
+
+
+def speed(args) -> None:
+    print(f"## Speed (sample {args.sample}; load average {os.getloadavg()[0]:.2f})\n")
+    rows = []
+    for job in args.jobs:
+        j = JOBS[job]
+        s = load_sample(args.sample, j["crop"])
+        kw = dict(block=j["block"], overlap=j["overlap"])
+        quilt(s, j["out"], rng=0, threads=1, mode="fast", **kw)  # compile numba kernels
+        base_t, base_img = median_time(
+            lambda s=s, j=j, kw=kw: baseline_quilt(s, j["out"], rng=0, **kw),
+            min_repeats=max(1, args.repeats // 2),
+            max_time=args.max_time,
+        )
+        rows.append(
+            [
+                job,
+                "baseline (numpy + fftconvolve per block, dp)",
+                1,
+                f"{base_t:.3f}",
+                "1.00",
+                "",
+                f"{grid_border_ratio(_Grid(base_img, **kw)):.3f}",
+            ]
+        )
+        images = {}
+        for mode in ("exact", "fast"):
+            for threads in (1, 2):
+                t, res = median_time(
+                    lambda s=s, j=j, kw=kw, mode=mode, threads=threads: quilt(
+                        s, j["out"], rng=0, mode=mode, threads=threads, **kw
+                    ),
+                    min_repeats=args.repeats,
+                    max_time=args.max_time,
+                )
+                images[mode, threads] = res.image
+                target = TARGETS.get((job, mode))
+                rows.append(
+                    [
+                        job,
+                        mode,
+                        threads,
+                        f"{t:.3f}",
+                        f"{base_t / t:.2f}",
+                        "" if target is None else f"<= {target}",
+                        f"{grid_border_ratio(res):.3f}",
+                    ]
+                )
+            same = np.array_equal(images[mode, 1], images[mode, 2])
+            print(f"job {job} {mode}: identical output on 1 and 2 threads: {same}")
+    print()
+    print(
+        format_table(
+            [
+                "job",
+                "implementation",
+                "threads",
+                "median s",
+                "× baseline",
+                "target",
+                "grid border ratio",
+            ],
+            rows,
+        )
+    )
+    print()
+
+
+def streaming(args) -> None:
+    print("## Streaming overhead (exact, 1 thread; quilt() drains every event vs no events)\n")
+    rows = []
+    for job in args.jobs:
+        j = JOBS[job]
+        s = load_sample(args.sample, j["crop"])
+        kw = dict(block=j["block"], overlap=j["overlap"], rng=0, threads=1)
+        t_stream, _ = median_time(
+            lambda s=s, j=j, kw=kw: quilt(s, j["out"], **kw),
+            min_repeats=args.repeats,
+            max_time=args.max_time,
+        )
+        t_plain, _ = median_time(
+            lambda s=s, j=j, kw=kw: _quilt_unstreamed(s, j["out"], **kw),
+            min_repeats=args.repeats,
+            max_time=args.max_time,
+        )
+        rows.append(
+            [job, f"{t_plain:.3f}", f"{t_stream:.3f}", f"{100 * (t_stream / t_plain - 1):+.1f} %"]
+        )
+    print(format_table(["job", "no events s", "streamed s", "overhead"], rows))
+    print()
+
+
+def quality(args) -> None:
+    print("## Quality (128×128 crops → 256×256, block 32; grid border ratio, max over offsets)\n")
+    rows = []
+    for name in SAMPLE_NAMES:
+        s = load_sample(name, 128)
+        kw = dict(block=32, overlap=6, rng=1)
+        dp = grid_border_ratio(quilt(s, (256, 256), seam="dp", **kw))
+        fast = grid_border_ratio(quilt(s, (256, 256), seam="dp", mode="fast", **kw))
+        straight = grid_border_ratio(quilt(s, (256, 256), seam="straight", **kw))
+        rnd = grid_border_ratio(quilt(s, (256, 256), select="random", seam="straight", **kw))
+        rnd_dp = grid_border_ratio(quilt(s, (256, 256), select="random", seam="dp", **kw))
+        bha = grid_border_ratio(
+            quilt(s, (256, 256), select="bhatia", seam="resistance", block=32, overlap=8, rng=1)
+        )
+        rows.append(
+            [
+                name,
+                f"{dp:.3f}",
+                f"{fast:.3f} ({100 * (fast / dp - 1):+.1f} %)",
+                f"{straight:.3f}",
+                f"{rnd:.3f}",
+                f"{rnd_dp:.3f}",
+                f"{bha:.3f}",
+            ]
+        )
+    print(
+        format_table(
+            [
+                "sample",
+                "best+dp",
+                "best+dp fast",
+                "best+straight",
+                "random+straight",
+                "random+dp",
+                "bhatia+resistance",
+            ],
+            rows,
+        )
+    )
+    print()
+    print("Mean seam peak over all cuts, block 32, overlap 16 (half block), error map euclid:\n")
+    rows = []
+    for name in SAMPLE_NAMES:
+        s = load_sample(name, 128)
+        kw = dict(block=32, overlap=16, rng=1, metric="euclid")
+        peaks = {}
+        for method in ("dp", "minimax"):
+            res = quilt(s, (256, 256), seam=method, **kw)
+            peaks[method] = np.nanmean([r.peak for r in res.blocks])
+        rows.append(
+            [
+                name,
+                f"{peaks['dp']:.4f}",
+                f"{peaks['minimax']:.4f}",
+                f"{100 * (peaks['minimax'] / peaks['dp'] - 1):+.1f} %",
+            ]
+        )
+    print(format_table(["sample", "dp mean peak", "minimax mean peak", "minimax vs dp"], rows))
+    print()
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("--sample", default="cobblestones", choices=SAMPLE_NAMES)
+    p.add_argument("--jobs", default="AB", help="which jobs to time (default AB)")
+    p.add_argument("--repeats", type=int, default=5, help="minimum repeats per timing (default 5)")
+    p.add_argument("--max-time", type=float, default=30.0, help="time budget per timing (s)")
+    p.add_argument("--skip-speed", action="store_true")
+    p.add_argument("--skip-quality", action="store_true")
+    args = p.parse_args(argv)
+    args.jobs = [j for j in args.jobs.upper() if j in JOBS]
+    if not args.skip_speed:
+        speed(args)
+        streaming(args)
+    if not args.skip_quality:
+        quality(args)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
