@@ -1,13 +1,25 @@
 """Image files in and out: float32 (H, W, C) in [0, 1], bit depth remembered.
 
-Every failure to read raises :class:`ImageError`, whose message names the file
-and the reason (not an image, truncated, empty, zero-sized, too many pixels,
-unsupported mode).
+Reading: PNG, JPEG, TIFF, BMP, WebP (anything Pillow opens), 8 or 16 bits per channel; gray,
+gray + alpha, RGB, RGBA and palette images stay distinct (C = 1, 2, 3, 4; palette images become
+RGB or RGBA with ``mode == "P"``); the EXIF orientation is applied. 16-bit PNG and TIFF are
+decoded exactly (Pillow would reduce 16-bit colour to 8 bits): PNG by the codec of
+:mod:`engine.export._png`, TIFF by tifffile.
+
+Writing: PNG and TIFF at 8 or 16 bits, JPEG / BMP / WebP at 8 bits; atomic (a temporary file
+renamed over the target).
+
+Every failure raises :class:`ImageError`, whose message names the file and the reason: no such
+file, a folder, empty, not an image, truncated or corrupt, zero-sized, over the pixel limit
+(decompression bomb), unsupported mode.
 """
 
 from __future__ import annotations
 
+import io
+import numbers
 import os
+import struct
 import tempfile
 import warnings
 from dataclasses import dataclass
@@ -18,18 +30,54 @@ from PIL import Image, ImageOps, UnidentifiedImageError
 
 DEFAULT_MAX_PIXELS = 100_000_000  # 10k x 10k; larger files are refused as decompression bombs
 READ_SUFFIXES = (".png", ".jpg", ".jpeg", ".tif", ".tiff", ".bmp", ".webp")
+WRITE_SUFFIXES = (".png", ".tif", ".tiff", ".jpg", ".jpeg", ".bmp", ".webp")
+MODES = ("1", "L", "LA", "P", "PA", "RGB", "RGBA", "CMYK", "YCbCr", "LAB", "HSV")
+
+_PNG = b"\x89PNG\r\n\x1a\n"
+_TIFF = (b"II*\x00", b"MM\x00*")
+_MAGIC = (_PNG, b"\xff\xd8\xff", b"BM", b"RIFF", b"GIF8", *_TIFF)
+_FLIPS = {  # EXIF orientation -> numpy transform (what ImageOps.exif_transpose does)
+    2: lambda a: a[:, ::-1],
+    3: lambda a: a[::-1, ::-1],
+    4: lambda a: a[::-1],
+    5: lambda a: a.transpose(1, 0, 2),
+    6: lambda a: np.rot90(a, -1),
+    7: lambda a: a.transpose(1, 0, 2)[::-1, ::-1],
+    8: lambda a: np.rot90(a, 1),
+}
+
+__all__ = [
+    "DEFAULT_MAX_PIXELS",
+    "ImageError",
+    "LoadedImage",
+    "READ_SUFFIXES",
+    "WRITE_SUFFIXES",
+    "load_image",
+    "save_image",
+    "to_rgb",
+]
 
 
 class ImageError(ValueError):
-    """An image file could not be read or written; the message says which and why."""
+    """An image file could not be read or written; the message says which file and why."""
 
 
 @dataclass(frozen=True, slots=True)
 class LoadedImage:
     """Pixels plus what the file said about them.
 
-    ``pixels`` is float32 (H, W, C) in [0, 1]; C is 1 (gray), 2 (gray+alpha),
-    3 (RGB) or 4 (RGBA). ``bit_depth`` is 8 or 16 (bits per channel in the file).
+    Attributes
+    ----------
+    pixels : (H, W, C) float32 in [0, 1]
+        C is 1 (gray), 2 (gray + alpha), 3 (RGB) or 4 (RGBA); orientation already applied.
+    bit_depth : int
+        8 or 16, bits per channel in the file.
+    path : str
+        The file that was read.
+    mode : str
+        The file's colour model (Pillow names, bit depth apart): ``"L"`` gray, ``"LA"``,
+        ``"RGB"``, ``"RGBA"``, ``"P"`` / ``"PA"`` palette (pixels RGB / RGBA), ``"1"`` bilevel
+        (pixels gray), ``"CMYK"``, ``"YCbCr"``, ``"LAB"``, ``"HSV"`` (pixels RGB).
     """
 
     pixels: np.ndarray
@@ -55,134 +103,248 @@ def to_rgb(pixels: np.ndarray) -> np.ndarray:
     return pixels[:, :, :3]
 
 
+# ----------------------------------------------------------------------------- reading
 def load_image(path, *, max_pixels: int = DEFAULT_MAX_PIXELS) -> LoadedImage:
-    """Read an image file into float32 (H, W, C) in [0, 1], honouring EXIF orientation."""
+    """Read an image file into float32 (H, W, C) in [0, 1] (see the module docstring).
+
+    Parameters
+    ----------
+    path : str or PathLike
+    max_pixels : int
+        Files declaring more pixels (width × height) are refused before any decoding.
+
+    Raises
+    ------
+    ImageError
+        The message names the file and the reason.
+    """
+    if isinstance(max_pixels, bool) or not isinstance(max_pixels, numbers.Integral):
+        raise TypeError(f"max_pixels must be an integer, got {max_pixels!r}")
+    if max_pixels < 1:
+        raise ValueError(f"max_pixels must be >= 1, got {max_pixels}")
     name = os.fspath(path)
     p = Path(name)
     if not p.exists():
         raise ImageError(f"{name}: no such file")
     if p.is_dir():
         raise ImageError(f"{name}: is a folder, not an image")
-    if p.stat().st_size == 0:
+    try:
+        data = p.read_bytes()
+    except OSError as exc:
+        raise ImageError(f"{name}: cannot be read ({exc.strerror or exc})") from None
+    if not data:
         raise ImageError(f"{name}: the file is empty")
+
+    def fail(reason: str) -> ImageError:
+        return ImageError(f"{name}: {reason}")
+
+    def check_size(w: int, h: int) -> None:
+        if w <= 0 or h <= 0:
+            raise fail(f"the image is zero-sized ({w}x{h})")
+        if w * h > max_pixels:
+            raise fail(
+                f"{w}x{h} = {w * h:,} pixels is over the limit of {max_pixels:,} pixels "
+                "(possible decompression bomb)"
+            )
+
+    if data.startswith(_PNG) and len(data) >= 33 and data[12:16] == b"IHDR":
+        w, h = struct.unpack(">II", data[16:24])
+        check_size(w, h)  # before Pillow or zlib inflate anything
+    if data.startswith(_TIFF):
+        tiff = _tiff_16bit(data, fail, check_size)
+        if tiff is not None:
+            pixels, mode = _from_uint16(tiff[0])
+            return LoadedImage(_oriented(pixels, tiff[1]), 16, name, mode)
     try:
         with warnings.catch_warnings():
-            warnings.simplefilter("error", Image.DecompressionBombWarning)
+            warnings.simplefilter("ignore", Image.DecompressionBombWarning)
             old_limit = Image.MAX_IMAGE_PIXELS
-            Image.MAX_IMAGE_PIXELS = None
+            Image.MAX_IMAGE_PIXELS = None  # our own limit applies (thread-unsafe global: restore)
             try:
-                with Image.open(p) as im:
-                    w, h = im.size
-                    if w == 0 or h == 0:
-                        raise ImageError(f"{name}: the image is zero-sized ({w}x{h})")
-                    if w * h > max_pixels:
-                        raise ImageError(
-                            f"{name}: {w}x{h} = {w * h:,} pixels is over the limit of "
-                            f"{max_pixels:,} pixels (possible decompression bomb)"
+                with Image.open(io.BytesIO(data)) as im:
+                    check_size(*im.size)
+                    exact = _png_16bit(data, max_pixels, fail)
+                    if exact is not None:
+                        return LoadedImage(
+                            _oriented(exact[0], _orientation(im)), 16, name, exact[1]
                         )
                     im.load()
                     im = ImageOps.exif_transpose(im)
-                    pixels, depth = _to_array(im, name)
-                    mode = im.mode
+                    pixels, depth, mode = _to_array(im, fail)
             finally:
                 Image.MAX_IMAGE_PIXELS = old_limit
     except ImageError:
         raise
     except UnidentifiedImageError:
-        raise ImageError(f"{name}: not an image file (or an unsupported format)") from None
-    except (OSError, SyntaxError, ValueError, EOFError) as exc:
-        msg = str(exc)
-        reason = "the file is truncated or corrupt" if "truncat" in msg.lower() or isinstance(exc, EOFError) else f"cannot be read ({msg})"
-        raise ImageError(f"{name}: {reason}") from None
-    if pixels.shape[0] == 0 or pixels.shape[1] == 0:
-        raise ImageError(f"{name}: the image is zero-sized")
-    return LoadedImage(pixels=pixels, bit_depth=depth, path=name, mode=mode)
+        if data.startswith(_TIFF):
+            raise fail(_tiff_problem(data)) from None
+        if data.startswith(_MAGIC):
+            raise fail("the file is truncated or corrupt (its header cannot be read)") from None
+        raise fail("not an image file (or an unsupported format)") from None
+    except (OSError, SyntaxError, ValueError, EOFError, struct.error, MemoryError) as exc:
+        raise fail(f"the file is truncated or corrupt ({exc})") from None
+    return LoadedImage(pixels, depth, name, mode)
 
 
-def _to_array(im: Image.Image, name: str) -> tuple[np.ndarray, int]:
+def _tiff_problem(data: bytes) -> str:
+    """Why Pillow could not open a TIFF: an unsupported sample layout, or damage."""
+    import tifffile
+
+    try:
+        with tifffile.TiffFile(io.BytesIO(data)) as tif:
+            page = tif.pages[0]
+            return (
+                f"unsupported image mode ({page.samplesperpixel} samples of "
+                f"{page.bitspersample}-bit {page.dtype}, photometric {page.photometric.name})"
+            )
+    except Exception:
+        return "the file is truncated or corrupt (its header cannot be read)"
+
+
+def _oriented(pixels: np.ndarray, orientation: int) -> np.ndarray:
+    """Apply an EXIF orientation (1-8) to (H, W, C) pixels, as ImageOps.exif_transpose."""
+    flip = _FLIPS.get(orientation)
+    return pixels if flip is None else np.ascontiguousarray(flip(pixels))
+
+
+def _orientation(im: Image.Image) -> int:
+    try:
+        return int(im.getexif().get(0x0112, 1))
+    except Exception:  # a broken EXIF block is ignored, as ImageOps.exif_transpose does
+        return 1
+
+
+def _png_16bit(data: bytes, max_pixels: int, fail):
+    """(pixels, mode) of a 16-bit PNG decoded without loss, else None."""
+    if data.startswith(_PNG) and data[24] == 16:
+        from engine.export._png import PNGError, decode_png
+
+        try:
+            q = decode_png(data, max_pixels=max_pixels)
+        except PNGError as exc:
+            if data[28] != 0:  # interlaced: Pillow decodes it (at 8 bits for colour)
+                return None
+            raise fail(f"the file is truncated or corrupt ({exc})") from None
+        return _from_uint16(q)
+    return None
+
+
+def _from_uint16(q: np.ndarray) -> tuple[np.ndarray, str]:
+    return q.astype(np.float32) / 65535.0, ("L", "LA", "RGB", "RGBA")[q.shape[2] - 1]
+
+
+def _tiff_16bit(data: bytes, fail, check_size):
+    """(uint16 (H, W, C), EXIF orientation) of a 16-bit gray / RGB(A) TIFF, else None."""
+    import tifffile
+
+    try:
+        with tifffile.TiffFile(io.BytesIO(data)) as tif:
+            page = tif.pages[0]
+            if page.bitspersample != 16 or page.dtype != np.uint16:
+                return None
+            check_size(page.imagewidth, page.imagelength)
+            tag = page.tags.get(274)
+            orientation = int(tag.value) if tag is not None else 1
+            q = page.asarray()
+    except ImageError:
+        raise
+    except Exception as exc:  # tifffile raises many types on damaged files
+        raise fail(f"the file is truncated or corrupt ({exc})") from None
+    if q.ndim not in (2, 3) or (q.ndim == 3 and q.shape[2] > 4):
+        raise fail(f"unsupported image mode (uint16 samples, shape {q.shape})")
+    return (q[:, :, None] if q.ndim == 2 else q), orientation
+
+
+def _to_array(im: Image.Image, fail) -> tuple[np.ndarray, int, str]:
+    """Pillow image -> (float32 (H, W, C), bit depth, colour model)."""
     mode = im.mode
-    if mode in ("I;16", "I;16B", "I;16L", "I;16N"):
-        a = np.asarray(im, dtype=np.uint16).astype(np.float32) / 65535.0
-        return a[:, :, None], 16
-    if mode == "I":
+    if mode in ("I;16", "I;16B", "I;16L", "I;16N", "I"):
         a = np.asarray(im)
-        depth = 16 if a.max(initial=0) > 255 else 8
-        return (np.clip(a, 0, 65535).astype(np.float32) / 65535.0 if depth == 16 else a.astype(np.float32) / 255.0)[:, :, None], depth
+        if a.min(initial=0) < 0 or a.max(initial=0) > 65535:
+            raise fail(f"unsupported image mode {mode!r} (values outside 0..65535)")
+        return a.astype(np.float32)[:, :, None] / 65535.0, 16, "L"
     if mode == "F":
         a = np.asarray(im, dtype=np.float32)
-        lo, hi = float(a.min()), float(a.max())
-        a = (a - lo) / (hi - lo) if hi > lo else np.zeros_like(a)
-        return a[:, :, None], 16
+        if not np.all(np.isfinite(a)) or a.min(initial=0) < 0 or a.max(initial=0) > 1:
+            raise fail("unsupported image mode 'F' (32-bit float outside [0, 1])")
+        return a[:, :, None].copy(), 16, "L"
     if mode in ("1", "L"):
-        return np.asarray(im.convert("L"), dtype=np.float32)[:, :, None] / 255.0, 8
-    if mode == "LA":
-        return np.asarray(im, dtype=np.float32) / 255.0, 8
+        return np.asarray(im.convert("L"), dtype=np.float32)[:, :, None] / 255.0, 8, mode
+    if mode in ("LA", "La"):
+        return np.asarray(im.convert("LA"), dtype=np.float32) / 255.0, 8, "LA"
     if mode in ("P", "PA"):
-        im = im.convert("RGBA") if ("transparency" in im.info or mode == "PA") else im.convert("RGB")
-        return np.asarray(im, dtype=np.float32) / 255.0, 8
+        alpha = mode == "PA" or "transparency" in im.info
+        rgb = im.convert("RGBA" if alpha else "RGB")
+        return np.asarray(rgb, dtype=np.float32) / 255.0, 8, mode
     if mode in ("RGB", "RGBA"):
-        return np.asarray(im, dtype=np.float32) / 255.0, 8
-    if mode in ("CMYK", "YCbCr", "LAB", "HSV", "RGBX", "RGBa", "La"):
-        return np.asarray(im.convert("RGB"), dtype=np.float32) / 255.0, 8
-    raise ImageError(f"{name}: unsupported image mode {mode!r}")
+        return np.asarray(im, dtype=np.float32) / 255.0, 8, mode
+    if mode in ("RGBa", "RGBX"):
+        out = "RGBA" if mode == "RGBa" else "RGB"
+        return np.asarray(im.convert(out), dtype=np.float32) / 255.0, 8, out
+    if mode in ("CMYK", "YCbCr", "LAB", "HSV"):
+        return np.asarray(im.convert("RGB"), dtype=np.float32) / 255.0, 8, mode
+    raise fail(f"unsupported image mode {mode!r}")
 
 
-
+# ----------------------------------------------------------------------------- writing
 def save_image(path, pixels, *, bit_depth: int = 8) -> Path:
-    """Write float (H, W[, C]) pixels in [0, 1] to PNG or TIFF (8 or 16 bit), atomically."""
+    """Write float (H, W[, C]) pixels in [0, 1] (or uint8/uint16) to an image file, atomically.
+
+    PNG and TIFF take 8 or 16 bits per channel; JPEG, BMP and WebP 8 bits (JPEG and BMP no
+    alpha). C is 1 (gray), 2 (gray + alpha), 3 (RGB) or 4 (RGBA). Values are rounded (no
+    dither; see :func:`engine.export.quantize`). Returns the path written.
+    """
+    from engine.export import _umask, quantize
+
     p = Path(os.fspath(path))
-    if bit_depth not in (8, 16):
-        raise ValueError(f"bit_depth must be 8 or 16, got {bit_depth}")
-    a = np.asarray(pixels, dtype=np.float32)
+    if isinstance(bit_depth, bool) or bit_depth not in (8, 16):
+        raise ValueError(f"bit_depth must be 8 or 16, got {bit_depth!r}")
+    a = np.asarray(pixels)
     if a.ndim == 3 and a.shape[2] == 1:
         a = a[:, :, 0]
-    if a.ndim not in (2, 3) or (a.ndim == 3 and a.shape[2] not in (2, 3, 4)):
-        raise ValueError(f"pixels must be (H, W) or (H, W, 1-4), got {a.shape}")
+    if a.ndim not in (2, 3) or (a.ndim == 3 and a.shape[2] not in (2, 3, 4)) or 0 in a.shape:
+        raise ValueError(f"pixels must be shaped (H, W) or (H, W, 1-4), got {np.shape(pixels)}")
     suffix = p.suffix.lower()
-    if suffix not in (".png", ".tif", ".tiff", ".jpg", ".jpeg", ".bmp", ".webp"):
-        raise ImageError(f"{p}: unsupported output format {suffix or '(none)'}")
-    a = np.clip(a, 0.0, 1.0)
-    p.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=p.parent, prefix=f".{p.name}.", suffix=suffix)
+    if suffix not in WRITE_SUFFIXES:
+        raise ImageError(
+            f"{p}: unsupported output format {suffix or '(no suffix)'} "
+            f"(use one of {', '.join(WRITE_SUFFIXES)})"
+        )
+    if bit_depth == 16 and suffix not in (".png", ".tif", ".tiff"):
+        raise ImageError(f"{p}: 16-bit output needs .png or .tif, not {suffix}")
+    channels = 1 if a.ndim == 2 else a.shape[2]
+    if channels in (2, 4) and suffix in (".jpg", ".jpeg", ".bmp"):
+        raise ImageError(f"{p}: {suffix} cannot store an alpha channel; use .png or .tif")
+    q = quantize(a, bit_depth, dither=False)
+    try:
+        p.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=p.parent, prefix=f".{p.name}.", suffix=suffix)
+    except OSError as exc:
+        raise ImageError(f"{p}: cannot write ({exc.strerror or exc})") from None
     os.close(fd)
     try:
-        if bit_depth == 16:
-            q = np.round(a * 65535.0).astype(np.uint16)
-            if suffix in (".tif", ".tiff"):
-                import tifffile
+        if suffix in (".tif", ".tiff"):
+            import tifffile
 
-                tifffile.imwrite(tmp, q, photometric="minisblack" if q.ndim == 2 else "rgb")
-            elif suffix == ".png":
-                _write_png16(tmp, q)
-            else:
-                raise ImageError(f"{p}: 16-bit output needs .png or .tif, not {suffix}")
+            tifffile.imwrite(
+                tmp,
+                q,
+                photometric="minisblack" if channels < 3 else "rgb",
+                extrasamples=("unassalpha",) if channels in (2, 4) else None,
+                compression="zlib",
+            )
+        elif suffix == ".png":
+            from engine.export._png import encode_png
+
+            Path(tmp).write_bytes(encode_png(q))
         else:
-            q = np.round(a * 255.0).astype(np.uint8)
             Image.fromarray(q).save(tmp, format=Image.registered_extensions()[suffix])
+        os.chmod(tmp, 0o666 & ~_umask())
         os.replace(tmp, p)
+    except OSError as exc:
+        Path(tmp).unlink(missing_ok=True)
+        raise ImageError(f"{p}: cannot write ({exc.strerror or exc})") from None
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
     return p
-
-
-def _write_png16(path: str, q: np.ndarray) -> None:
-    """16-bit PNG via Pillow (gray: I;16; colour: raw 16-bit RGB(A) data)."""
-    if q.ndim == 2:
-        Image.fromarray(q, mode="I;16").save(path, format="PNG")
-        return
-    import zlib
-    import struct
-
-    h, w, c = q.shape
-    color_type = {2: 4, 3: 2, 4: 6}[c]
-    raw = b"".join(b"\x00" + q[y].astype(">u2").tobytes() for y in range(h))
-
-    def chunk(tag: bytes, data: bytes) -> bytes:
-        return struct.pack(">I", len(data)) + tag + data + struct.pack(">I", zlib.crc32(tag + data) & 0xFFFFFFFF)
-
-    with open(path, "wb") as f:
-        f.write(b"\x89PNG\r\n\x1a\n")
-        f.write(chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 16, color_type, 0, 0, 0)))
-        f.write(chunk(b"IDAT", zlib.compress(raw, 6)))
-        f.write(chunk(b"IEND", b""))
