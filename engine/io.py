@@ -21,7 +21,6 @@ import numbers
 import os
 import struct
 import tempfile
-import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -112,6 +111,8 @@ def load_image(path, *, max_pixels: int = DEFAULT_MAX_PIXELS) -> LoadedImage:
     path : str or PathLike
     max_pixels : int
         Files declaring more pixels (width × height) are refused before any decoding.
+        Pillow's own hard limit (2 × ``PIL.Image.MAX_IMAGE_PIXELS``, about 179 million) also
+        applies to the formats it decodes; the global is never changed (thread safety).
 
     Raises
     ------
@@ -156,25 +157,18 @@ def load_image(path, *, max_pixels: int = DEFAULT_MAX_PIXELS) -> LoadedImage:
             pixels, mode = _from_uint16(tiff[0])
             return LoadedImage(_oriented(pixels, tiff[1]), 16, name, mode)
     try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", Image.DecompressionBombWarning)
-            old_limit = Image.MAX_IMAGE_PIXELS
-            Image.MAX_IMAGE_PIXELS = None  # our own limit applies (thread-unsafe global: restore)
-            try:
-                with Image.open(io.BytesIO(data)) as im:
-                    check_size(*im.size)
-                    exact = _png_16bit(data, max_pixels, fail)
-                    if exact is not None:
-                        return LoadedImage(
-                            _oriented(exact[0], _orientation(im)), 16, name, exact[1]
-                        )
-                    im.load()
-                    im = ImageOps.exif_transpose(im)
-                    pixels, depth, mode = _to_array(im, fail)
-            finally:
-                Image.MAX_IMAGE_PIXELS = old_limit
+        with Image.open(io.BytesIO(data)) as im:
+            check_size(*im.size)
+            exact = _png_16bit(data, max_pixels, fail)
+            if exact is not None:
+                return LoadedImage(_oriented(exact[0], _orientation(im)), 16, name, exact[1])
+            im.load()
+            im = ImageOps.exif_transpose(im)
+            pixels, depth, mode = _to_array(im, fail)
     except ImageError:
         raise
+    except Image.DecompressionBombError as exc:  # over Pillow's own (larger) hard limit
+        raise fail(f"over the pixel limit (possible decompression bomb: {exc})") from None
     except UnidentifiedImageError:
         if data.startswith(_TIFF):
             raise fail(_tiff_problem(data)) from None
