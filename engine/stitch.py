@@ -76,27 +76,18 @@ def from_canonical(a: np.ndarray, orientation: str) -> np.ndarray:
     return np.swapaxes(a, 0, 1)[::-1]
 
 
-def _points_to_canonical(pts: np.ndarray, orientation: str, shape) -> np.ndarray:
+def _map_points(pts: np.ndarray, orientation: str, shape, *, inverse: bool = False):
+    """(row, col) points of a map of ``shape`` to canonical coordinates (or back: ``inverse``)."""
     h, w = shape
     r, c = pts[:, 0], pts[:, 1]
-    out = {
-        "right": (r, c),
-        "left": (r, w - 1 - c),
-        "bottom": (c, r),
-        "top": (c, h - 1 - r),
-    }[orientation]
-    return np.column_stack(out).astype(np.intp)
-
-
-def _points_from_canonical(pts: np.ndarray, orientation: str, shape) -> np.ndarray:
-    h, w = shape
-    r, c = pts[:, 0], pts[:, 1]
-    out = {
-        "right": (r, c),
-        "left": (r, w - 1 - c),
-        "bottom": (c, r),
-        "top": (h - 1 - c, r),
-    }[orientation]
+    if orientation == "left":
+        out = (r, w - 1 - c)
+    elif orientation == "bottom":
+        out = (c, r)
+    elif orientation == "top":
+        out = (h - 1 - c, r) if inverse else (c, h - 1 - r)
+    else:
+        out = (r, c)
     return np.column_stack(out).astype(np.intp)
 
 
@@ -237,13 +228,13 @@ def stitch(
             wp = np.asarray(waypoints, dtype=np.intp).reshape(-1, 2)
         except (TypeError, ValueError):
             raise ValueError(f"waypoints must be (row, col) pairs, got {waypoints!r}") from None
-        wps = [tuple(p) for p in _points_to_canonical(wp, orientation, err.shape).tolist()]
+        wps = [tuple(p) for p in _map_points(wp, orientation, err.shape).tolist()]
     kw = _seam_kwargs(start, end, wps, cyclic, cancel)
     seam = find_seam(ce, method=method, **kw, **seam_options)
     alpha_c = blend_weights(seam, ce, mode=blend, width=width, rho=rho, cyclic=bool(cyclic))
     alpha = np.ascontiguousarray(from_canonical(alpha_c, orientation))
     mask = np.ascontiguousarray(from_canonical(np.asarray(seam.mask), orientation))
-    path = _points_from_canonical(np.asarray(seam.path), orientation, err.shape)
+    path = _map_points(np.asarray(seam.path), orientation, err.shape, inverse=True)
     image = composite(alpha, a, b)
     _frozen(image, err, path, mask, alpha)
     return StitchResult(image, err, seam, path, mask, alpha, orientation)

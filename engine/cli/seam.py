@@ -13,18 +13,9 @@ import sys
 import time
 
 from engine.blend import BLEND_MODES
+from engine.cli.export import _positive
 from engine.errormap import METRICS
 from engine.seams import METHODS
-
-
-def _positive(text: str) -> int:
-    try:
-        v = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
-    if v < 1:
-        raise argparse.ArgumentTypeError(f"must be >= 1, got {v}")
-    return v
 
 
 def _nonneg_float(text: str) -> float:
