@@ -38,6 +38,7 @@ from engine.blend import (
 from engine.cancel import check
 from engine.errormap import error_map
 from engine.seams import METHODS, Seam, find_seam, graph_path
+from engine.seams import OPTIONS as SEAM_OPTIONS
 
 ORIENTATIONS = ("right", "left", "bottom", "top")
 GRAPH_METHODS = ("dijkstra", "minimax")
@@ -386,6 +387,9 @@ def l_cut(
     if ovt > bh:
         raise ValueError(f"overlap_top must be <= the block height {bh}, got {ovt}")
     choice(method, "method", METHODS)
+    unknown = sorted(set(seam_options) - set(SEAM_OPTIONS[method]))
+    if unknown:
+        raise TypeError(f"unexpected option(s) for method {method!r}: {', '.join(unknown)}")
     check(cancel)
     meeting = None
     if ovt == 0:
@@ -417,14 +421,10 @@ def l_cut(
 
 def _graph_l_path(e, ovl, ovt, method, cancel, options) -> np.ndarray:
     opts = dict(options)
-    variant = opts.pop("variant", "exact")
+    metric = "sum"
     if method == "minimax":
-        metric = _MINIMAX_METRIC[choice(variant, "variant", tuple(_MINIMAX_METRIC))]
-    else:
-        metric = "sum"
-    unknown = sorted(set(opts) - {"connectivity", "levels"})
-    if unknown or (method == "dijkstra" and "levels" in opts):
-        raise TypeError(f"unexpected option(s) for method {method!r}: {', '.join(unknown)}")
+        variant = choice(opts.pop("variant", "exact"), "variant", tuple(_MINIMAX_METRIC))
+        metric = _MINIMAX_METRIC[variant]
     bh, bw = e.shape
     domain = np.zeros(e.shape, dtype=bool)
     domain[:, :ovl] = True
