@@ -37,6 +37,7 @@ from engine.project import (
     save_project,
 )
 from quilt_gui import jobs, params, settings
+from quilt_gui._compat import emit_steals_references, top_up
 from quilt_gui.app import APP_NAME, apply_theme
 from quilt_gui.document import Document, Source, safe_name
 from quilt_gui.imaging import pixel_text
@@ -89,6 +90,11 @@ class MainWindow(QMainWindow):
         self.autosave_timer.setInterval(max(5, settings.get("autosave_seconds")) * 1000)
         self.autosave_timer.timeout.connect(self.autosave_now)
         self.autosave_timer.start()
+        self._refcount_timer = QTimer(self)  # see quilt_gui/_compat.py
+        self._refcount_timer.setInterval(1000)
+        self._refcount_timer.timeout.connect(top_up)
+        if emit_steals_references():
+            self._refcount_timer.start()
         self.resize(1500, 950)
         geo, state = settings.get("window_geometry"), settings.get("window_state")
         if not geo.isEmpty():
@@ -855,6 +861,7 @@ class MainWindow(QMainWindow):
             return
         self._closing = True
         self.autosave_timer.stop()
+        self.pipeline.shutdown()
         self.jobs.shutdown(3000)
         self.recovery_file().unlink(missing_ok=True)
         settings.set("window_geometry", self.saveGeometry())

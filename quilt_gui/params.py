@@ -113,24 +113,6 @@ PARAMS: tuple[Param, ...] = (
         choices=METRICS,
     ),
     _P(
-        "o_max",
-        8,
-        "o_max",
-        "Oscillating search: largest block of control points moved at once.",
-        "Seam",
-        1,
-        64,
-    ),
-    _P(
-        "max_run",
-        8,
-        "Max run",
-        "Resistance cut: longest straight run of the walk (px).",
-        "Seam",
-        1,
-        256,
-    ),
-    _P(
         "blend",
         "adaptive",
         "Blending",
@@ -149,6 +131,59 @@ PARAMS: tuple[Param, ...] = (
         64,
     ),
     _P("rho", 3, "rho", "Adaptive blending strength (Somol & Haindl, default 3).", "Seam", 0, 16),
+    # -- options of the seam methods (shared by the tile set and quilting)
+    _P(
+        "o_max",
+        8,
+        "o_max",
+        "oscillating: largest block of control points moved at once.",
+        "Seam options",
+        1,
+        64,
+    ),
+    _P(
+        "osc_variant",
+        "resume",
+        "Oscillating variant",
+        "oscillating: resume (continue from the "
+        "last improvement) or faithful (restart the sweep, as in the paper).",
+        "Seam options",
+        choices=("resume", "faithful"),
+    ),
+    _P(
+        "max_run",
+        8,
+        "Max run",
+        "resistance: longest straight run of the walk (px).",
+        "Seam options",
+        1,
+        256,
+    ),
+    _P(
+        "connectivity",
+        "8",
+        "Connectivity",
+        "dijkstra, minimax: pixel neighbours of the path graph.",
+        "Seam options",
+        choices=("8", "4"),
+    ),
+    _P(
+        "minimax_variant",
+        "exact",
+        "Minimax variant",
+        "minimax: exact (smallest peak, then sum), lm (Long & Mould) or sorted.",
+        "Seam options",
+        choices=("exact", "lm", "sorted"),
+    ),
+    _P(
+        "levels",
+        32,
+        "Minimax levels",
+        "minimax: error quantisation levels.",
+        "Seam options",
+        2,
+        1024,
+    ),
     # -- candidates
     _P(
         "n_candidates",
@@ -319,24 +354,6 @@ PARAMS: tuple[Param, ...] = (
         choices=METRICS,
     ),
     _P(
-        "q_o_max",
-        8,
-        "o_max",
-        "Oscillating seams: largest block of control points moved at once.",
-        "Quilting",
-        1,
-        64,
-    ),
-    _P(
-        "q_max_run",
-        8,
-        "Max run",
-        "Resistance seams: longest straight run (px).",
-        "Quilting",
-        1,
-        256,
-    ),
-    _P(
         "q_blend",
         "none",
         "Blending",
@@ -450,13 +467,14 @@ DEFAULTS: dict[str, Any] = {p.key: p.default for p in PARAMS}
 
 #: Parameters whose change invalidates the seamless tile (and everything after it).
 SEAMLESS_KEYS = frozenset(
-    {"overlap", "method", "metric", "o_max", "max_run", "blend", "width", "rho"}
+    {"overlap", "method", "metric", "blend", "width", "rho"}
+    | {p.key for p in PARAMS if p.group == "Seam options"}
 )
 CANDIDATE_KEYS = frozenset(
     {"n_candidates", "patch_size", "patch_overlap", "margin", "neighbourhood", "seed"}
 )
 PREVIEW_KEYS = frozenset({"preview_rows", "preview_cols", "no_equal_neighbours", "layout_seed"})
-QUILT_KEYS = frozenset(p.key for p in PARAMS if p.group in ("Quilting", "Transfer"))
+QUILT_KEYS = frozenset(p.key for p in PARAMS if p.group in ("Quilting", "Transfer", "Seam options"))
 
 
 def coerce_all(values: dict) -> dict:
@@ -469,11 +487,16 @@ def coerce_all(values: dict) -> dict:
     return out
 
 
-def seam_options(p: dict, *, prefix: str = "") -> dict:
-    """Options of the seam method ``p[prefix + "method"]`` (only those the method takes)."""
-    method = p[prefix + "method"]
-    if method.startswith("oscillating"):
-        return {"o_max": p[prefix + "o_max"]}
-    if method == "resistance":
-        return {"max_run": p[prefix + "max_run"]}
-    return {}
+def seam_options(p: dict, method: str) -> dict:
+    """The options seam ``method`` takes (engine.seams.OPTIONS), from the parameters."""
+    from engine.seams import OPTIONS
+
+    allowed = OPTIONS.get(method, {})
+    values = {
+        "o_max": p["o_max"],
+        "max_run": p["max_run"],
+        "connectivity": int(p["connectivity"]),
+        "levels": p["levels"],
+        "variant": p["minimax_variant"] if method == "minimax" else p["osc_variant"],
+    }
+    return {k: v for k, v in values.items() if k in allowed}

@@ -110,6 +110,12 @@ class Pipeline(QObject):
     def stop(self, key: str) -> None:
         self.jobs.stop(key)
 
+    def shutdown(self) -> None:
+        """No new jobs from now on (the window closes); running ones are the manager's."""
+        for timer in (self._seamless_timer, self._preview_timer, self._quilt_timer):
+            timer.stop()
+            timer.timeout.disconnect()
+
     def busy(self) -> bool:
         """True while a job runs or a recompute is scheduled (tests wait for False)."""
         timers = (self._seamless_timer, self._preview_timer, self._quilt_timer)
@@ -188,7 +194,7 @@ class Pipeline(QObject):
             rho=p["rho"],
             waypoints=wps or None,
             maps=extra or None,
-            **params.seam_options(p),
+            **params.seam_options(p, p["method"]),
         )
         inputs = (
             doc.template_rect,
@@ -264,7 +270,7 @@ class Pipeline(QObject):
             width=p["width"],
             rho=p["rho"],
             maps=extra or None,
-            **params.seam_options(p),
+            **params.seam_options(p, p["method"]),
         )
 
     def _template_ready(self) -> bool:
@@ -596,7 +602,7 @@ def quilt_options(p: dict) -> dict:
         min_block=p["min_block"] or None,
         mode=p["q_mode"],
         rng=p["q_seed"],
-        **(params.seam_options(p, prefix="q_") if p["q_method"] != "straight" else {}),
+        **(params.seam_options(p, p["q_method"]) if p["q_method"] != "straight" else {}),
     )
 
 

@@ -43,14 +43,12 @@ SLIDERS = frozenset(
         "margin",
         "neighbourhood",
         "iterations",
-        "q_o_max",
-        "q_max_run",
         "q_width",
         "q_rho",
     }
 )
-TILESET_GROUPS = ("Template", "Seam", "Candidates", "Preview")
-QUILT_GROUPS = ("Quilting", "Transfer")
+TILESET_GROUPS = ("Template", "Seam", "Seam options", "Candidates", "Preview")
+QUILT_GROUPS = ("Quilting", "Seam options", "Transfer")
 
 
 class ParamsPanel(QScrollArea):

@@ -20,7 +20,9 @@ def test_gui_thread_stays_responsive_and_cancel_is_quick(qtbot):
     for name, s in rows.items():
         if "ms" in s:
             assert s["ms"] <= CANCEL_MS, (name, s)
-        else:
+        elif "p99" in s:
             assert s["n"] > 0, name
             assert s["p99"] <= P99_MS, (name, s)
             assert s["max"] <= MAX_MS, (name, s)
+        else:  # parameter change -> seamless tile redrawn: reported, not a pass/fail target
+            assert 0 < s["recompute_ms"] < 10_000, (name, s)
