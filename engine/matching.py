@@ -152,10 +152,9 @@ class SampleSpectrum:
             )
         if bh > h or bw > w:
             raise ValueError(f"block {bw}x{bh} is larger than the sample {w}x{h}")
-        fk = self._forward(k, workers)
-        fw = self._forward(wts, workers)
-        x = _channel_sum(fw, self._fsq)
-        x -= 2 * _channel_sum(fk, self._fs)
+        f = self._forward(np.concatenate([wts, -2.0 * k], axis=1), workers)  # one transform call
+        x = _channel_sum(f[:, : wts.shape[1]], self._fsq)
+        x += _channel_sum(f[:, wts.shape[1] :], self._fs)
         e = self._inverse(x, h - bh + 1, w - bw + 1, workers)
         e += np.asarray(const, dtype=np.float64).astype(np.float32)[:, None, None]
         np.maximum(e, 0, out=e)

@@ -278,17 +278,23 @@ def _check_torus_axis(n_out: int, block: int, overlap: int, axis: str) -> None:
         )
 
 
-def _dependency_levels(rects, shape, torus: bool) -> list[int]:
-    """Level of each rect (y, x, h, w) in raster order: 1 + max level of the earlier rects its
-    footprint touches (a map of the last level written to each pixel)."""
+def _dependencies(rects, shape, torus: bool):
+    """Predecessors and level of each rect (y, x, h, w), given in raster order.
+
+    The predecessors of a block are the last earlier blocks written under its footprint (the
+    earlier writers of those pixels precede them in turn); its level is one more than theirs.
+    Blocks of one level neither read nor write each other's pixels.
+    """
     last = np.full(shape, -1, dtype=np.int64)
-    levels = []
-    for y, x, h, w in rects:
+    preds, levels = [], []
+    for k, (y, x, h, w) in enumerate(rects):
         idx = _index(y, x, h, w, shape, torus)
-        lv = int(last[idx].max()) + 1
-        last[idx] = lv
-        levels.append(lv)
-    return levels
+        p = np.unique(last[idx])
+        p = p[p >= 0]
+        preds.append(p.tolist())
+        levels.append(1 + max((levels[j] for j in preds[-1]), default=-1))
+        last[idx] = k
+    return preds, levels
 
 
 def _index(y, x, h, w, shape, torus):
@@ -776,61 +782,65 @@ class _Quilter:
 
 
 def _run_levels(q: _Quilter, rects, total_label: str):
-    """Place ``rects`` (top-level blocks in raster order) level by level; yields events and
-    returns the records."""
+    """Place ``rects`` (top-level blocks, raster order); yields events, returns the records.
+
+    Blocks are placed one by one in level order (level, then raster index). A block's search
+    needs only its predecessors placed, so with ``threads > 1`` the searches run ahead on a pool
+    (FFT, numba kernels and large numpy operations release the GIL) while this thread places
+    blocks. Every block is searched alone, on exactly the canvas its predecessors left, with its
+    own generator: the result does not depend on the number of threads.
+    """
     if q.select == "best":
         _ = q.spectrum  # built once, before any thread reads it
         if q.mode == "fast":
             q.pca()
-    levels = _dependency_levels(rects, q.out_shape, q.tileable)
-    order: dict[int, list[int]] = {}
-    for i, lv in enumerate(levels):
-        order.setdefault(lv, []).append(i)
+    preds, levels = _dependencies(rects, q.out_shape, q.tileable)
+    order = sorted(range(len(rects)), key=lambda k: (levels[k], k))
+    works = [_Work(k, *r, rng=np.random.default_rng([q.seed, k])) for k, r in enumerate(rects)]
+    waiting = [len(p) for p in preds]
+    dependents: list[list[int]] = [[] for _ in rects]
+    for k, p in enumerate(preds):
+        for j in p:
+            dependents[j].append(k)
+    pool = ThreadPoolExecutor(max(1, q.threads - 1)) if q.threads > 1 else None
+    futures = {}
+
+    def search(k):
+        wk = works[k]
+        q.load(wk)
+        q.search([wk])
+
     records: list[BlockRecord] = []
-    pool = ThreadPoolExecutor(q.threads) if q.threads > 1 else None
-    done = 0
     try:
-        for lv in sorted(order):
+        if pool is not None:
+            for k in order:
+                if not waiting[k]:
+                    futures[k] = pool.submit(search, k)
+        for n, k in enumerate(order):
             check(q.cancel)
-            works = [_Work(i, *rects[i], rng=np.random.default_rng([q.seed, i])) for i in order[lv]]
-            for wk in works:
-                q.load(wk)
-            placed = list(_search_and_place(q, pool, works))
-            for group in placed:
-                for rec, pixels in group:
-                    rec = _renumber(rec, len(records))
-                    records.append(rec)
-                    if q.stream:
-                        yield BlockPlaced(rec, pixels)
-            done += len(works)
-            if q.stream:
-                yield Progress(done, len(rects), total_label)
+            if pool is None:
+                search(k)
+            else:
+                futures.pop(k).result()
+            for rec, pixels in q.place(works[k]):
+                rec = _renumber(rec, len(records))
+                records.append(rec)
+                if q.stream:
+                    yield BlockPlaced(rec, pixels)
+            works[k] = None  # its arrays live on in the records
+            for d in dependents[k]:
+                waiting[d] -= 1
+                if not waiting[d] and pool is not None:
+                    futures[d] = pool.submit(search, d)
+            last = n + 1 == len(order) or levels[order[n + 1]] != levels[k]
+            if q.stream and last:
+                yield Progress(n + 1, len(rects), total_label)
     finally:
         if pool is not None:
+            for f in futures.values():
+                f.cancel()
             pool.shutdown(wait=True, cancel_futures=True)
     return records
-
-
-SEARCH_CHUNK = 4
-"""Blocks searched in one batch. Fixed, so that batches (and any float round-off in them) do not
-depend on the number of threads."""
-
-
-def _search_and_place(q: _Quilter, pool, works: list[_Work]):
-    """Search the blocks of one level in fixed chunks and place them in order.
-
-    With a pool, every chunk's search runs on the pool (FFTs and numba kernels release the GIL)
-    while this thread places the blocks of the chunks already searched; the results do not depend
-    on the number of threads (same chunks, same order)."""
-    chunks = [works[i : i + SEARCH_CHUNK] for i in range(0, len(works), SEARCH_CHUNK)]
-    futures = [pool.submit(q.search, c) for c in chunks] if pool is not None else None
-    for i, chunk in enumerate(chunks):
-        if futures is None:
-            q.search(chunk)
-        else:
-            futures[i].result()
-        for wk in chunk:
-            yield q.place(wk)
 
 
 def _renumber(rec: BlockRecord, index: int) -> BlockRecord:
