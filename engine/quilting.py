@@ -476,53 +476,14 @@ class _Work:
 class _Quilter:
     """Shared state of one synthesis: sample, spectra, canvas, valid anchors, options."""
 
-    def __init__(
-        self,
-        sample,
-        out_shape,
-        *,
-        block,
-        overlap,
-        select,
-        tolerance,
-        candidates,
-        seam,
-        blend,
-        blend_width,
-        rho,
-        metric,
-        excluded,
-        tileable,
-        adaptive_threshold,
-        min_block,
-        mode,
-        seed,
-        cancel,
-        threads,
-        seam_options,
-    ):
-        self.sample = sample
+    def __init__(self, *, seed: int, cancel, threads: int, **options):
+        # options: the validated keywords of iter_quilt, as returned by _check_options (sample,
+        # out_shape, block, overlap, select, tolerance, candidates, seam, blend, blend_width, rho,
+        # metric, excluded, tileable, adaptive_threshold, min_block, mode, seam_options)
+        self.__dict__.update(options)
+        self.seed, self.cancel, self.threads = seed, cancel, threads
+        sample, out_shape = self.sample, self.out_shape
         self.match_sample = np.ascontiguousarray(colour_channels(sample))
-        self.out_shape = out_shape
-        self.block = block
-        self.overlap = overlap
-        self.select = select
-        self.tolerance = tolerance
-        self.candidates = candidates
-        self.seam = seam
-        self.blend = blend
-        self.blend_width = blend_width
-        self.rho = rho
-        self.metric = metric
-        self.excluded = excluded
-        self.tileable = tileable
-        self.adaptive_threshold = adaptive_threshold
-        self.min_block = min_block
-        self.mode = mode
-        self.seed = seed
-        self.cancel = cancel
-        self.threads = threads
-        self.seam_options = seam_options
         self.canvas = np.zeros((*out_shape, sample.shape[2]), np.float32)
         self.filled = np.zeros(out_shape, dtype=bool)
         self.floor = error_floor(self.match_sample)

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from engine.cli.tileset import _colour_range, load_source
+from engine.cli.tileset import _colour_range, _int_at_least, load_source
 
 
 def parse_wxh(text: str) -> tuple[int, int]:
@@ -31,17 +31,7 @@ def parse_wxh(text: str) -> tuple[int, int]:
     return h, w
 
 
-def int_at_least(minimum: int):
-    def parse(text: str) -> int:
-        try:
-            v = int(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
-        if v < minimum:
-            raise argparse.ArgumentTypeError(f"must be >= {minimum}, got {v}")
-        return v
-
-    return parse
+int_at_least = _int_at_least  # an integer argument type with a minimum
 
 
 def non_negative_float(text: str) -> float:
