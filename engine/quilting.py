@@ -5,10 +5,13 @@ sample, streaming a :class:`BlockPlaced` item per block and :class:`~engine.even
 ``quilt`` drains it and returns the :class:`QuiltResult`.
 
 Layout and order
-    Blocks of ``block`` pixels are placed in raster order with a step of ``block - overlap``;
-    per axis ``ceil((N - overlap) / step)`` blocks, the last ones cropped (only their valid part is
+    Blocks of ``block`` pixels lie on a grid with a step of ``block - overlap``; per axis
+    ``ceil((N - overlap) / step)`` blocks, the last ones cropped (only their valid part is
     compared). ``tileable=True`` places ``ceil(N / step)`` evenly spaced blocks on a torus, so the
     last column and row overlap the first ones (wrap-around overlaps) and the output tiles.
+    ``adaptive_threshold`` splits a block whose best overlap error is too high into four smaller
+    overlapping blocks (recursively, down to ``min_block``), as in the hybrid framework Long &
+    Mould built on.
 
 Selection (``select``)
     ``"best"``: every sample position is scored by the masked SSD over the overlap (the *union* of
@@ -29,11 +32,14 @@ Boundary (``seam``)
     ``"adaptive"``: ρ-adaptive half-widths, §1.3).
 
 Determinism and threads
-    Every block draws from its own generator seeded by (seed, block index), and blocks are
-    processed in *levels*: a block's level is one more than the highest level of the earlier blocks
-    whose footprint it touches, so the blocks of one level neither read nor write each other's
-    pixels. Their searches and cuts run on ``threads`` threads; the output is identical for any
-    number of threads and equals the sequential raster-order result.
+    Every block draws from its own generator seeded by (seed, block index). A block depends on
+    the earlier blocks (in raster order) whose footprints it touches; its *level* is one more
+    than theirs, and blocks are placed in (level, raster) order, which gives exactly the raster
+    result (blocks of one level neither read nor write each other's pixels). A block's search
+    needs only its predecessors placed, so with ``threads > 1`` the searches (FFTs and numba
+    kernels, which release the GIL) run ahead on a pool while blocks are placed. Each block is
+    searched alone on exactly the canvas its predecessors left: the output is identical for any
+    number of threads.
 """
 
 from __future__ import annotations
@@ -92,7 +98,8 @@ class BlockRecord:
     Attributes
     ----------
     index : int
-        Placement number (0, 1, ...), in the order the blocks were placed.
+        Placement number (0, 1, ...), in the order the blocks were placed and streamed (the
+        dependency order of the module docstring; sort by ``position`` for raster order).
     position : (int, int)
         (row, col) of the block's top-left pixel in the output (on a tileable output, pixels
         past the right or bottom edge wrap around).
@@ -1151,7 +1158,10 @@ def iter_quilt(
         Wrap-around overlaps on the last column and row: the output tiles seamlessly.
     adaptive_threshold : float, optional
         Split a block into four when its best overlap error, per overlap pixel and channel
-        (mean squared difference in [0, 1]² units), exceeds this; down to ``min_block``.
+        (mean squared difference in [0, 1]² units), exceeds this.
+    min_block : int, optional
+        Smallest block adaptive splitting makes (default max(2 overlap + 1, block / 4)); children
+        of a block of n pixels measure (n + overlap + 1) // 2 and overlap like the grid.
     mode : {"exact", "fast"}
         Exhaustive FFT search, or principal-component ranking with exact re-ranking.
     rng : int, Generator or None

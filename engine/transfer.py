@@ -76,7 +76,11 @@ class IterationDone(Snapshot):
 
 @dataclass(frozen=True)
 class TransferResult:
-    """Final image, every iteration's summary, and the last iteration's block records."""
+    """Final image, every iteration's summary, and the last iteration's block records.
+
+    In these records ``match_error`` and ``best_error`` are the transfer cost scaled so that the
+    overlap term has weight 1 (the correspondence term's weight when a block has no overlap).
+    """
 
     image: np.ndarray
     iterations: tuple[IterationDone, ...]

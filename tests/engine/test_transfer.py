@@ -53,6 +53,13 @@ def test_correspondence_error_falls_with_each_iteration(cobbles, target, kind):
     assert errs[-1] < 0.6 * np.mean((correspondence_map(plain, kind=kind) - cs) ** 2)
 
 
+def test_same_seed_same_transfer_for_any_thread_count(cobbles):
+    kw = dict(block=20, iterations=2, rng=4)
+    a = transfer(cobbles, disc(), threads=1, **kw)
+    b = transfer(cobbles, disc(), threads=2, **kw)
+    np.testing.assert_array_equal(a.image, b.image)
+
+
 def test_schedule_does_not_compound():
     sched = transfer_schedule(30, 3)
     assert [b for b, _, _ in sched] == [30, 20, 13]  # 30·(2/3)^i, not 30·2^i//3^i chained
