@@ -195,3 +195,19 @@ class SetLayout(QUndoCommand):
 
     def undo(self) -> None:
         self.doc.apply_layout(self.old)
+
+
+class SetPainted(QUndoCommand):
+    """The painted exclusion mask of the quilting sample (one brush stroke = one step)."""
+
+    def __init__(self, doc: Document, mask, text: str) -> None:
+        super().__init__(text)
+        self.doc = doc
+        self.new = mask
+        self.old = doc.exclude_painted
+
+    def redo(self) -> None:
+        self.doc.apply_painted(self.new)
+
+    def undo(self) -> None:
+        self.doc.apply_painted(self.old)

@@ -105,6 +105,7 @@ class Document(QObject):
     quilt_finished = Signal()
     quilt_iteration = Signal(int)  # a texture-transfer pass finished (its number)
     target_changed = Signal()
+    exclusion_changed = Signal()  # the painted exclusion mask
 
     def __init__(self, parent=None) -> None:
         super().__init__(parent)
@@ -126,6 +127,7 @@ class Document(QObject):
         self.quilt_result = None  # engine QuiltResult / TransferResult when finished
         self.transfer_target: np.ndarray | None = None  # the image a transfer imitates
         self.transfer_target_path = ""
+        self.exclude_painted: np.ndarray | None = None  # (H, W) bool, sample pixels never used
         self._dirty = False  # changes that are not undo steps (streamed results)
         self._was_modified = False
         self.undo_stack.cleanChanged.connect(self._on_clean_changed)
@@ -339,6 +341,14 @@ class Document(QObject):
         self.quilt_blocks = []
         self.quilt_iteration.emit(int(event.iteration))
 
+    def set_painted(self, mask: np.ndarray | None, *, text: str = "Paint exclusion") -> None:
+        """Replace the painted exclusion mask (one undo step)."""
+        self.undo_stack.push(commands.SetPainted(self, mask, text))
+
+    def apply_painted(self, mask: np.ndarray | None) -> None:
+        self.exclude_painted = mask
+        self.exclusion_changed.emit()
+
     def set_transfer_target(self, pixels: np.ndarray | None, path: str = "") -> None:
         self.transfer_target = pixels
         self.transfer_target_path = path
@@ -397,6 +407,7 @@ class Document(QObject):
         self.layout_changed.emit()
         self.preview_changed.emit()
         self.path_changed.emit()
+        self.apply_painted(None)
         self.start_quilt(None)
         self._emit_modified()
 

@@ -205,6 +205,12 @@ class MainWindow(QMainWindow):
             "Ctrl+Shift+Return",
             "Re-create the target image with the source's texture",
         )
+        self.act_clear_painted = A(
+            "Clear painted e&xclusion",
+            self._clear_painted,
+            None,
+            "Forget the pixels painted as never to copy",
+        )
         self.act_cancel = A(
             "&Cancel running job", self.jobs.stop_all, "Esc", "Stop the running computation"
         )
@@ -310,6 +316,8 @@ class MainWindow(QMainWindow):
         m.addAction(self.act_cancel)
         m = mb.addMenu("&Quilting")
         m.addActions([self.act_quilt, self.act_load_target, self.act_transfer])
+        m.addSeparator()
+        m.addAction(self.act_clear_painted)
         m = mb.addMenu("&Help")
         m.addAction("&Keyboard and mouse", self.show_help)
 
@@ -729,6 +737,9 @@ class MainWindow(QMainWindow):
     def run_quilt(self, *_args) -> None:
         self.tabs.setCurrentWidget(self.quilt_view)
         self.pipeline.run_quilt()
+
+    def _clear_painted(self, *_args) -> None:
+        self.quilt_view.clear_painted()
 
     def run_transfer(self, *_args) -> None:
         self.tabs.setCurrentWidget(self.quilt_view)

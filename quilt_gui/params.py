@@ -400,6 +400,16 @@ PARAMS: tuple[Param, ...] = (
         "Quilting",
     ),
     _P(
+        "brush",
+        8,
+        "Brush radius",
+        "Radius of the exclusion brush (Shift+drag on the sample in the Quilting tab; "
+        "Shift+right-drag erases).",
+        "Quilting",
+        1,
+        256,
+    ),
+    _P(
         "exclude_tolerance",
         0.0,
         "Exclude colour ±",
@@ -474,7 +484,10 @@ CANDIDATE_KEYS = frozenset(
     {"n_candidates", "patch_size", "patch_overlap", "margin", "neighbourhood", "seed"}
 )
 PREVIEW_KEYS = frozenset({"preview_rows", "preview_cols", "no_equal_neighbours", "layout_seed"})
-QUILT_KEYS = frozenset(p.key for p in PARAMS if p.group in ("Quilting", "Transfer", "Seam options"))
+#: Parameters whose change re-runs a shown quilting / transfer result (the brush only paints).
+QUILT_KEYS = frozenset(
+    p.key for p in PARAMS if p.group in ("Quilting", "Transfer", "Seam options")
+) - {"brush"}
 
 
 def coerce_all(values: dict) -> dict:

@@ -66,6 +66,7 @@ class Pipeline(QObject):
         doc.picks_changed.connect(self.schedule_preview)
         doc.candidates_reset.connect(self.schedule_preview)
         doc.candidate_changed.connect(self._on_candidate_changed)
+        doc.exclusion_changed.connect(self.restart_quilt_if_shown)
         self._quilt_timer = _soon(self, self._restart_quilt)
         self._gen_old = ([], [])
         self._quilt_mode = "quilt"  # what a parameter change restarts: "quilt" or "transfer"
@@ -96,9 +97,13 @@ class Pipeline(QObject):
             self.schedule_seamless()
         if keys & params.PREVIEW_KEYS:
             self.schedule_preview()
-        if keys & params.QUILT_KEYS and (
-            self.jobs.get("quilt") is not None or self.doc.quilt_result is not None
-        ):
+        if keys & params.QUILT_KEYS:
+            self.restart_quilt_if_shown()
+
+    @Slot()
+    def restart_quilt_if_shown(self) -> None:
+        """Re-run quilting / transfer after an input changed, if a result is shown or running."""
+        if self.jobs.get("quilt") is not None or self.doc.quilt_result is not None:
             self.jobs.abort("quilt")  # its blocks are stale now
             self._quilt_timer.start()
 
@@ -466,14 +471,18 @@ class Pipeline(QObject):
             doc.source.main,
             shape,
             label="Quilting",
-            exclude_color=p["exclude_color"],
-            exclude_tolerance=p["exclude_tolerance"],
+            exclusion=self.exclusion(),
             on_event=self._on_quilt_event,
             on_done=self._on_quilt_done,
             on_error=self._on_quilt_error,
             on_cancel=self._on_quilt_cancel,
             **quilt_options(p),
         )
+
+    def exclusion(self) -> tuple:
+        """(colour, tolerance, painted mask): the arguments of :func:`excluded_mask`."""
+        p = self.doc.params
+        return p["exclude_color"], p["exclude_tolerance"], self.doc.exclude_painted
 
     def run_transfer(self) -> jobs.Job | None:
         """Texture transfer of the source onto the target's layout; passes stream in."""
@@ -496,8 +505,7 @@ class Pipeline(QObject):
             doc.source.main,
             doc.transfer_target,
             label="Texture transfer",
-            exclude_color=p["exclude_color"],
-            exclude_tolerance=p["exclude_tolerance"],
+            exclusion=self.exclusion(),
             alpha=None if p["alpha_ramp"] else p["alpha"],
             iterations=p["iterations"],
             correspondence=p["correspondence"],
@@ -606,40 +614,40 @@ def quilt_options(p: dict) -> dict:
     )
 
 
-def excluded_mask(sample: np.ndarray, color: str, tolerance: float):
-    """The sample pixels within ``tolerance`` of ``color`` (per channel), or None."""
+def excluded_mask(sample: np.ndarray, color: str, tolerance: float, painted=None):
+    """Sample pixels within ``tolerance`` of ``color`` (per channel) or painted; None if none."""
     from engine.exclusion import exclusion_mask
 
     rgb = parse_color(color)
-    if rgb is None or tolerance <= 0:
+    color_range = None
+    if rgb is not None and tolerance > 0:
+        color_range = (
+            [max(0.0, v - tolerance) for v in rgb],
+            [min(1.0, v + tolerance) for v in rgb],
+        )
+    if color_range is None and (painted is None or not painted.any()):
         return None
-    lo = [max(0.0, v - tolerance) for v in rgb]
-    hi = [min(1.0, v + tolerance) for v in rgb]
-    return exclusion_mask(sample, color_range=(lo, hi))
+    return exclusion_mask(sample, color_range=color_range, painted=painted)
 
 
-def _job_mask(sample, color: str, tolerance: float):
-    mask = excluded_mask(sample, color, tolerance)
+def _job_mask(sample, exclusion):
+    mask = excluded_mask(sample, *exclusion)
     if mask is not None and mask.all():
-        raise ValueError("the excluded colour range covers the whole sample; lower the tolerance")
+        raise ValueError("the excluded colour range and painted mask cover the whole sample")
     return mask
 
 
-def quilt_job(
-    sample, out_shape, *, exclude_color: str, exclude_tolerance: float, cancel=None, **options
-):
+def quilt_job(sample, out_shape, *, exclusion, cancel=None, **options):
     """Worker body of a quilting run: exclusion mask, then the engine's event generator."""
     from engine.quilting import iter_quilt
 
-    mask = _job_mask(sample, exclude_color, exclude_tolerance)
+    mask = _job_mask(sample, exclusion)
     return iter_quilt(sample, out_shape, excluded=mask, cancel=cancel, threads=2, **options)
 
 
-def transfer_job(
-    sample, target, *, exclude_color: str, exclude_tolerance: float, cancel=None, **options
-):
+def transfer_job(sample, target, *, exclusion, cancel=None, **options):
     """Worker body of a texture transfer: exclusion mask, then the engine's generator."""
     from engine.transfer import iter_transfer
 
-    mask = _job_mask(sample, exclude_color, exclude_tolerance)
+    mask = _job_mask(sample, exclusion)
     return iter_transfer(sample, target, excluded=mask, cancel=cancel, threads=2, **options)

@@ -9,7 +9,7 @@ block's sample window, its placed pixels and its overlap error map, with the sea
 from __future__ import annotations
 
 import numpy as np
-from PySide6.QtCore import QRectF, Qt, QTimer, Slot
+from PySide6.QtCore import QEvent, QRectF, Qt, QTimer, Slot
 from PySide6.QtGui import QColor, QImage, QPainter
 from PySide6.QtWidgets import (
     QGraphicsItem,
@@ -97,6 +97,14 @@ class QuiltView(QWidget):
         )
         self.info.setWordWrap(True)
         self.selected: int | None = None
+        self._stroke: np.ndarray | None = None  # the mask being painted (Shift+drag)
+        self._stroke_value = True
+        self._last_px: tuple[int, int] | None = None
+        self.sample.viewport().installEventFilter(self)
+        self.sample.setToolTip(
+            "Ctrl+click: exclude this colour · Shift+drag: paint pixels "
+            "never to copy · Shift+right-drag: erase"
+        )
         self._inspect_timer = QTimer(self)
         self._inspect_timer.setSingleShot(True)
         self._inspect_timer.setInterval(0)
@@ -150,6 +158,7 @@ class QuiltView(QWidget):
         doc.quilt_iteration.connect(self._on_iteration)
         doc.target_changed.connect(self._on_target_changed)
         doc.params_changed.connect(self._on_params_changed)
+        doc.exclusion_changed.connect(self._update_exclusion)
         self._on_source_changed()
 
     # ------------------------------------------------------------------ document -> view
@@ -168,10 +177,11 @@ class QuiltView(QWidget):
     def _update_exclusion(self) -> None:
         src = self.doc.source
         p = self.doc.params
+        painted = self._stroke if self._stroke is not None else self.doc.exclude_painted
         mask = (
             None
             if src is None
-            else excluded_mask(src.main, p["exclude_color"], p["exclude_tolerance"])
+            else excluded_mask(src.main, p["exclude_color"], p["exclude_tolerance"], painted)
         )
         if mask is None or not mask.any():
             self.excluded.hide()
@@ -240,6 +250,59 @@ class QuiltView(QWidget):
         self.target.set_image(self.doc.transfer_target, fit=True)
         if self.doc.transfer_target is not None:
             self.inputs.setCurrentWidget(self.target)
+
+    # ------------------------------------------------------------------ painted exclusion
+    def eventFilter(self, obj, event) -> bool:  # noqa: N802 - Qt API
+        """Shift+drag on the sample paints the exclusion mask (right button erases)."""
+        if obj is not self.sample.viewport() or self.doc.source is None:
+            return False
+        kind = event.type()
+        if (
+            kind == QEvent.Type.MouseButtonPress
+            and event.modifiers() & Qt.KeyboardModifier.ShiftModifier
+        ):
+            px = self.sample.pixel_at(event.position())
+            if px is None:
+                return False
+            current = self.doc.exclude_painted
+            self._stroke = (
+                np.zeros(self.doc.source.shape, bool) if current is None else current.copy()
+            )
+            self._stroke_value = event.button() != Qt.MouseButton.RightButton
+            self._last_px = px
+            self._paint(px, px)
+            return True
+        if kind == QEvent.Type.MouseMove and self._stroke is not None:
+            px = self.sample.pixel_at(event.position())
+            if px is not None:
+                self._paint(self._last_px or px, px)
+                self._last_px = px
+            return True
+        if kind == QEvent.Type.MouseButtonRelease and self._stroke is not None:
+            stroke, self._stroke, self._last_px = self._stroke, None, None
+            text = "Paint exclusion" if self._stroke_value else "Erase exclusion"
+            self.doc.set_painted(stroke if stroke.any() else None, text=text)
+            return True
+        return False
+
+    def _paint(self, a: tuple[int, int], b: tuple[int, int]) -> None:
+        """Stamp the brush along the segment a -> b (pixels (row, col))."""
+        r = int(self.doc.params["brush"])
+        H, W = self._stroke.shape
+        steps = max(abs(b[0] - a[0]), abs(b[1] - a[1]), 1)
+        for t in np.linspace(0.0, 1.0, steps + 1):
+            cy, cx = a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t
+            r0, r1 = max(0, int(cy) - r), min(H, int(cy) + r + 1)
+            c0, c1 = max(0, int(cx) - r), min(W, int(cx) + r + 1)
+            yy, xx = np.mgrid[r0:r1, c0:c1]
+            disk = (yy - cy) ** 2 + (xx - cx) ** 2 <= r * r
+            self._stroke[r0:r1, c0:c1][disk] = self._stroke_value
+        self._update_exclusion()
+
+    @Slot()
+    def clear_painted(self) -> None:
+        if self.doc.exclude_painted is not None:
+            self.doc.set_painted(None, text="Clear painted exclusion")
 
     # ------------------------------------------------------------------ inspection
     @Slot()

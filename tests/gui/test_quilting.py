@@ -108,3 +108,33 @@ def test_texture_transfer_streams_passes_and_follows_the_target(qtbot, tmp_path)
     w.doc.set_param("alpha_ramp", False)  # a parameter change re-runs the transfer
     wait_idle(qtbot, w)
     assert w.doc.quilt_result is not res and len(w.doc.quilt_result.iterations) == 2
+
+
+def test_painted_exclusion_is_one_undo_step_and_never_copied(qtbot):
+    w = make_window(qtbot)
+    open_sample(qtbot, w)
+    small(w, select="random")
+    w.tabs.setCurrentWidget(w.quilt_view)
+    s = w.quilt_view.sample
+    s.set_zoom(1.0)
+    s.center_on_pixel(256, 256)
+    w.doc.set_param("brush", 6)
+    n0 = w.doc.undo_stack.count()
+    a = s.view_pos_of_pixel(200, 150).toPoint()
+    b = s.view_pos_of_pixel(260, 330).toPoint()
+    shift = Qt.KeyboardModifier.ShiftModifier
+    qtbot.mousePress(s.viewport(), Qt.MouseButton.LeftButton, shift, a)
+    for t in np.linspace(0, 1, 8)[1:]:
+        qtbot.mouseMove(s.viewport(), a + (b - a) * t)
+    qtbot.mouseRelease(s.viewport(), Qt.MouseButton.LeftButton, shift, b)
+    mask = w.doc.exclude_painted
+    assert w.doc.undo_stack.count() == n0 + 1
+    assert mask[200, 150] and mask[260, 330] and mask[230, 240] and not mask[100, 100]
+    assert w.quilt_view.excluded.isVisible()
+    w.act_quilt.trigger()
+    wait_idle(qtbot, w)
+    for blk in w.doc.quilt_result.blocks:
+        x, y, bw, bh = blk.source
+        assert not mask[y : y + bh, x : x + bw].any()
+    w.doc.undo_stack.undo()
+    assert w.doc.exclude_painted is None and not w.quilt_view.excluded.isVisible()
