@@ -80,36 +80,59 @@ def pair_ratios(tiles) -> np.ndarray:
 
 
 # ----------------------------------------------------------------------------- tables
+def pair_text(pair, digits: int = 2) -> str:
+    return " / ".join(f"{v:.{digits}f}" for v in pair)
+
+
+def sample_figures(name: str, tile: int, n: int, seed: int, joint_weight=None) -> dict:
+    """Template, seamless tile and ``n`` candidates of one bundled sample, and their figures."""
+    S = load_image(resources.sample_path(name)).pixels
+    opts = {} if joint_weight is None else {"joint_weight": joint_weight}
+    tmpl = find_template(S, tile_min=tile, tile_max=tile, **opts)
+    st = make_seamless(S, tmpl)
+    a, b = tmpl.rect[2:]
+    cands = candidates(S, st, n, rng=seed, workers=2)
+    ratios = pair_ratios([c.tile for c in cands])
+    picked = sorted(cands, key=lambda c: c.scores["criterion"])[:8]
+    layout = random_layout(len(picked), 8, 8, rng=seed, no_equal_neighbours=True)
+    g = grid_score(assemble(picked, layout), (b, a), source=S)
+    g0 = grid_score(assemble([st.tile], np.zeros((8, 8), int)), (b, a), source=S)
+    fade = crossfade_tile(S, (0, 0, a, b), tmpl.overlap)
+    return {
+        "S": S,
+        "template": tmpl,
+        "naive": (wrap_border_ratio(S[:b, :a]), detail_ratio(S[:b, :a], S)),
+        "fade": (wrap_border_ratio(fade), detail_ratio(fade, S)),
+        "ours": (wrap_border_ratio(st.tile), detail_ratio(st.tile, S)),
+        "ours_hv": (
+            wrap_border_ratio(st.tile, direction="horizontal"),
+            wrap_border_ratio(st.tile, direction="vertical"),
+        ),
+        "pairs": (float(np.median(ratios)), float(ratios.max())),
+        "changed": float(np.mean([c.scores["changed"] for c in cands])),
+        "grid": (g, g0),
+    }
+
+
 def quality(tile: int, n: int, seed: int) -> str:
-    rows = []
+    rows, wraps, details = [], [], []
     for name in resources.SAMPLE_NAMES:
-        S = load_image(resources.sample_path(name)).pixels
-        tmpl = find_template(S, tile_min=tile, tile_max=tile)
-        st = make_seamless(S, tmpl)
-        a, b = tmpl.rect[2:]
-        naive = S[:b, :a]
-        fade = crossfade_tile(S, (0, 0, a, b), tmpl.overlap)
-        cands = candidates(S, st, n, rng=seed, workers=2)
-        ratios = pair_ratios([c.tile for c in cands])
-        changed = np.mean([c.scores["changed"] for c in cands])
-        picked = sorted(cands, key=lambda c: c.scores["criterion"])[:8]
-        layout = random_layout(len(picked), 8, 8, rng=seed, no_equal_neighbours=True)
-        g = grid_score(assemble(picked, layout), (b, a), source=S)
-        g0 = grid_score(assemble([st.tile], np.zeros((8, 8), int)), (b, a), source=S)
+        f = sample_figures(name, tile, n, seed)
+        g, g0 = f["grid"]
+        wraps.append(f["ours"][0])
+        details.append(f["ours"][1])
         rows.append(
             [
                 name,
-                f"{wrap_border_ratio(naive):.2f} / {detail_ratio(naive, S):.2f}",
-                f"{wrap_border_ratio(fade):.2f} / {detail_ratio(fade, S):.2f}",
-                f"{wrap_border_ratio(st.tile):.2f} / {detail_ratio(st.tile, S):.2f}",
-                f"{np.median(ratios):.3f}",
-                f"{ratios.max():.3f}",
-                f"{changed:.0%}",
+                pair_text(f["naive"]),
+                pair_text(f["fade"]),
+                pair_text(f["ours"]),
+                f"{f['pairs'][0]:.3f}",
+                f"{f['pairs'][1]:.3f}",
+                f"{f['changed']:.0%}",
                 f"{g:.3f} / {g0:.3f} = {g / g0:.2f}",
             ]
         )
-    wraps = [float(r[3].split(" / ")[0]) for r in rows]
-    details = [float(r[3].split(" / ")[1]) for r in rows]
     table = format_table(
         [
             "sample",
@@ -127,6 +150,54 @@ def quality(tile: int, n: int, seed: int) -> str:
         table + f"\nmedian over samples: ours wrap {np.median(wraps):.2f} (target <= 1.15),"
         f" detail {np.median(details):.2f} (target >= 0.95); pairs: median <= 1.2, "
         "max <= 1.6; grid ratio <= 0.35"
+    )
+
+
+def joint_weight_sweep(weights, tile: int, n: int, seed: int) -> str:
+    """Per sample and λ (``joint_weight``): the template's strip mismatch and wrap-joint step
+    (G over the mean column/row step of the source), its wrap ratio h/v, detail, and the
+    candidates' pair median/max and grid ratio: how the default λ was chosen."""
+    rows = []
+    for lam in weights:
+        worst_max, wraps = 0.0, []
+        for name in resources.SAMPLE_NAMES:
+            f = sample_figures(name, tile, n, seed, joint_weight=lam)
+            t, S = f["template"], f["S"]
+            step = [  # the mean column / row step of the source, in the units of G
+                np.sqrt((np.diff(S.astype(np.float64), axis=ax) ** 2).sum(axis=2)).mean()
+                for ax in (1, 0)
+            ]
+            g, g0 = f["grid"]
+            wraps.append(f["ours"][0])
+            worst_max = max(worst_max, f["pairs"][1])
+            rows.append(
+                [
+                    f"{lam:g}",
+                    name,
+                    str(t.rect),
+                    f"{t.cost_horizontal:.4f} / {t.cost_vertical:.4f}",
+                    f"{t.joint_horizontal / step[0]:.2f} / {t.joint_vertical / step[1]:.2f}",
+                    pair_text(f["ours_hv"]),
+                    f"{f['ours'][1]:.2f}",
+                    pair_text(f["pairs"], 3),
+                    f"{g / g0:.2f}",
+                ]
+            )
+        summary = f"median {np.median(wraps):.2f}", "", f"worst max {worst_max:.3f}", ""
+        rows.append([f"{lam:g}", "all samples", "", "", "", *summary])
+    return format_table(
+        [
+            "λ",
+            "sample",
+            "rect",
+            "mismatch D_h / D_v",
+            "joint G_h / G_v (x mean step)",
+            "wrap h / v",
+            "detail",
+            "pairs median / max",
+            "grid ratio",
+        ],
+        rows,
     )
 
 
@@ -218,25 +289,33 @@ def main(argv=None) -> int:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--skip-quality", action="store_true")
     ap.add_argument("--skip-big", action="store_true", help="skip the 4096 px run")
+    ap.add_argument("--skip-speed", action="store_true", help="skip the speed tables")
+    ap.add_argument(
+        "--joint-weights",
+        type=lambda v: [float(x) for x in v.split(",")],
+        metavar="L1,L2,...",
+        help="also sweep the template search's joint_weight λ over these values (quality only)",
+    )
     args = ap.parse_args(argv)
     print(f"python -m benchmarks.tileset (candidates={args.candidates}, seed={args.seed})")
     headers = ["source -> tile", "step", "seconds / MiB", "target"]
-    print("\n## Speed and memory\n")
-    S = load_image(resources.sample_path("cobblestones")).pixels
-    print(
-        format_table(headers, speed(S, 256, args.candidates, args.seed, "512 -> 256")), flush=True
-    )
-    if not args.skip_big:
-        print()
-        big = big_source(4096, args.seed)
-        print(
-            format_table(headers, speed(big, 1024, args.candidates, args.seed, "4096 -> 1024")),
-            flush=True,
-        )
-        del big
+    if not args.skip_speed:
+        print("\n## Speed and memory\n")
+        S = load_image(resources.sample_path("cobblestones")).pixels
+        rows = speed(S, 256, args.candidates, args.seed, "512 -> 256")
+        print(format_table(headers, rows), flush=True)
+        if not args.skip_big:
+            print()
+            big = big_source(4096, args.seed)
+            rows = speed(big, 1024, args.candidates, args.seed, "4096 -> 1024")
+            print(format_table(headers, rows), flush=True)
+            del big
     if not args.skip_quality:
         print("\n## Quality: 512x512 samples, 256x256 tiles\n")
         print(quality(256, args.candidates, args.seed), flush=True)
+    if args.joint_weights:
+        print("\n## Template search: joint weight λ (512x512 samples, 256x256 tiles)\n")
+        print(joint_weight_sweep(args.joint_weights, 256, args.candidates, args.seed), flush=True)
     return 0
 
 

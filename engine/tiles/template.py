@@ -10,6 +10,17 @@ The search minimises the mean RGB Euclidean distance between R_L and R_R and bet
 R_B, in the paper's two phases (horizontal: every x and width at once, vertical: every y and
 height with the columns fixed), optionally refined by redoing the horizontal phase on the
 chosen rows until the rectangle is stable (at most three times).
+
+**Calm wrap joints** [REC, beyond the paper]: after the stitch (:mod:`engine.tiles.seamless`)
+the tile's left edge is source column ``x + w`` and its right edge column ``x + w - 1`` (the
+cuts keep both), so the tile's left-right wrap joint *is* the natural column pair
+``(x + w - 1, x + w)``; likewise its top-bottom joint is the row pair ``(y + h - 1, y + h)``.
+Minimising the strip mismatch alone may put that pair on an edge of the texture (a mortar
+line of a brick wall: 2.6x the mean column step), which no cut can repair. The phases
+therefore minimise ``D_h(x, w) + λ·G_h(x + w)`` and ``D_v(y, h) + λ·G_v(y + h)`` where
+``G_h(c)`` is the mean distance between columns ``c - 1`` and ``c`` over the rows in use (the
+units of D) and λ is ``joint_weight`` (default :data:`JOINT_WEIGHT`, chosen on the bundled
+samples by ``benchmarks/tileset.py --joint-weights``; 0 gives the paper's criterion).
 """
 
 from __future__ import annotations
@@ -38,6 +49,7 @@ __all__ = [
 ]
 
 _CHUNK = 8  # shifts per kernel call between cancel checks / progress events
+JOINT_WEIGHT = 0.5  # λ: weight of the natural wrap joint's step G next to the strip mismatch D
 
 
 @dataclass(frozen=True, slots=True)
@@ -61,11 +73,17 @@ class Template:
     overlap : int
         w_T, the width of the border regions R_L/R_R/R_T/R_B.
     cost : float
-        Mean of ``cost_horizontal`` and ``cost_vertical``.
+        The searched criterion: ``(cost_horizontal + cost_vertical) / 2 + joint_weight *
+        (joint_horizontal + joint_vertical) / 2`` (:func:`template_cost` gives the same).
     cost_horizontal, cost_vertical : float
-        Mean RGB Euclidean distance R_L vs R_R and R_T vs R_B.
+        Mean RGB Euclidean distance R_L vs R_R and R_T vs R_B (the strip mismatch).
     warnings : tuple of str
         Anything the caller should show the user (clamped range, flat source...).
+    joint_horizontal, joint_vertical : float
+        Mean distance between the natural columns ``x + w - 1`` and ``x + w`` (rows
+        ``y + h - 1`` and ``y + h``) over the footprint: the step across the tile's wrap.
+    joint_weight : float
+        λ used by the search.
     """
 
     rect: tuple[int, int, int, int]
@@ -74,6 +92,9 @@ class Template:
     cost_horizontal: float = 0.0
     cost_vertical: float = 0.0
     warnings: tuple[str, ...] = ()
+    joint_horizontal: float = 0.0
+    joint_vertical: float = 0.0
+    joint_weight: float = 0.0
 
     @property
     def footprint(self) -> tuple[int, int, int, int]:
@@ -205,44 +226,62 @@ def _runs_1d(free: np.ndarray) -> np.ndarray:
 
 
 # --------------------------------------------------------------------------- phases
-class _Scan:
-    """One phase over shifts: the cost D(x, a) of every position and shift (means)."""
+def _sums(S, valid, rows, shifts, out_sum, out_cnt) -> None:
+    use_valid = valid is not None
+    _shift_sums(
+        S,
+        valid if use_valid else np.ones((1, 1), dtype=np.bool_),
+        use_valid,
+        rows[0],
+        rows[1],
+        shifts,
+        out_sum,
+        out_cnt,
+    )
 
-    def __init__(self, S, valid, rows, shifts, overlap):
+
+def _joint_steps(S, valid, rows) -> np.ndarray:
+    """G[c] = mean distance between columns c - 1 and c over ``rows`` (valid pairs); G[0] = 0."""
+    W = S.shape[1]
+    s = np.zeros((1, W))
+    c = np.zeros((1, W))
+    _sums(S, valid, rows, np.ones(1, dtype=np.int64), s, c)
+    G = np.zeros(W)
+    G[1:] = s[0, : W - 1] / np.maximum(c[0, : W - 1], 1.0)
+    return G
+
+
+class _Scan:
+    """One phase over shifts: the cost D(x, a) + λ·G(x + a) of every position and shift."""
+
+    def __init__(self, S, valid, rows, shifts, overlap, joint_weight=0.0):
         self.S = S
         self.valid = valid
         self.rows = rows
         self.shifts = np.asarray(shifts, dtype=np.int64)
         self.overlap = overlap
+        self.joint_weight = float(joint_weight)
         W = S.shape[1]
         self.sum = np.zeros((self.shifts.size, W), dtype=np.float64)
         self.cnt = np.zeros((self.shifts.size, W), dtype=np.float64)
 
     def chunks(self):
         """Run the kernel chunk by chunk; yields the number of shifts done so far."""
-        use_valid = self.valid is not None
-        valid = self.valid if use_valid else np.ones((1, 1), dtype=np.bool_)
         for k0 in range(0, self.shifts.size, _CHUNK):
             k1 = min(k0 + _CHUNK, self.shifts.size)
-            _shift_sums(
-                self.S,
-                valid,
-                use_valid,
-                self.rows[0],
-                self.rows[1],
-                self.shifts[k0:k1],
-                self.sum[k0:k1],
-                self.cnt[k0:k1],
+            _sums(
+                self.S, self.valid, self.rows, self.shifts[k0:k1], self.sum[k0:k1], self.cnt[k0:k1]
             )
             yield k1
 
     def costs(self, feasible_run: np.ndarray | None) -> np.ndarray:
-        """(K, W) mean cost of the border pair at x with shift shifts[k]; inf where invalid.
+        """(K, W) cost of the border pair at x with shift shifts[k]; inf where invalid.
 
         ``feasible_run[x]`` is the widest footprint allowed to start at column x.
         """
         K, W = self.sum.shape
         w = self.overlap
+        G = self.joint_weight * _joint_steps(self.S, self.valid, self.rows)
         cs = np.cumsum(np.pad(self.sum, ((0, 0), (1, 0))), axis=1)
         cc = np.cumsum(np.pad(self.cnt, ((0, 0), (1, 0))), axis=1)
         out = np.full((K, W), np.inf)
@@ -254,6 +293,7 @@ class _Scan:
             c = cc[k, w : w + n] - cc[k, :n]
             with np.errstate(invalid="ignore", divide="ignore"):
                 d = np.where(c > 0, s / np.maximum(c, 1), np.inf)
+            d = d + G[int(a) : int(a) + n]
             if feasible_run is not None:
                 d = np.where(feasible_run[:n] >= int(a) + w, d, np.inf)
             out[k, :n] = d
@@ -269,40 +309,76 @@ def _argmin(costs: np.ndarray, shifts: np.ndarray) -> tuple[int, int, float] | N
     return int(x), int(shifts[kk]), c
 
 
-def _pair_cost(S, valid, rows, x, a, overlap) -> float:
-    """Mean distance of columns [x, x+w_T) and [x+a, x+a+w_T) over ``rows``."""
+def _pair_cost(S, valid, rows, x, a, overlap) -> tuple[float, float]:
+    """Mean distance of columns [x, x+w_T) and [x+a, x+a+w_T) over ``rows``, and the joint
+    G: mean distance of columns x+a-1 and x+a (valid pairs only)."""
     r0, r1 = rows
-    A = S[r0:r1, x : x + overlap].astype(np.float64)
-    B = S[r0:r1, x + a : x + a + overlap].astype(np.float64)
-    d = np.sqrt(((A - B) ** 2).sum(axis=2))
-    if valid is not None:
-        ok = valid[r0:r1, x : x + overlap] & valid[r0:r1, x + a : x + a + overlap]
-        return float(d[ok].mean()) if ok.any() else math.inf
-    return float(d.mean())
+    F = S[r0:r1, x : x + a + overlap].astype(np.float64)
+    d = np.sqrt(((F[:, :overlap] - F[:, a:]) ** 2).sum(axis=2))
+    g = np.sqrt(((F[:, a - 1] - F[:, a]) ** 2).sum(axis=1))
+    if valid is None:
+        return float(d.mean()), float(g.mean())
+    v = valid[r0:r1, x : x + a + overlap]
+    ok = v[:, :overlap] & v[:, a:]
+    gk = v[:, a - 1] & v[:, a]
+    return (
+        float(d[ok].mean()) if ok.any() else math.inf,
+        float(g[gk].mean()) if gk.any() else 0.0,
+    )
 
 
-def _rect_costs(S, valid, rect, overlap) -> tuple[float, float]:
+def _rect_costs(S, valid, rect, overlap) -> tuple[float, float, float, float]:
+    """(D_h, D_v, G_h, G_v) of ``rect``: strip mismatches and wrap-joint steps."""
     x, y, a, b = rect
     St = np.ascontiguousarray(S[:, x : x + a + overlap].transpose(1, 0, 2))
     vt = None if valid is None else np.ascontiguousarray(valid[:, x : x + a + overlap].T)
-    ch = _pair_cost(S, valid, (y, y + b + overlap), x, a, overlap)
-    cv = _pair_cost(St, vt, (0, a + overlap), y, b, overlap)
-    return ch, cv
+    ch, gh = _pair_cost(S, valid, (y, y + b + overlap), x, a, overlap)
+    cv, gv = _pair_cost(St, vt, (0, a + overlap), y, b, overlap)
+    return ch, cv, gh, gv
+
+
+def _make_template(S, valid, rect, overlap, joint_weight, notes=()) -> Template:
+    ch, cv, gh, gv = _rect_costs(S, valid, rect, overlap)
+    return Template(
+        rect=rect,
+        overlap=overlap,
+        cost=(ch + cv) / 2.0 + joint_weight * (gh + gv) / 2.0,
+        cost_horizontal=ch,
+        cost_vertical=cv,
+        warnings=tuple(notes),
+        joint_horizontal=gh,
+        joint_vertical=gv,
+        joint_weight=joint_weight,
+    )
+
+
+def _joint_weight(value) -> float:
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise TypeError(f"joint_weight must be a number, got {value!r}")
+    if not (math.isfinite(value) and value >= 0):
+        raise ValueError(f"joint_weight must be finite and >= 0, got {value!r}")
+    return float(value)
 
 
 # --------------------------------------------------------------------------- API
-def template_cost(source, rect, *, overlap: int, excluded=None) -> tuple[float, float, float]:
+def template_cost(
+    source, rect, *, overlap: int, excluded=None, joint_weight: float = JOINT_WEIGHT
+) -> tuple[float, float, float]:
     """Cost of a given (e.g. user-dragged) rectangle: ``(cost, cost_horizontal, cost_vertical)``.
 
     ``rect = (x, y, w, h)``; its footprint ``(x, y, w + overlap, h + overlap)`` must lie in
-    the source. Excluded pixels are left out of the means.
+    the source. Excluded pixels are left out of the means. ``cost`` is the search's criterion
+    (strip mismatches plus ``joint_weight`` times the wrap-joint steps, as
+    :attr:`Template.cost`); ``cost_horizontal`` / ``cost_vertical`` are the strip mismatches.
     """
     S = colour_channels(as_image(source, "source"))
     H, W = S.shape[:2]
     x, y, a, b = _check_rect(rect, overlap, (H, W))
     ex = _excluded_mask(excluded, (H, W))
-    ch, cv = _rect_costs(S, None if ex is None else ~ex, (x, y, a, b), overlap)
-    return (ch + cv) / 2.0, ch, cv
+    t = _make_template(
+        S, None if ex is None else ~ex, (x, y, a, b), int(overlap), _joint_weight(joint_weight)
+    )
+    return t.cost, t.cost_horizontal, t.cost_vertical
 
 
 def _check_rect(rect, overlap, shape) -> tuple[int, int, int, int]:
@@ -332,6 +408,7 @@ def iter_find_template(
     excluded=None,
     refine: bool = True,
     coarse: int | None = None,
+    joint_weight: float = JOINT_WEIGHT,
     cancel=None,
 ):
     """Search the tile rectangle; returns a generator of events whose value is a Template.
@@ -353,6 +430,11 @@ def iter_find_template(
         Search first on an image ``coarse`` times smaller, then at full resolution only
         around that result (shifts ±coarse, positions ±2·coarse). None (default): chosen
         from the work (1 = off for a 512 px source, 4 for 4096 px with a ±12 % size range).
+    joint_weight : float
+        λ >= 0: weight of the step across the tile's wrap joints (the natural column pair
+        ``x + w - 1, x + w`` and row pair ``y + h - 1, y + h``) added to the strip mismatch,
+        so the wrap does not fall on an edge of the texture (module docstring). 0 searches
+        the strip mismatch alone (the paper's criterion).
     cancel : CancelToken or None
         Once a first rectangle exists the search returns the best so far; before that it
         raises :class:`engine.cancel.Cancelled`.
@@ -379,8 +461,9 @@ def iter_find_template(
         warnings.warn(n, stacklevel=2)
     if coarse is not None:
         positive_int(coarse, "coarse")
+    lam = _joint_weight(joint_weight)
     return _iter_find_template(
-        S, valid, run0, lo, hi, overlap, bool(refine), cancel, tuple(notes), coarse
+        S, valid, run0, lo, hi, overlap, bool(refine), cancel, tuple(notes), coarse, lam
     )
 
 
@@ -413,7 +496,9 @@ def _coarse_factor(shape, n_shifts: int) -> int:
     return f
 
 
-def _iter_find_template(S, valid, run0, lo, hi, overlap, refine, cancel, notes, coarse=None):
+def _iter_find_template(
+    S, valid, run0, lo, hi, overlap, refine, cancel, notes, coarse=None, lam=JOINT_WEIGHT
+):
     H, W = S.shape[:2]
     n_a = hi[1] - lo[1] + 1
     f = _coarse_factor((H, W), n_a) if coarse is None else int(coarse)
@@ -432,11 +517,11 @@ def _iter_find_template(S, valid, run0, lo, hi, overlap, refine, cancel, notes, 
         hic = (max(loc[0], hi[0] // f), max(loc[1], hi[1] // f))
         ovc = max(2, round(overlap / f))
         if loc[0] + ovc <= Hc and loc[1] + ovc <= Wc:
-            prog["total"] += hic[1] - loc[1] + hic[0] - loc[0] + 2
+            prog["total"] += rounds * (hic[1] - loc[1] + hic[0] - loc[0] + 2)
             run0c = None if vc is None else _feasible_run0(vc, loc[0] + ovc)
             if run0c is None or run0c.max(initial=0) >= loc[1] + ovc:
                 c, stopped = yield from _phases(
-                    Sc, vc, run0c, loc, hic, ovc, False, cancel, notes, prog, "coarse "
+                    Sc, vc, run0c, loc, hic, ovc, refine, cancel, notes, prog, "coarse ", lam
                 )
                 if stopped:
                     raise Cancelled("cancelled before the first tile rectangle was found")
@@ -458,12 +543,13 @@ def _iter_find_template(S, valid, run0, lo, hi, overlap, refine, cancel, notes, 
         notes,
         prog,
         "",
+        lam,
         xwin,
         ywin,
     )
     if best is None and not stopped and xwin is not None:  # the windows missed: search it all
         best, stopped = yield from _phases(
-            S, valid, run0, lo, hi, overlap, refine, cancel, notes, prog, ""
+            S, valid, run0, lo, hi, overlap, refine, cancel, notes, prog, "", lam
         )
     if best is None:
         if stopped:
@@ -476,7 +562,7 @@ def _iter_find_template(S, valid, run0, lo, hi, overlap, refine, cancel, notes, 
 
 
 def _phases(
-    S, valid, run0, lo, hi, overlap, refine, cancel, notes, prog, label, xwin=None, ywin=None
+    S, valid, run0, lo, hi, overlap, refine, cancel, notes, prog, label, lam, xwin=None, ywin=None
 ):
     """The two phases (+ refinement rounds); returns (best Template or None, cancelled)."""
     H, W = S.shape[:2]
@@ -486,7 +572,7 @@ def _phases(
     best: Template | None = None
 
     def scan(St, vt, rows, shifts, feasible, what):
-        sc = _Scan(St, vt, rows, shifts, overlap)
+        sc = _Scan(St, vt, rows, shifts, overlap, lam)
         for k in sc.chunks():
             yield Progress(
                 min(prog["done"] + k, prog["total"]), prog["total"], f"template: {label}{what}"
@@ -524,21 +610,13 @@ def _phases(
         if rect == current:
             break
         current = rect
-        ch, cv = _rect_costs(S, valid, rect, overlap)
-        cost = (ch + cv) / 2.0
-        if best is None or cost < best.cost - 1e-12:
-            best = Template(
-                rect=rect,
-                overlap=overlap,
-                cost=cost,
-                cost_horizontal=ch,
-                cost_vertical=cv,
-                warnings=notes,
-            )
+        t = _make_template(S, valid, rect, overlap, lam, notes)
+        if best is None or t.cost < best.cost - 1e-12:
+            best = t
             if not label:
                 yield TemplateUpdate(
                     rect=rect,
-                    cost=cost,
+                    cost=t.cost,
                     overlap=overlap,
                     phase="search" if _round == 0 else "refine",
                 )

@@ -244,7 +244,7 @@ def test_connectability_and_variety_on_samples():
     """Acceptance: 30 candidates per sample; all ordered pairs, h and v: median border
     ratio <= 1.2 and max <= 1.6; an 8x8 preview of 8 picked tiles has a grid score at most
     0.35 x that of the template repeated."""
-    for name in ("cobblestones", "gravel", "lichen"):
+    for name in ("brick", "cobblestones", "gravel", "lichen"):
         S = load_image(resources.sample_path(name)).pixels
         st = make_seamless(S, find_template(S, tile_min=256, tile_max=256))
         cands = candidates(S, st, 30, rng=0, workers=2)

@@ -180,6 +180,32 @@ def test_bundled_samples_wrap_and_detail():
     assert np.median(wraps) <= 1.15
     assert np.median(details) >= 0.95
     assert np.median(naive) > 2 * np.median(wraps)
+    # per sample too (the brick wall's wrap was 1.85 before the calm-joint term)
+    assert max(wraps) <= 1.15, dict(zip(resources.SAMPLE_NAMES, wraps, strict=True))
+
+
+def test_brick_wrap_joint_is_calm():
+    """The tile's wrap joint is the natural column pair (x+w-1, x+w) of the source (row pair
+    (y+h-1, y+h)); the strip mismatch alone puts it on a mortar edge of the brick wall, the
+    joint term (joint_weight) moves it where the wall is calm."""
+    S = load_image(resources.sample_path("brick")).pixels
+    step = np.abs(np.diff(S, axis=1)).mean()  # mean column step (gray: |d| = Euclidean)
+    for lam, calm in ((0.0, False), (None, True)):
+        t = find_template(
+            S, tile_min=256, tile_max=256, **({} if lam is None else {"joint_weight": lam})
+        )
+        x, y, a, b = t.rect
+        st = make_seamless(S, t)
+        w = t.overlap
+        # below the vertical stitch the tile's wrap columns are the source's columns x+a-1, x+a
+        np.testing.assert_array_equal(st.tile[w:, -1], S[y + w : y + b, x + a - 1])
+        np.testing.assert_array_equal(st.tile[w:, 0], S[y + w : y + b, x + a])
+        wrap_h = wrap_border_ratio(st.tile, direction="horizontal")
+        wrap_v = wrap_border_ratio(st.tile, direction="vertical")
+        if calm:
+            assert t.joint_horizontal <= step and max(wrap_h, wrap_v) <= 1.15
+        else:  # the diagnosis: a mortar edge, > 2x the mean column step
+            assert t.joint_horizontal > 2 * step and wrap_h > 2
 
 
 def test_bad_input():

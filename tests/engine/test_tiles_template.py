@@ -25,32 +25,46 @@ def periodic(period=(23, 29), shape=(90, 100), channels=3, seed=0):
     return np.tile(cell, reps)[: shape[0], : shape[1]]
 
 
-def brute_rect_cost(S, rect, w):
+def dist(p, q):
+    return np.sqrt(((p.astype(np.float64) - q) ** 2).sum(-1))
+
+
+def brute_rect_cost(S, rect, w, lam=0.0):
+    """(D_h + D_v) / 2 + λ (G_h + G_v) / 2, G the step across the natural wrap joints."""
     x, y, a, b = rect
-    S = S.astype(np.float64)
-    dh = np.sqrt(((S[y : y + b + w, x : x + w] - S[y : y + b + w, x + a : x + a + w]) ** 2).sum(2))
-    dv = np.sqrt(((S[y : y + w, x : x + a + w] - S[y + b : y + b + w, x : x + a + w]) ** 2).sum(2))
-    return (dh.mean() + dv.mean()) / 2
+    rows, cols = slice(y, y + b + w), slice(x, x + a + w)
+    dh = dist(S[rows, x : x + w], S[rows, x + a : x + a + w]).mean()
+    dv = dist(S[y : y + w, cols], S[y + b : y + b + w, cols]).mean()
+    gh = dist(S[rows, x + a - 1], S[rows, x + a]).mean()
+    gv = dist(S[y + b - 1, cols], S[y + b, cols]).mean()
+    return (dh + dv) / 2 + lam * (gh + gv) / 2
 
 
 @pytest.mark.parametrize("masked", [False, True])
-def test_scan_costs_match_brute_force(masked):
+@pytest.mark.parametrize("lam", [0.0, 0.7])
+def test_scan_costs_match_brute_force(masked, lam):
     rng = np.random.default_rng(1)
     S = rng.random((20, 40, 3), dtype=np.float32)
-    valid = rng.random((20, 40)) > 0.2 if masked else None
+    valid = rng.random((20, 40)) > 0.2 if masked else np.ones((20, 40), bool)
     shifts = np.arange(8, 15)
     w = 4
-    sc = _Scan(S, valid, (3, 17), shifts, w)
+    sc = _Scan(S, valid if masked else None, (3, 17), shifts, w, lam)
     for _ in sc.chunks():
         pass
     costs = sc.costs(None)
+    r = slice(3, 17)
     for k, a in enumerate(shifts):
         for x in range(40):
             if x + a + w > 40:
                 assert costs[k, x] == np.inf
                 continue
-            want = _pair_cost(S, valid, (3, 17), x, int(a), w)
-            assert costs[k, x] == pytest.approx(want, rel=1e-6, abs=1e-9)
+            ok = valid[r, x : x + w] & valid[r, x + a : x + a + w]
+            d = dist(S[r, x : x + w], S[r, x + a : x + a + w])[ok].mean()
+            gk = valid[r, x + a - 1] & valid[r, x + a]
+            g = dist(S[r, x + a - 1], S[r, x + a])[gk].mean()
+            assert costs[k, x] == pytest.approx(d + lam * g, rel=1e-6, abs=1e-9)
+            dd, gg = _pair_cost(S, valid if masked else None, (3, 17), x, int(a), w)
+            assert (dd, gg) == pytest.approx((d, g), rel=1e-6, abs=1e-9)
     x, a, c = _argmin(costs, shifts)
     assert c == pytest.approx(np.nanmin(costs))
 
@@ -64,18 +78,27 @@ def test_periodic_source_finds_its_period(dtype):
     assert isinstance(t, Template)
     x, y, w, h = t.rect
     assert (h, w) == (23, 29)
-    assert t.cost == pytest.approx(0, abs=1e-6)
+    assert (t.cost_horizontal, t.cost_vertical) == pytest.approx((0, 0), abs=1e-6)
+    assert t.cost == pytest.approx(t.joint_weight * (t.joint_horizontal + t.joint_vertical) / 2)
+    pure = find_template(src, tile_min=(18, 20), tile_max=(30, 34), overlap=4, joint_weight=0)
+    assert pure.rect[2:] == (29, 23) and pure.cost == pytest.approx(0, abs=1e-6)
     assert t.footprint == (x, y, w + 4, h + 4)
     np.testing.assert_array_equal(src, before)
 
 
 def test_gray_source_and_reported_costs():
     S = periodic(channels=1)[:, :, 0] * 0.5 + np.linspace(0, 0.3, 100)[None, :]
+    for lam in (0.0, 0.5, 3.0):
+        t = find_template(S, tile_min=20, tile_max=32, overlap=4, joint_weight=lam)
+        assert t.joint_weight == lam
+        cost, ch, cv = template_cost(S, t.rect, overlap=4, joint_weight=lam)
+        assert cost == pytest.approx(t.cost)
+        assert (ch, cv) == pytest.approx((t.cost_horizontal, t.cost_vertical))
+        assert cost == pytest.approx(brute_rect_cost(S[:, :, None], t.rect, 4, lam), rel=1e-6)
+        assert (ch + cv) / 2 == pytest.approx(brute_rect_cost(S[:, :, None], t.rect, 4))
+    # the default λ is the search's default: a user-fixed rectangle scores like a found one
     t = find_template(S, tile_min=20, tile_max=32, overlap=4)
-    cost, ch, cv = template_cost(S, t.rect, overlap=4)
-    assert cost == pytest.approx(t.cost)
-    assert (ch, cv) == pytest.approx((t.cost_horizontal, t.cost_vertical))
-    assert cost == pytest.approx(brute_rect_cost(S[:, :, None], t.rect, 4), rel=1e-6)
+    assert template_cost(S, t.rect, overlap=4)[0] == pytest.approx(t.cost)
 
 
 def test_refine_never_worse_and_two_phase_near_brute_force():
@@ -175,6 +198,11 @@ def test_bad_input_messages():
     assert any("does not fit" in w for w in t.warnings)
     with pytest.raises(ValueError, match="outside"):
         template_cost(S, (50, 0, 20, 20), overlap=4)
+    for bad in (-0.1, float("nan"), float("inf")):
+        with pytest.raises(ValueError, match="joint_weight"):
+            find_template(S, tile_min=20, overlap=4, joint_weight=bad)
+    with pytest.raises(TypeError, match="joint_weight"):
+        template_cost(S, (0, 0, 20, 20), overlap=4, joint_weight="high")
 
 
 def test_flat_source_warns_and_still_works():
@@ -199,7 +227,8 @@ def test_coarse_to_fine_finds_the_period_and_is_chosen_by_size():
 
     S = periodic(period=(46, 58), shape=(260, 280))
     t = find_template(S, tile_min=(40, 50), tile_max=(60, 70), overlap=6, coarse=2)
-    assert t.rect[2:] == (58, 46) and t.cost == pytest.approx(0, abs=1e-6)
+    assert t.rect[2:] == (58, 46)
+    assert (t.cost_horizontal, t.cost_vertical) == pytest.approx((0, 0), abs=1e-6)
     full = find_template(S, tile_min=(40, 50), tile_max=(60, 70), overlap=6, coarse=1)
     assert full.rect[2:] == (58, 46)
     assert _coarse_factor((512, 512), 257) == 1  # bundled samples: full resolution
