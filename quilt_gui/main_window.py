@@ -37,7 +37,6 @@ from engine.project import (
     save_project,
 )
 from quilt_gui import jobs, params, settings
-from quilt_gui._compat import leaking_singletons, top_up
 from quilt_gui.app import APP_NAME, apply_theme
 from quilt_gui.document import Document, Source, safe_name
 from quilt_gui.imaging import pixel_text
@@ -90,11 +89,6 @@ class MainWindow(QMainWindow):
         self.autosave_timer.setInterval(max(5, settings.get("autosave_seconds")) * 1000)
         self.autosave_timer.timeout.connect(self.autosave_now)
         self.autosave_timer.start()
-        self._refcount_timer = QTimer(self)  # see quilt_gui/_compat.py
-        self._refcount_timer.setInterval(1000)
-        self._refcount_timer.timeout.connect(top_up)
-        if leaking_singletons():
-            self._refcount_timer.start()
         self.resize(1500, 950)
         geo, state = settings.get("window_geometry"), settings.get("window_state")
         if not geo.isEmpty():
