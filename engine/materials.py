@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from engine._validate import as_image, choice
+from engine.errormap import error_map
 
 NORMAL_CONVENTIONS = ("opengl", "directx")
 MAP_KINDS = ("color", "normal", "height", "roughness", "ao", "metallic", "mask", "other")
@@ -186,11 +187,6 @@ def _error(a, b, metric: str) -> np.ndarray:
     b = as_image(b, "r2")
     if a.shape != b.shape:
         raise ValueError(f"r1 and r2 must have the same shape, got {a.shape} and {b.shape}")
-    try:
-        from engine.errormap import error_map
-    except ImportError:  # pragma: no cover - errormap not written yet
-        d = a.astype(np.float64) - b
-        return np.sqrt((d * d).sum(axis=2))
     return error_map(a, b, metric=metric)
 
 
