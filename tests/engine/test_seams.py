@@ -2,12 +2,11 @@
 
 import numpy as np
 import pytest
-from PIL import Image
 from scipy import ndimage
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra as cs_dijkstra
 
-import resources
+from benchmarks.seams import sample_map
 from engine import Cancelled, CancelToken
 from engine.seams import (
     METHODS,
@@ -18,6 +17,7 @@ from engine.seams import (
     iter_find_seam,
     warmup,
 )
+from engine.seams.oscillating import INITS, SMOOTH_SIGMA
 from engine.seams.oscillating import criterion as osc_criterion
 from tests.engine.test_seams_oracles import (
     brute_dp,
@@ -188,37 +188,78 @@ def improves(e, c, o_max, cyclic, frozen=()):
     return False
 
 
+def expected_start(e, init, cyclic):
+    """The first streamed control points of each ``init``, computed independently."""
+    if init == "argmin":
+        return np.argmin(e, axis=1)
+    if init == "smoothed":
+        mode = "wrap" if cyclic else "nearest"
+        return np.argmin(ndimage.gaussian_filter1d(e, SMOOTH_SIGMA, 0, mode=mode, truncate=3), 1)
+    return find_seam(e, method="dp").path[:, 1]  # the open cut, even on a cyclic map
+
+
+@pytest.mark.parametrize("init", INITS)
 @pytest.mark.parametrize("variant", ["resume", "faithful"])
 @pytest.mark.parametrize("cyclic", [False, True])
 @pytest.mark.parametrize("o_max", [1, 3])
-def test_oscillating_monotone_and_locally_optimal(variant, cyclic, o_max):
+def test_oscillating_monotone_and_locally_optimal(init, variant, cyclic, o_max):
     for seed in range(3):
         e = smooth_map((24, 7), seed, sigma=1.0)
         updates = list(
-            iter_find_seam(e, method="oscillating", o_max=o_max, variant=variant, cyclic=cyclic)
+            iter_find_seam(
+                e, method="oscillating", o_max=o_max, variant=variant, init=init, cyclic=cyclic
+            )
         )
         crits = [u.seam.criterion for u in updates]
-        assert all(b <= a + 1e-12 for a, b in zip(crits, crits[1:], strict=False))
-        assert len(updates) > 2, "the search never improved the initial path"
+        assert all(b < a for a, b in zip(crits[:-1], crits[1:-1], strict=False))
         assert [u.final for u in updates] == [False] * (len(updates) - 1) + [True]
         assert updates[-1].seam is updates[-2].seam
-        # the first path is the per-row argmin
-        assert np.array_equal(controls_of(updates[0].seam), np.argmin(e, axis=1))
+        assert np.array_equal(controls_of(updates[0].seam), expected_start(e, init, cyclic))
+        if init != "dp":
+            assert len(updates) > 2, "the search never improved the initial path"
         final = updates[-1].seam
         assert_valid(final, e)
         c = controls_of(final)
         assert final.criterion == pytest.approx(osc_eps(e, c, cyclic))
         assert not improves(e, c, o_max, cyclic)
+        opt = find_seam(e, method="oscillating-optimal", cyclic=cyclic).criterion
+        assert opt <= final.criterion + 1e-9
+        if init == "dp":  # the DP cut is a point of the model: never worse than dp itself
+            assert final.criterion <= find_seam(e, cyclic=cyclic).criterion + 1e-9
 
 
-def test_oscillating_frozen_points_and_waypoints():
+def test_oscillating_dp_start_streams_the_closed_cut_on_cyclic_maps():
+    closed_better = 0
+    for seed in range(12):
+        e = smooth_map((20, 8), seed, sigma=1.0)
+        updates = list(iter_find_seam(e, method="oscillating", init="dp", cyclic=True))
+        open_cut = controls_of(updates[0].seam)
+        closed = find_seam(e, method="dp", cyclic=True).path[:, 1]
+        if osc_eps(e, closed, cyclic=True) < osc_eps(e, open_cut, cyclic=True) - 1e-9:
+            closed_better += 1
+            assert np.array_equal(controls_of(updates[1].seam), closed)
+    assert closed_better >= 3
+
+
+@pytest.mark.parametrize("init", INITS)
+def test_oscillating_frozen_points_and_waypoints(init):
     e = smooth_map((20, 8), 5, sigma=1.0)
-    s = find_seam(e, method="oscillating", start=7, end=0, waypoints=[(9, 3)])
+    s = find_seam(e, method="oscillating", start=7, end=0, waypoints=[(9, 3)], init=init)
     c = controls_of(s)
     assert (c[0], c[19], c[9]) == (7, 0, 3)
     assert not improves(e, c, 3, False, frozen={0, 9, 19})
     opt = find_seam(e, method="oscillating-optimal", start=7, end=0, waypoints=[(9, 3)])
     assert opt.criterion <= s.criterion + 1e-9
+
+
+def test_oscillating_dp_start_falls_back_to_argmin_when_pins_admit_no_dp_cut():
+    e = smooth_map((5, 8), 0)
+    first = next(iter_find_seam(e, method="oscillating", start=0, end=7)).seam
+    expected = np.argmin(e, axis=1)
+    expected[[0, 4]] = 0, 7
+    assert np.array_equal(controls_of(first), expected)
+    s = find_seam(e, method="oscillating", start=0, end=7)
+    assert s.criterion == pytest.approx(osc_eps(e, controls_of(s)))
 
 
 def test_oscillating_larger_o_max_not_worse_on_average():
@@ -227,52 +268,77 @@ def test_oscillating_larger_o_max_not_worse_on_average():
         e = smooth_map((40, 10), seed)
         opt = find_seam(e, method="oscillating-optimal").criterion
         for o in gaps:
-            gaps[o].append(find_seam(e, method="oscillating", o_max=o).criterion / opt - 1)
+            s = find_seam(e, method="oscillating", o_max=o, init="argmin")
+            gaps[o].append(s.criterion / opt - 1)
     assert np.mean(gaps[5]) <= np.mean(gaps[1]) + 1e-9
 
 
-def sample_overlaps(n_per_sample=8, h=64, w=16, seed=0):
-    """Error maps (RGB Euclidean) between two random 64x16 strips of the same sample."""
-    rng = np.random.default_rng(seed)
-    for name in resources.SAMPLE_NAMES:
-        img = np.asarray(Image.open(resources.sample_path(name)).convert("RGB"), float) / 255
-        H, W = img.shape[:2]
-        for _ in range(n_per_sample):
-            y1, y2 = rng.integers(0, H - h, 2)
-            x1, x2 = rng.integers(0, W - w, 2)
-            a = img[y1 : y1 + h, x1 : x1 + w]
-            b = img[y2 : y2 + h, x2 : x2 + w]
-            yield name, np.sqrt(((a - b) ** 2).sum(axis=2))
-
-
-def test_oscillating_gap_to_optimum_on_samples(record_property):
-    """Mean relative excess of the oscillating search over the exact optimum on real overlaps.
-
-    Measured on these 40 overlaps: o_max=3 (default) ~ +47 %, o_max=8 ~ +21 %, o_max=16 ~ +13.5 %
-    (resume variant). The acceptance target (<= 15 %) holds from o_max = h/4; the default
-    o_max=3 is guarded against regressions only (see the report / benchmarks/seams.py).
-    """
-    maps = [e for _, e in sample_overlaps()]
+def test_oscillating_faithful_reproduces_the_spec_on_smoothed_random_maps():
+    """The paper's algorithm (faithful, argmin start) on smoothed random 40x10 maps: the spec
+    (ALGORITHMS §1.2) reports ~17 / 9 / 7 % above the optimum for o_max = 1 / 3 / 10;
+    measured here (sigma 1): 15.1 / 7.9 / 4.3 %."""
+    maps = [
+        ndimage.gaussian_filter(np.random.default_rng(s).random((40, 10)), 1.0) for s in range(20)
+    ]
     opt = np.array([find_seam(e, method="oscillating-optimal").criterion for e in maps])
-    means = {}
-    for o_max in (3, 16):
-        osc = np.array([find_seam(e, method="oscillating", o_max=o_max).criterion for e in maps])
-        assert np.all(osc >= opt - 1e-9)
-        means[o_max] = float(np.mean(osc / opt - 1))
-        record_property(f"oscillating_gap_o_max_{o_max}", means[o_max])
-    print(
-        f"oscillating vs optimum, {len(maps)} sample overlaps 64x16: "
-        + ", ".join(f"o_max={o}: +{100 * m:.1f} %" for o, m in means.items())
-    )
-    assert means[16] <= 0.15
-    assert means[3] <= 0.60
+    mean = {}
+    for o_max in (1, 3, 10):
+        osc = [
+            find_seam(e, method="oscillating", o_max=o_max, variant="faithful", init="argmin")
+            for e in maps
+        ]
+        mean[o_max] = float(np.mean([s.criterion for s in osc] / opt - 1))
+    assert 0.10 <= mean[1] <= 0.22
+    assert 0.05 <= mean[3] <= 0.12
+    assert 0.02 <= mean[10] <= 0.08
+    assert mean[1] > mean[3] > mean[10]
 
 
-def test_oscillating_cancel_returns_valid_path_no_worse_than_initial():
-    e = smooth_map((200, 24), 7)
-    full = find_seam(e, method="oscillating")
+@pytest.fixture(scope="module")
+def overlap_sets():
+    """The samples' overlaps: random strip pairs and those the product cuts (template,
+    candidate patch rings, best-match quilting), with their optima."""
+    from benchmarks.seams import optima, product_overlaps, random_overlaps
+
+    sets = {"random strips": random_overlaps(), **product_overlaps()}
+    return {k: (v, optima(v)) for k, v in sets.items()}
+
+
+def test_oscillating_default_within_15_percent_of_optimum_on_sample_overlaps(
+    overlap_sets, record_property
+):
+    """Acceptance: the default setting stays within 15 % of ``oscillating-optimal`` on average
+    over the bundled samples' overlaps. Measured (``python -m benchmarks.seams --quality``):
+    +0.7 to +2.3 % per set; from the paper's start (``init="argmin"``) +31 to +65 %."""
+    from benchmarks.seams import gaps
+
+    assert set(overlap_sets) == {"random strips", "template", "patch ring", "quilting"}
+    for name, (overlaps, opt) in overlap_sets.items():
+        g, _ = gaps(overlaps, opt)
+        assert np.all(g >= -1e-9)
+        record_property(f"oscillating_default_gap_{name}", float(g.mean()))
+        print(f"oscillating default vs optimum, {name} ({len(g)}): +{100 * g.mean():.1f} %")
+        assert g.mean() <= 0.15, name
+
+
+def test_oscillating_paper_start_misses_the_15_percent_line(overlap_sets):
+    """The default's margin comes from its start: the published argmin start with the same
+    moves ends far above the line (measured ~+47 % on the random strips)."""
+    from benchmarks.seams import gaps
+
+    overlaps, opt = overlap_sets["random strips"]
+    g, _ = gaps(overlaps, opt, init="argmin")
+    assert g.mean() > 0.30
+
+
+@pytest.mark.parametrize("init", INITS)
+def test_oscillating_cancel_returns_valid_path_no_worse_than_initial(init):
+    # improvements are streamed in batches of one kernel call (~0.1 ms of search): the map must
+    # keep the search busy for several calls (from the DP cut: a long real overlap)
+    e = sample_map(2048, 128, "cobblestones") if init == "dp" else smooth_map((200, 24), 7)
+    full = find_seam(e, method="oscillating", init=init)
     token = CancelToken()
-    gen = iter_find_seam(e, method="oscillating", cancel=token)
+    gen = iter_find_seam(e, method="oscillating", init=init, cancel=token)
     first = next(gen)
     for _ in range(5):
         next(gen)
@@ -284,12 +350,14 @@ def test_oscillating_cancel_returns_valid_path_no_worse_than_initial():
     assert result.criterion > full.criterion  # it really stopped early
 
 
-def test_oscillating_cancelled_before_start_returns_initial_path():
+@pytest.mark.parametrize("cyclic", [False, True])
+@pytest.mark.parametrize("init", INITS)
+def test_oscillating_cancelled_before_start_returns_initial_path(init, cyclic):
     e = smooth_map((30, 6), 1)
     token = CancelToken()
     token.cancel()
-    s = find_seam(e, method="oscillating", cancel=token)
-    assert np.array_equal(controls_of(s), np.argmin(e, axis=1))
+    s = find_seam(e, method="oscillating", init=init, cyclic=cyclic, cancel=token)
+    assert np.array_equal(controls_of(s), expected_start(e, init, cyclic))
 
 
 @pytest.mark.parametrize("method", [m for m in METHODS if m != "oscillating"])
@@ -525,6 +593,8 @@ def test_validation_messages():
         find_seam(e, method="dijkstra", connectivity=6)
     with pytest.raises(ValueError, match="o_max"):
         find_seam(e, method="oscillating", o_max=0)
+    with pytest.raises(ValueError, match="init"):
+        find_seam(e, method="oscillating", init="random")
     with pytest.raises(ValueError, match="non-negative"):
         find_seam(-e)
     with pytest.raises(ValueError, match="finite"):
@@ -580,6 +650,16 @@ def test_benchmark_runs_and_baseline_matches_dp(capsys):
     assert main(["--sizes", "32x6", "--min-time", "0"]) == 0
     out = capsys.readouterr().out
     assert "numpy row DP" in out and "oscillating o_max=3" in out
+
+
+def test_benchmark_quality_table_and_diagnosis_run():
+    from benchmarks.seams import diagnose, quality, random_overlaps
+
+    sets = {"random strips": random_overlaps(n_per_sample=1, h=24, w=8)}
+    table = quality(sets)
+    assert "paper: faithful, argmin, o_max=3" in table and "(default)" in table
+    assert "random strips (5)" in table
+    assert "argmin start" in diagnose(sets, limit=2)
 
 
 class CountdownToken:
