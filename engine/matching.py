@@ -305,7 +305,7 @@ def _matmul(a, b):  # pragma: no cover - compiled
 def _smallest(values, m):  # pragma: no cover - compiled
     """Indices of the ``m`` smallest of ``values`` (1-D), ascending; ties by index.
 
-    A threshold from a strided sample keeps a few times ``m`` candidates in one pass, then only
+    A threshold from a strided sample keeps about 8 ``m`` candidates in one pass, then only
     those are sorted (falls back to a full sort when the threshold keeps fewer than ``m``).
     Runs without the GIL, unlike ``np.argpartition``.
     """
@@ -313,13 +313,16 @@ def _smallest(values, m):  # pragma: no cover - compiled
     if m >= nn:
         return np.argsort(values, kind="mergesort")[:m]
     step = max(1, nn // 2048)
-    sample = np.sort(values[::step])
-    k = min(sample.shape[0] - 1, (4 * m * sample.shape[0]) // nn + 1)
-    tau = sample[k]
-    keep = np.empty(nn, np.int64)
+    sample = values[::step].copy()
+    k = min(sample.shape[0] - 1, (8 * m * sample.shape[0]) // nn + 1)
+    tau = np.partition(sample, k)[k]
+    cap = 32 * m + 256
+    keep = np.empty(cap, np.int64)
     c = 0
     for j in range(nn):
         if values[j] <= tau:
+            if c == cap:  # a threshold far too loose (many ties): sort everything
+                return np.argsort(values, kind="mergesort")[:m]
             keep[c] = j
             c += 1
     if c < m:

@@ -749,6 +749,11 @@ class _Quilter:
         return rec, _ro(pixels)
 
 
+POOL_MIN_SAMPLE_AREA = 200 * 200
+"""Below this sample area a block's search is so cheap (< 0.1 ms) that handing it to another
+thread costs more than it saves: such runs stay on one thread (same result either way)."""
+
+
 def _run_levels(q: _Quilter, rects, total_label: str):
     """Place ``rects`` (top-level blocks, raster order); yields events, returns the records.
 
@@ -770,7 +775,8 @@ def _run_levels(q: _Quilter, rects, total_label: str):
     for k, p in enumerate(preds):
         for j in p:
             dependents[j].append(k)
-    pool = ThreadPoolExecutor(max(1, q.threads - 1)) if q.threads > 1 else None
+    heavy = q.sample.shape[0] * q.sample.shape[1] >= POOL_MIN_SAMPLE_AREA
+    pool = ThreadPoolExecutor(max(1, q.threads - 1)) if q.threads > 1 and heavy else None
     futures = {}
 
     def search(k):

@@ -1,6 +1,7 @@
 import numpy as np
 import pytest
 
+from engine import quilting
 from engine.cancel import Cancelled, CancelToken
 from engine.quilting import BlockPlaced, quilt
 from engine.transfer import (
@@ -53,7 +54,8 @@ def test_correspondence_error_falls_with_each_iteration(cobbles, target, kind):
     assert errs[-1] < 0.6 * np.mean((correspondence_map(plain, kind=kind) - cs) ** 2)
 
 
-def test_same_seed_same_transfer_for_any_thread_count(cobbles):
+def test_same_seed_same_transfer_for_any_thread_count(cobbles, monkeypatch):
+    monkeypatch.setattr(quilting, "POOL_MIN_SAMPLE_AREA", 0)
     kw = dict(block=20, iterations=2, rng=4)
     a = transfer(cobbles, disc(), threads=1, **kw)
     b = transfer(cobbles, disc(), threads=2, **kw)
