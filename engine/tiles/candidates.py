@@ -110,24 +110,74 @@ def _base_seed(rng) -> int:
 
 
 # --------------------------------------------------------------------------- kernels
-@njit(cache=True, nogil=True)
-def _band_costs(S, U, rr, cc, y0, x0, out):  # pragma: no cover
-    """out[i, j] = mean over the band pixels of d(S[y0+i+r, x0+j+c], U[r, c])."""
+@njit(cache=True, nogil=True, fastmath=True)
+def _band_costs(Sp, Up, runs, y0, x0, out):  # pragma: no cover
+    """out[i, j] = mean over the band pixels (r, c) of d(S[y0+i+r, x0+j+c], U[r, c]).
+
+    ``Sp`` / ``Up`` are channel-planar (C, H, W) float32; the band is given as runs
+    ``(r, c0, c1)`` of columns c0..c1-1 in row r. Positions j are the innermost loop (SIMD);
+    each run's sum is accumulated in float32, the total in float64.
+    """
     ny, nx = out.shape
-    C = U.shape[2]
-    n = rr.shape[0]
+    C = Up.shape[0]
+    n = 0
+    for k in range(runs.shape[0]):
+        n += runs[k, 2] - runs[k, 1]
+    acc = np.zeros((ny, nx))
+    row = np.empty(nx, dtype=np.float32)
+    for k in range(runs.shape[0]):
+        r, c0, c1 = runs[k, 0], runs[k, 1], runs[k, 2]
+        for i in range(ny):
+            y = y0 + i + r
+            row[:] = 0.0
+            for c in range(c0, c1):
+                x = x0 + c
+                if C == 3:
+                    u0, u1, u2 = Up[0, r, c], Up[1, r, c], Up[2, r, c]
+                    for j in range(nx):
+                        d0 = Sp[0, y, x + j] - u0
+                        d1 = Sp[1, y, x + j] - u1
+                        d2 = Sp[2, y, x + j] - u2
+                        row[j] += math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+                else:
+                    for j in range(nx):
+                        t = np.float32(0.0)
+                        for ch in range(C):
+                            d = Sp[ch, y, x + j] - Up[ch, r, c]
+                            t += d * d
+                        row[j] += math.sqrt(t)
+            for j in range(nx):
+                acc[i, j] += row[j]
     for i in range(ny):
         for j in range(nx):
-            s = 0.0
-            for k in range(n):
-                r = rr[k]
-                c = cc[k]
-                t = 0.0
-                for ch in range(C):
-                    d = S[y0 + i + r, x0 + j + c, ch] - U[r, c, ch]
-                    t += d * d
-                s += math.sqrt(t)
-            out[i, j] = s / n
+            out[i, j] = acc[i, j] / n
+
+
+@njit(cache=True, nogil=True)
+def _count_changed(a, b):  # pragma: no cover
+    """Number of pixels of (h, w, C) ``a`` and ``b`` that differ in any channel."""
+    n = 0
+    for y in range(a.shape[0]):
+        for x in range(a.shape[1]):
+            for c in range(a.shape[2]):
+                if a[y, x, c] != b[y, x, c]:
+                    n += 1
+                    break
+    return n
+
+
+def _runs(mask: np.ndarray) -> np.ndarray:
+    """The True runs of a 2-D mask as rows ``(r, c0, c1)`` (columns c0..c1-1), row-major."""
+    m = np.pad(mask.astype(np.int8), ((0, 0), (1, 1)))
+    d = np.diff(m, axis=1)
+    r0, c0 = np.nonzero(d == 1)
+    _, c1 = np.nonzero(d == -1)
+    return np.ascontiguousarray(np.column_stack([r0, c0, c1]), dtype=np.int64)
+
+
+def _planar(image: np.ndarray) -> np.ndarray:
+    """(H, W, C) -> contiguous (C, H, W) float32 colour channels."""
+    return np.ascontiguousarray(colour_channels(image).transpose(2, 0, 1), dtype=np.float32)
 
 
 class _AnyCancel:
@@ -251,11 +301,9 @@ class _Setup:
         # ring band for the position refinement (offsets margin .. ring-1)
         r, c = np.mgrid[0:ph, 0:pw]
         d = np.minimum.reduce([r, c, ph - 1 - r, pw - 1 - c])
-        band = (d >= self.margin) & (d < self.ring)
-        self.rr = np.ascontiguousarray(r[band], dtype=np.int64)
-        self.cc = np.ascontiguousarray(c[band], dtype=np.int64)
-        self.Sc = np.ascontiguousarray(colour_channels(self.S))
-        self.Uc = np.ascontiguousarray(colour_channels(self.U[MAIN]))
+        self.band_runs = _runs((d >= self.margin) & (d < self.ring))
+        self.Sp = _planar(self.S)
+        self.Up = _planar(self.U[MAIN])
 
     # ---- positions
     def random_origin(self, gen: np.random.Generator) -> tuple[int, int]:
@@ -273,7 +321,7 @@ class _Setup:
         ylo, yhi = max(0, y0 - n), min(H - self.ph, y0 + n)
         xlo, xhi = max(0, x0 - n), min(W - self.pw, x0 + n)
         out = np.empty((yhi - ylo + 1, xhi - xlo + 1), dtype=np.float64)
-        _band_costs(self.Sc, self.Uc, self.rr, self.cc, ylo, xlo, out)
+        _band_costs(self.Sp, self.Up, self.band_runs, ylo, xlo, out)
         if self.valid is not None:
             out[~self.valid[ylo : yhi + 1, xlo : xhi + 1]] = np.inf
         if not np.isfinite(out).any():  # the given origin itself must be valid
@@ -320,7 +368,7 @@ class _Setup:
         mask[ty : ty + ph, tx : tx + pw] = cut.mask
         alpha = np.zeros((th, tw), dtype=np.float32)
         alpha[ty : ty + ph, tx : tx + pw] = cut.alpha
-        changed = float(np.any(tile != self.tmaps[MAIN], axis=2).mean())
+        changed = _count_changed(tile, self.tmaps[MAIN]) / (th * tw)
         scores = {
             "criterion": float(cut.criterion),
             "peak": float(cut.peak),

@@ -80,9 +80,13 @@ def test_same_seed_same_tiles_whatever_the_workers(small):
     S, st = small
     a = candidates(S, st, 5, rng=11, workers=1)
     b = candidates(S, st, 7, rng=11, workers=2)
-    for x, y in zip(a, b[:5], strict=True):
-        np.testing.assert_array_equal(x.tile, y.tile)
-        assert x.patch_rect == y.patch_rect and x.seed == y.seed
+    c = candidates(S, st, 6, rng=11, workers=3)
+    for x, y, z in zip(a, b[:5], c[:5], strict=True):
+        for other in (y, z):
+            for field in ("tile", "alpha", "mask", "loop"):
+                np.testing.assert_array_equal(getattr(x, field), getattr(other, field))
+            assert x.patch_rect == other.patch_rect and x.seed == other.seed
+            assert x.scores == other.scores
         assert x.seed == candidate_seed(11, x.index)
     c = candidates(S, st, 5, rng=12, workers=2)
     assert any(x.patch_rect != y.patch_rect for x, y in zip(a, c, strict=True))
@@ -134,8 +138,12 @@ def test_make_candidate_from_origin_and_from_seed(small):
         make_candidate(S, st, patch_origin=(139, 0))
 
 
-def test_position_refinement_against_brute_force(small):
+@pytest.mark.parametrize("channels", [3, 1])
+def test_position_refinement_against_brute_force(small, channels):
     S, st = small
+    if channels == 1:
+        S = texture(channels=1, seed=7)
+        st = make_seamless(S, RECT, overlap=W_T)
     setup = _Setup(
         S,
         st,
