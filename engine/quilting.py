@@ -70,6 +70,7 @@ from engine.matching import (
     select_within_tolerance,
     ssd_at,
 )
+from engine.stitch import _map_points, from_canonical, l_cut, to_canonical
 
 SELECTIONS = ("best", "random", "sampled", "bhatia")
 MODES = ("exact", "fast")
@@ -330,49 +331,18 @@ def arms_of(filled: np.ndarray) -> tuple[int, int, int, int]:
 
 
 # ------------------------------------------------------------------------------ cutting
-def _l_cut_function():
-    """:func:`engine.stitch.l_cut` when it exists (the L cut joined in the corner)."""
-    try:
-        from engine.stitch import l_cut
-    except ImportError:
-        return None
-    return l_cut
+#: orientation (engine.stitch) of each overlap arm: where the new block (R2) lies from the old
+#: content (R1) that the arm keeps on its outer side
+_ARM_ORIENTATION = {"top": "bottom", "left": "right", "bottom": "top", "right": "left"}
 
 
-def _orient(err: np.ndarray, side: str, k: int) -> np.ndarray:
-    """Canonical error map of one overlap arm (old content = R1 on the left)."""
-    h, w = err.shape
-    if side == "left":
-        return err[:, :k]
-    if side == "top":
-        return err[:k].T
-    if side == "right":
-        return err[:, w - k :][:, ::-1]
-    return err[h - k :][::-1].T  # bottom
-
-
-def _unorient_mask(mask: np.ndarray, side: str, k: int, keep: np.ndarray) -> None:
-    h, w = keep.shape
-    if side == "left":
-        keep[:, :k] |= mask
-    elif side == "top":
-        keep[:k] |= mask.T
-    elif side == "right":
-        keep[:, w - k :] |= mask[:, ::-1]
-    else:
-        keep[h - k :] |= mask.T[::-1]
-
-
-def _unorient_path(path: np.ndarray, side: str, k: int, shape) -> np.ndarray:
-    h, w = shape
-    r, c = path[:, 0], path[:, 1]
-    if side == "left":
-        return np.column_stack([r, c])
-    if side == "top":
-        return np.column_stack([c, r])
-    if side == "right":
-        return np.column_stack([r, w - 1 - c])
-    return np.column_stack([h - 1 - c, r])
+def _arm_window(side: str, k: int, h: int, w: int) -> tuple[slice, slice]:
+    return {
+        "top": (slice(0, k), slice(0, w)),
+        "left": (slice(0, h), slice(0, k)),
+        "bottom": (slice(h - k, h), slice(0, w)),
+        "right": (slice(0, h), slice(w - k, w)),
+    }[side]
 
 
 @dataclass
@@ -383,33 +353,38 @@ class _Cut:
     peak: float
 
 
-def cut_overlap(err, arms, *, method: str, cancel=None, l_cut=None, **options) -> _Cut:
+def cut_overlap(err, arms, *, method: str, cancel=None, **options) -> _Cut:
     """Cut a block's overlap (arms = top, left, bottom, right widths) with a seam ``method``.
 
-    The left and top arms are cut as one L joined in the corner by ``l_cut`` when given (else
-    one seam per arm, keeping the old content wherever either keeps it); wrap-around arms get a
-    seam each. Returns the keep-old mask, the path pixels, criterion and peak.
+    The left and top arms are cut as one L joined in the corner (:func:`engine.stitch.l_cut`);
+    wrap-around arms (bottom, right) get a seam each, oriented so the old content is R1; the old
+    content is kept wherever one of the cuts keeps it. Returns the keep-old mask, the path pixels,
+    criterion and peak.
     """
     h, w = err.shape
     t, left, b, r = arms
     keep = np.zeros((h, w), dtype=bool)
     paths, crit, peak = [], 0.0, 0.0
-    sides = [("top", t), ("left", left), ("bottom", b), ("right", r)]
-    if l_cut is not None and (t or left):
+    if t or left:
         lc = l_cut(err, overlap_left=left, overlap_top=t, method=method, cancel=cancel, **options)
         keep |= np.asarray(lc.mask, dtype=bool)
         paths.append(np.asarray(lc.path, dtype=np.intp).reshape(-1, 2))
-        crit += float(lc.criterion)
-        peak = max(peak, float(lc.peak))
-        sides = sides[2:]
-    for side, k in sides:
+        crit, peak = float(lc.criterion), float(lc.peak)
+    for side, k in (("bottom", b), ("right", r)):
         if not k:
             continue
+        rows, cols = _arm_window(side, k, h, w)
+        orient = _ARM_ORIENTATION[side]
+        strip = err[rows, cols]
         seam = _seams.find_seam(
-            np.ascontiguousarray(_orient(err, side, k)), method=method, cancel=cancel, **options
+            np.ascontiguousarray(to_canonical(strip, orient)),
+            method=method,
+            cancel=cancel,
+            **options,
         )
-        _unorient_mask(np.asarray(seam.mask), side, k, keep)
-        paths.append(_unorient_path(np.asarray(seam.path), side, k, (h, w)))
+        keep[rows, cols] |= from_canonical(np.asarray(seam.mask), orient)
+        pts = _map_points(np.asarray(seam.path), orient, strip.shape, inverse=True)
+        paths.append(pts + (rows.start, cols.start))
         crit += seam.criterion
         peak = max(peak, seam.peak)
     path = np.concatenate(paths).astype(np.intp) if paths else np.zeros((0, 2), np.intp)
@@ -497,7 +472,6 @@ class _Quilter:
         self._valid: dict[tuple[int, int], tuple[np.ndarray | None, np.ndarray]] = {}
         self._spectrum = None
         self._pca = None
-        self.l_cut = _l_cut_function()
         self.fft_workers = 1 if threads > 1 else threads  # the pool already uses every thread
         self.stream = True  # False: no events (the benchmark's streaming-overhead reference)
 
@@ -705,12 +679,7 @@ class _Quilter:
                 keep, crit, peak, alpha = overlap.copy(), 0.0, 0.0, None
             else:
                 cut = cut_overlap(
-                    err,
-                    wk.arms,
-                    method=self.seam,
-                    cancel=self.cancel,
-                    l_cut=self.l_cut,
-                    **self.seam_options,
+                    err, wk.arms, method=self.seam, cancel=self.cancel, **self.seam_options
                 )
                 keep, path, crit, peak = cut.keep_old, _ro(cut.path), cut.criterion, cut.peak
                 keep &= overlap
