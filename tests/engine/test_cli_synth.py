@@ -22,29 +22,12 @@ def png_bit_depth(path) -> int:
 
 
 def test_synth_writes_output_seams_and_progress(sample_png, tmp_path, capsys):
-    out = tmp_path / "out.png"
-    seams = tmp_path / "seams.json"
-    rc = main(
-        [
-            "synth",
-            str(sample_png),
-            "--size",
-            "70x50",
-            "--block",
-            "16",
-            "--overlap",
-            "4",
-            "--seam",
-            "minimax",
-            "--seed",
-            "3",
-            "-o",
-            str(out),
-            "--save-seams",
-            str(seams),
-        ]
-    )
-    assert rc == 0
+    def synth(out, seams):
+        args = "--size 70x50 --block 16 --overlap 4 --seam minimax --seed 3".split()
+        return main(["synth", str(sample_png), *args, "-o", str(out), "--save-seams", str(seams)])
+
+    out, seams = tmp_path / "out.png", tmp_path / "seams.json"
+    assert synth(out, seams) == 0
     img = load_image(out)
     assert img.pixels.shape == (50, 70, 3) and img.bit_depth == 8
     doc = json.loads(seams.read_text())
@@ -56,28 +39,8 @@ def test_synth_writes_output_seams_and_progress(sample_png, tmp_path, capsys):
     err = capsys.readouterr().err
     assert "synth: 24/24 blocks" in err and "wrote" in err
     # same seed, same output; the seams image marks the cuts in red
-    out2 = tmp_path / "out2.png"
-    overlay = tmp_path / "seams.png"
-    main(
-        [
-            "synth",
-            str(sample_png),
-            "--size",
-            "70x50",
-            "--block",
-            "16",
-            "--overlap",
-            "4",
-            "--seam",
-            "minimax",
-            "--seed",
-            "3",
-            "-o",
-            str(out2),
-            "--save-seams",
-            str(overlay),
-        ]
-    )
+    out2, overlay = tmp_path / "out2.png", tmp_path / "seams.png"
+    assert synth(out2, overlay) == 0
     np.testing.assert_array_equal(load_image(out2).pixels, img.pixels)
     assert (np.abs(load_image(overlay).pixels - (1, 0, 0)).sum(axis=2) == 0).sum() > 50
 
