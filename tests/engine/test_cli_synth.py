@@ -23,7 +23,18 @@ def png_bit_depth(path) -> int:
 
 def test_synth_writes_output_seams_and_progress(sample_png, tmp_path, capsys):
     def synth(out, seams):
-        args = ["--size", "70x50", "--block", "16", "--overlap", "4", "--seam", "minimax", "--seed", "3"]
+        args = [
+            "--size",
+            "70x50",
+            "--block",
+            "16",
+            "--overlap",
+            "4",
+            "--seam",
+            "minimax",
+            "--seed",
+            "3",
+        ]
         return main(["synth", str(sample_png), *args, "-o", str(out), "--save-seams", str(seams)])
 
     out, seams = tmp_path / "out.png", tmp_path / "seams.json"
