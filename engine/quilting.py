@@ -723,14 +723,19 @@ POOL_MIN_SAMPLE_AREA = 200 * 200
 thread costs more than it saves: such runs stay on one thread (same result either way)."""
 
 
+SEARCH_CHUNK = 4
+"""Blocks of one level searched in one batch (fixed: batches never depend on the threads)."""
+
+
 def _run_levels(q: _Quilter, rects, total_label: str):
     """Place ``rects`` (top-level blocks, raster order); yields events, returns the records.
 
-    Blocks are placed one by one in level order (level, then raster index). A block's search
-    needs only its predecessors placed, so with ``threads > 1`` the searches run ahead on a pool
-    (FFT, numba kernels and large numpy operations release the GIL) while this thread places
-    blocks. Every block is searched alone, on exactly the canvas its predecessors left, with its
-    own generator: the result does not depend on the number of threads.
+    Blocks are placed one by one in level order (level, then raster index) and searched in fixed
+    batches of up to :data:`SEARCH_CHUNK` consecutive blocks of one level. A batch's search needs
+    only its blocks' predecessors placed, so with ``threads > 1`` the searches run ahead on a pool
+    (FFTs and numba kernels release the GIL) while this thread places blocks. Every batch is the
+    same and sees exactly the canvas its predecessors left whatever the number of threads, and
+    every block has its own generator: the result does not depend on the number of threads.
     """
     if q.select == "best":
         _ = q.spectrum  # built once, before any thread reads it
@@ -739,45 +744,54 @@ def _run_levels(q: _Quilter, rects, total_label: str):
     preds, levels = _dependencies(rects, q.out_shape, q.tileable)
     order = sorted(range(len(rects)), key=lambda k: (levels[k], k))
     works = [_Work(k, *r, rng=np.random.default_rng([q.seed, k])) for k, r in enumerate(rects)]
-    waiting = [len(p) for p in preds]
-    dependents: list[list[int]] = [[] for _ in rects]
-    for k, p in enumerate(preds):
-        for j in p:
-            dependents[j].append(k)
+    chunks: list[list[int]] = []
+    for k in order:
+        if chunks and len(chunks[-1]) < SEARCH_CHUNK and levels[chunks[-1][0]] == levels[k]:
+            chunks[-1].append(k)
+        else:
+            chunks.append([k])
+    waiting, dependents = [], [[] for _ in rects]
+    for c, members in enumerate(chunks):
+        needed = {j for k in members for j in preds[k]}
+        waiting.append(len(needed))
+        for j in needed:
+            dependents[j].append(c)
     heavy = q.sample.shape[0] * q.sample.shape[1] >= POOL_MIN_SAMPLE_AREA
     pool = ThreadPoolExecutor(max(1, q.threads - 1)) if q.threads > 1 and heavy else None
     futures = {}
 
-    def search(k):
-        wk = works[k]
-        q.load(wk)
-        q.search([wk])
+    def search(c):
+        batch = [works[k] for k in chunks[c]]
+        for wk in batch:
+            q.load(wk)
+        q.search(batch)
 
     records: list[BlockRecord] = []
     try:
         if pool is not None:
-            for k in order:
-                if not waiting[k]:
-                    futures[k] = pool.submit(search, k)
-        for n, k in enumerate(order):
+            futures = {c: pool.submit(search, c) for c in range(len(chunks)) if not waiting[c]}
+        done = 0
+        for c, members in enumerate(chunks):
             check(q.cancel)
             if pool is None:
-                search(k)
+                search(c)
             else:
-                futures.pop(k).result()
-            for rec, pixels in q.place(works[k]):
-                rec = _renumber(rec, len(records))
-                records.append(rec)
-                if q.stream:
-                    yield BlockPlaced(rec, pixels)
-            works[k] = None  # its arrays live on in the records
-            for d in dependents[k]:
-                waiting[d] -= 1
-                if not waiting[d] and pool is not None:
-                    futures[d] = pool.submit(search, d)
-            last = n + 1 == len(order) or levels[order[n + 1]] != levels[k]
+                futures.pop(c).result()
+            for k in members:
+                for rec, pixels in q.place(works[k]):
+                    rec = _renumber(rec, len(records))
+                    records.append(rec)
+                    if q.stream:
+                        yield BlockPlaced(rec, pixels)
+                works[k] = None  # its arrays live on in the records
+                for d in dependents[k]:
+                    waiting[d] -= 1
+                    if not waiting[d] and pool is not None:
+                        futures[d] = pool.submit(search, d)
+            done += len(members)
+            last = c + 1 == len(chunks) or levels[chunks[c + 1][0]] != levels[members[0]]
             if q.stream and last:
-                yield Progress(n + 1, len(rects), total_label)
+                yield Progress(done, len(rects), total_label)
     finally:
         if pool is not None:
             for f in futures.values():
