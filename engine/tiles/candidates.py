@@ -111,12 +111,12 @@ def _base_seed(rng) -> int:
 
 # --------------------------------------------------------------------------- kernels
 @njit(cache=True, nogil=True, fastmath=True)
-def _band_costs(Sp, Up, runs, y0, x0, out):  # pragma: no cover
+def _band_costs(S, Up, runs, y0, x0, out):  # pragma: no cover
     """out[i, j] = mean over the band pixels (r, c) of d(S[y0+i+r, x0+j+c], U[r, c]).
 
-    ``Sp`` / ``Up`` are channel-planar (C, H, W) float32; the band is given as runs
-    ``(r, c0, c1)`` of columns c0..c1-1 in row r. Positions j are the innermost loop (SIMD);
-    each run's sum is accumulated in float32, the total in float64.
+    ``S`` is (H, W, C) float32, ``Up`` channel-planar (C, h, w) float32; the band is given
+    as runs ``(r, c0, c1)`` of columns c0..c1-1 in row r. Positions j are the innermost loop
+    (SIMD); each run's sum is accumulated in float32, the total in float64.
     """
     ny, nx = out.shape
     C = Up.shape[0]
@@ -135,15 +135,15 @@ def _band_costs(Sp, Up, runs, y0, x0, out):  # pragma: no cover
                 if C == 3:
                     u0, u1, u2 = Up[0, r, c], Up[1, r, c], Up[2, r, c]
                     for j in range(nx):
-                        d0 = Sp[0, y, x + j] - u0
-                        d1 = Sp[1, y, x + j] - u1
-                        d2 = Sp[2, y, x + j] - u2
+                        d0 = S[y, x + j, 0] - u0
+                        d1 = S[y, x + j, 1] - u1
+                        d2 = S[y, x + j, 2] - u2
                         row[j] += math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
                 else:
                     for j in range(nx):
                         t = np.float32(0.0)
                         for ch in range(C):
-                            d = Sp[ch, y, x + j] - Up[ch, r, c]
+                            d = S[y, x + j, ch] - Up[ch, r, c]
                             t += d * d
                         row[j] += math.sqrt(t)
             for j in range(nx):
@@ -173,11 +173,6 @@ def _runs(mask: np.ndarray) -> np.ndarray:
     r0, c0 = np.nonzero(d == 1)
     _, c1 = np.nonzero(d == -1)
     return np.ascontiguousarray(np.column_stack([r0, c0, c1]), dtype=np.int64)
-
-
-def _planar(image: np.ndarray) -> np.ndarray:
-    """(H, W, C) -> contiguous (C, H, W) float32 colour channels."""
-    return np.ascontiguousarray(colour_channels(image).transpose(2, 0, 1), dtype=np.float32)
 
 
 class _AnyCancel:
@@ -302,8 +297,8 @@ class _Setup:
         r, c = np.mgrid[0:ph, 0:pw]
         d = np.minimum.reduce([r, c, ph - 1 - r, pw - 1 - c])
         self.band_runs = _runs((d >= self.margin) & (d < self.ring))
-        self.Sp = _planar(self.S)
-        self.Up = _planar(self.U[MAIN])
+        self.Sc = np.ascontiguousarray(colour_channels(self.S))
+        self.Up = np.ascontiguousarray(colour_channels(self.U[MAIN]).transpose(2, 0, 1))
 
     # ---- positions
     def random_origin(self, gen: np.random.Generator) -> tuple[int, int]:
@@ -321,7 +316,7 @@ class _Setup:
         ylo, yhi = max(0, y0 - n), min(H - self.ph, y0 + n)
         xlo, xhi = max(0, x0 - n), min(W - self.pw, x0 + n)
         out = np.empty((yhi - ylo + 1, xhi - xlo + 1), dtype=np.float64)
-        _band_costs(self.Sp, self.Up, self.band_runs, ylo, xlo, out)
+        _band_costs(self.Sc, self.Up, self.band_runs, ylo, xlo, out)
         if self.valid is not None:
             out[~self.valid[ylo : yhi + 1, xlo : xhi + 1]] = np.inf
         if not np.isfinite(out).any():  # the given origin itself must be valid
