@@ -110,7 +110,7 @@ def _base_seed(rng) -> int:
 
 
 # --------------------------------------------------------------------------- kernels
-@njit(cache=True, nogil=True, fastmath=True)
+@njit(cache=True, nogil=True)
 def _band_costs(S, Up, runs, y0, x0, out):  # pragma: no cover
     """out[i, j] = mean over the band pixels (r, c) of d(S[y0+i+r, x0+j+c], U[r, c]).
 
