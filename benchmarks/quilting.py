@@ -9,11 +9,12 @@ sample (``resources/samples/cobblestones.png`` by default):
 Rows: a straightforward baseline (numpy: ``scipy.signal.fftconvolve`` per channel and block in
 float64, union L mask, the compiled dp L-cut, single thread), the exact FFT search and the fast
 (principal components + exact re-ranking) search, on 1 and 2 threads. Every time is the median
-of repeats (the machine's load average is printed: on a shared machine, rerun when it is near
-0). Samples smaller than 200×200 (job A) run on one thread whatever ``threads`` says
-(:data:`engine.quilting.POOL_MIN_SAMPLE_AREA`). Each output's border ratio along the block grid (max over the offsets the cuts run
-in, :func:`engine.quilting.grid_border_ratio`) is shown beside it. Then: the streaming overhead
-(``quilt`` draining every event vs the same run creating none), and the quality figures: grid
+of repeats (the load average is printed: on a shared machine rerun when it is near 0).
+Samples under 200×200 (job A) run on one thread whatever ``threads`` says
+(:data:`engine.quilting.POOL_MIN_SAMPLE_AREA`). Each output's border ratio along the block grid
+(max over the offsets the cuts run in, :func:`engine.quilting.grid_border_ratio`) is shown
+beside it. Then: the streaming overhead (``quilt`` draining every event vs the same run creating
+none), and the quality figures: grid
 border ratio of best+dp vs best+straight vs random on every bundled sample, and the mean seam
 peak of Long & Mould's minimax at half-block overlap vs dp at the same overlap.
 """
