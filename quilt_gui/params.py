@@ -31,6 +31,7 @@ class Param:
     choices: tuple = ()
     step: float = 1
     decimals: int = 2
+    special: str = ""  # shown instead of the minimum (e.g. "auto" where 0 means the default)
 
     @property
     def kind(self) -> type:
@@ -149,6 +150,7 @@ PARAMS: tuple[Param, ...] = (
         "Candidates",
         0,
         4096,
+        special="auto",
     ),
     _P(
         "patch_overlap",
@@ -158,6 +160,7 @@ PARAMS: tuple[Param, ...] = (
         "Candidates",
         0,
         256,
+        special="auto",
     ),
     _P(
         "margin",
@@ -243,6 +246,7 @@ PARAMS: tuple[Param, ...] = (
         "Quilting",
         0,
         512,
+        special="auto",
     ),
     _P(
         "select",
@@ -274,6 +278,7 @@ PARAMS: tuple[Param, ...] = (
         "Quilting",
         0,
         100_000,
+        special="auto",
     ),
     _P(
         "q_mode",
@@ -330,6 +335,7 @@ PARAMS: tuple[Param, ...] = (
         "Quilting",
         0,
         1024,
+        special="auto",
     ),
     _P(
         "tileable",
@@ -371,7 +377,7 @@ PARAMS: tuple[Param, ...] = (
     # -- options of the seam methods (shared by the tile set and quilting)
     _P(
         "o_max",
-        8,
+        3,
         "o_max",
         "oscillating: largest block of control points moved at once.",
         "Seam options",
@@ -388,8 +394,19 @@ PARAMS: tuple[Param, ...] = (
         choices=("resume", "faithful"),
     ),
     _P(
+        "osc_init",
+        "dp",
+        "Oscillating start",
+        "oscillating: the path the search starts from. dp: the exact one-pixel-per-row cut "
+        "(default; ends within a few % of the optimum); argmin: each row's smallest error, as "
+        "in the paper (Somol & Haindl; with 'faithful' this is the published algorithm, which "
+        "ends 30-60 % above the optimum on real overlaps); smoothed: argmin of a blurred map.",
+        "Seam options",
+        choices=("dp", "argmin", "smoothed"),
+    ),
+    _P(
         "max_run",
-        8,
+        5,
         "Max run",
         "resistance: longest straight run of the walk (px).",
         "Seam options",
@@ -511,5 +528,6 @@ def seam_options(p: dict, method: str) -> dict:
         "connectivity": int(p["connectivity"]),
         "levels": p["levels"],
         "variant": p["minimax_variant"] if method == "minimax" else p["osc_variant"],
+        "init": p["osc_init"],
     }
     return {k: v for k, v in values.items() if k in allowed}

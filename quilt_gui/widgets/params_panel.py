@@ -130,6 +130,7 @@ class ParamsPanel(QScrollArea):
         else:
             w = QSpinBox()
             w.setRange(int(p.minimum), int(p.maximum))
+            w.setSpecialValueText(p.special)
             w.setKeyboardTracking(False)
             w.setAccelerated(True)
             w.valueChanged.connect(partial(self._edit, key))
