@@ -300,6 +300,66 @@ def speed(
     return rows
 
 
+def stage_scaling(S: np.ndarray, tile: int, seed: int, calls: int = 20) -> list:
+    """Per stage of one candidate: ms per call on one thread and the throughput speed-up of
+    two threads running it side by side (below ~1.9: the stage holds the GIL or contends)."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from engine.materials import apply_cut
+    from engine.stitch import patch_cut
+    from engine.tiles.candidates import _Setup
+    from engine.tiles.seamless import MAIN, seam_error
+
+    st = make_seamless(S, find_template(S, tile_min=tile, tile_max=tile))
+    opts = dict(method="dp", metric="euclid", blend="adaptive", width=4, rho=3)
+    setup = _Setup(
+        S,
+        st,
+        patch_size=None,
+        patch_overlap=None,
+        margin=2,
+        neighbourhood=5,
+        excluded=None,
+        maps=None,
+        weights=None,
+        seam_options={},
+        **opts,
+    )
+    origin = setup.random_origin(np.random.default_rng(seed))
+    (sy, sx), _ = setup.refine(origin, setup.n)
+    Q = {k: v[sy : sy + setup.ph, sx : sx + setup.pw] for k, v in setup.stack.items()}
+    err = seam_error(Q, setup.U, None, "euclid")
+    cut = patch_cut(Q[MAIN], setup.U[MAIN], ring=setup.ring, margin=2, error=err, **opts)
+    stages = {
+        "position refinement (numba)": lambda: setup.refine(origin, setup.n),
+        "seam error map": lambda: seam_error(Q, setup.U, None, "euclid"),
+        "patch_cut (4 seams, EDT ramp)": lambda: patch_cut(
+            Q[MAIN], setup.U[MAIN], ring=setup.ring, margin=2, error=err, **opts
+        ),
+        "apply_cut": lambda: apply_cut(Q, setup.U, cut.alpha),
+        "whole candidate": lambda: setup.make(0, None, origin, setup.n, None),
+    }
+
+    def run(fn, n):
+        for _ in range(n):
+            fn()
+
+    rows = []
+    with ThreadPoolExecutor(2) as pool:
+        for name, fn in stages.items():
+            one, two = [], []
+            for _ in range(3):
+                t0 = time.perf_counter()
+                run(fn, 2 * calls)
+                one.append(time.perf_counter() - t0)
+                t0 = time.perf_counter()
+                list(pool.map(run, (fn, fn), (calls, calls)))
+                two.append(time.perf_counter() - t0)
+            t1, t2 = float(np.median(one)), float(np.median(two))
+            rows.append([name, f"{t1 / (2 * calls) * 1e3:.2f}", f"{t1 / t2:.2f}"])
+    return rows
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(
         prog="python -m benchmarks.tileset",
@@ -311,6 +371,11 @@ def main(argv=None) -> int:
     ap.add_argument("--skip-quality", action="store_true")
     ap.add_argument("--skip-big", action="store_true", help="skip the 4096 px run")
     ap.add_argument("--skip-speed", action="store_true", help="skip the speed tables")
+    ap.add_argument(
+        "--stages",
+        action="store_true",
+        help="also time the stages of one candidate and their 2-thread speed-up (512 px)",
+    )
     ap.add_argument(
         "--joint-weights",
         type=lambda v: [float(x) for x in v.split(",")],
@@ -331,6 +396,16 @@ def main(argv=None) -> int:
             rows = speed(big, 1024, args.candidates, args.seed, "4096 -> 1024", 1, False)
             print(format_table(headers, rows), flush=True)
             del big
+    if args.stages:
+        print("\n## Stages of one candidate (512 -> 256, cobblestones)\n")
+        S = load_image(resources.sample_path("cobblestones")).pixels
+        busy0, own0, t0 = _busy_seconds(), time.process_time(), time.perf_counter()
+        rows = stage_scaling(S, 256, args.seed)
+        others = (_busy_seconds() - busy0 - (time.process_time() - own0)) / (
+            time.perf_counter() - t0
+        )
+        print(format_table(["stage", "ms per call", "2-thread speed-up"], rows))
+        print(f"other processes used {max(0.0, others):.2f} cores meanwhile", flush=True)
     if not args.skip_quality:
         print("\n## Quality: 512x512 samples, 256x256 tiles\n")
         print(quality(256, args.candidates, args.seed), flush=True)
