@@ -428,8 +428,9 @@ def iter_find_template(
         Redo the horizontal phase on the chosen rows until stable (≤ 3 rounds).
     coarse : int or None
         Search first on an image ``coarse`` times smaller (with the same refinement), then
-        at full resolution only around that result (shifts ±coarse, positions ±2·coarse). None (default): chosen
-        from the work (1 = off for a 512 px source, 4 for 4096 px with a ±12 % size range).
+        at full resolution only around that result (shifts ±coarse, positions ±2·coarse).
+        None (default): chosen from the work (1 = off for a 512 px source, 4 for 4096 px
+        with a ±12 % size range).
     joint_weight : float
         λ >= 0: weight of the step across the tile's wrap joints (the natural column pair
         ``x + w - 1, x + w`` and row pair ``y + h - 1, y + h``) added to the strip mismatch,
