@@ -311,20 +311,100 @@ def _nonneg(value, name: str) -> int:
     return int(value)
 
 
+@njit(cache=True, nogil=True)
+def _old_side_of_barrier(barrier, seed_left, seed_top):  # pragma: no cover - compiled
+    """Old region of a cut given as a barrier (h, w) bool: the barrier, every pixel 4-connected
+    to the left (``seed_left``) or top (``seed_top``) edge without crossing it, and every pocket
+    of the rest not 4-connected to the block's border (holes filled).
+
+    The same as labelling ``~barrier`` (4-connectivity), keeping the labels met on the seed
+    edges, adding the barrier and ``ndimage.binary_fill_holes``; two flood fills of one stack.
+    """
+    h, w = barrier.shape
+    state = np.zeros((h, w), np.uint8)  # 0 unvisited, 1 barrier, 2 old side, 3 new side
+    for r in range(h):
+        for c in range(w):
+            if barrier[r, c]:
+                state[r, c] = 1
+    stack = np.empty(h * w, np.int64)
+    for fill in (2, 3):
+        n = 0
+        for r in range(h):
+            for c in range(w):
+                if state[r, c] != 0:
+                    continue
+                if fill == 2:
+                    seed = (seed_left and c == 0) or (seed_top and r == 0)
+                else:  # what the old side left and touches the border is new
+                    seed = r == 0 or c == 0 or r == h - 1 or c == w - 1
+                if seed:
+                    state[r, c] = fill
+                    stack[n] = r * w + c
+                    n += 1
+        while n:
+            n -= 1
+            r, c = divmod(stack[n], w)
+            for rr, cc in ((r - 1, c), (r + 1, c), (r, c - 1), (r, c + 1)):
+                if 0 <= rr < h and 0 <= cc < w and state[rr, cc] == 0:
+                    state[rr, cc] = fill
+                    stack[n] = rr * w + cc
+                    n += 1
+    old = np.empty((h, w), np.bool_)
+    for r in range(h):
+        for c in range(w):
+            old[r, c] = state[r, c] != 3
+    return old
+
+
 def _old_side(path: np.ndarray, shape, seed_left: bool, seed_top: bool) -> np.ndarray:
     """Old region of a cut: the cut plus everything 4-connected to the block's left (top) edge
     without crossing it; pockets of the new side enclosed by it become old (holes filled)."""
     barrier = np.zeros(shape, dtype=bool)
     barrier[path[:, 0], path[:, 1]] = True
-    labels, _ = ndimage.label(~barrier)
-    seeds = []
-    if seed_left:
-        seeds.append(labels[:, 0])
-    if seed_top:
-        seeds.append(labels[0, :])
-    ids = np.unique(np.concatenate(seeds))
-    old = np.isin(labels, ids[ids > 0]) | barrier
-    return ndimage.binary_fill_holes(old)
+    return _old_side_of_barrier(barrier, seed_left, seed_top)
+
+
+@njit(cache=True, nogil=True)
+def _dp_meeting(e, ovl, ovt):  # pragma: no cover - compiled
+    """Where the dp arms of an L-cut join: the first (row-major) corner pixel q of least
+    ``E_v(q) + E_h(q) - e(q)``, with the step tables of the left strip (bottom-up) and of the
+    transposed top strip (right-to-left)."""
+    v_cost, v_step = _dp_to_bottom(np.ascontiguousarray(e[:, :ovl]))
+    h_cost, h_step = _dp_to_bottom(np.ascontiguousarray(e[:ovt].T))
+    qr = qc = 0
+    best = v_cost[0, 0] + h_cost[0, 0] - e[0, 0]
+    for r in range(ovt):
+        for c in range(ovl):
+            joint = v_cost[r, c] + h_cost[c, r] - e[r, c]
+            if joint < best:
+                best, qr, qc = joint, r, c
+    return qr, qc, v_step, h_step
+
+
+@njit(cache=True, nogil=True)
+def _dp_l_cut(e, ovl, ovt):  # pragma: no cover - compiled
+    """The dp L-cut of an (bh, bw) error map with both arms: path, old side and meeting point.
+
+    The arms join at :func:`_dp_meeting`'s q; the path runs from the bottom row up the left
+    arm to q, then along the top arm to the right column, each pixel once (first visit kept).
+    """
+    bh, bw = e.shape
+    qr, qc, v_step, h_step = _dp_meeting(e, ovl, ovt)
+    down = _trace_down(v_step, qr, qc)  # columns of rows qr .. bh - 1
+    right = _trace_down(h_step, qc, qr)  # rows of columns qc .. bw - 1
+    barrier = np.zeros((bh, bw), np.bool_)
+    path = np.empty((down.size + right.size, 2), np.intp)
+    n = 0
+    for k in range(down.size + right.size):
+        if k < down.size:
+            r, c = qr + down.size - 1 - k, down[down.size - 1 - k]
+        else:
+            r, c = right[k - down.size], qc + k - down.size
+        if not barrier[r, c]:
+            barrier[r, c] = True
+            path[n, 0], path[n, 1] = r, c
+            n += 1
+    return path[:n].copy(), _old_side_of_barrier(barrier, True, True), qr, qc
 
 
 def _strip_path(strip: np.ndarray, method: str, start, cancel, options) -> np.ndarray:
@@ -391,29 +471,25 @@ def l_cut(
     if unknown:
         raise TypeError(f"unexpected option(s) for method {method!r}: {', '.join(unknown)}")
     check(cancel)
-    meeting = None
+    meeting = mask = None
     if ovt == 0:
         path = _strip_path(e[:, :ovl], method, None, cancel, seam_options)[::-1]
     elif ovl == 0:
         path = _strip_path(e[:ovt].T, method, None, cancel, seam_options)[:, ::-1]
     elif method in GRAPH_METHODS:
         path = _graph_l_path(e, ovl, ovt, method, cancel, seam_options)
+    elif method == "dp":
+        path, mask, qr, qc = _dp_l_cut(e, ovl, ovt)
+        meeting = (int(qr), int(qc))
     else:
-        v_cost, v_step = _dp_to_bottom(np.ascontiguousarray(e[:, :ovl]))
-        h_cost, h_step = _dp_to_bottom(np.ascontiguousarray(e[:ovt].T))
-        joint = v_cost[:ovt, :ovl] + h_cost[:ovl, :ovt].T - e[:ovt, :ovl]
-        qr, qc = (int(v) for v in np.unravel_index(np.argmin(joint), joint.shape))
-        meeting = (qr, qc)
-        if method == "dp":
-            down = np.column_stack([np.arange(qr, bh), _trace_down(v_step, qr, qc)])
-            right = np.column_stack([_trace_down(h_step, qc, qr), np.arange(qc, bw)])
-        else:
-            down = _strip_path(e[qr:, :ovl], method, qc, cancel, seam_options) + (qr, 0)
-            right = _strip_path(e[:ovt, qc:].T, method, qr, cancel, seam_options)
-            right = right[:, ::-1] + (0, qc)
-        path = _unique_in_order(np.concatenate([down[::-1], right]))
-    path = np.ascontiguousarray(path, dtype=np.intp)
-    mask = _old_side(path, e.shape, ovl > 0, ovt > 0)
+        qr, qc, _, _ = _dp_meeting(e, ovl, ovt)
+        meeting = (int(qr), int(qc))
+        down = _strip_path(e[qr:, :ovl], method, qc, cancel, seam_options) + (qr, 0)
+        right = _strip_path(e[:ovt, qc:].T, method, qr, cancel, seam_options)
+        path = _unique_in_order(np.concatenate([down[::-1], right[:, ::-1] + (0, qc)]))
+    if mask is None:
+        path = np.ascontiguousarray(path, dtype=np.intp)
+        mask = _old_side(path, e.shape, ovl > 0, ovt > 0)
     values = e[path[:, 0], path[:, 1]]
     _frozen(mask, path)
     return LCut(mask, path, float(values.sum()), float(values.max()), meeting)
