@@ -39,7 +39,7 @@ from engine.project import (
 from quilt_gui import jobs, params, settings
 from quilt_gui.app import APP_NAME, apply_theme
 from quilt_gui.document import Document, Source, safe_name
-from quilt_gui.imaging import pixel_text
+from quilt_gui.imaging import pixel_text, prepare_display
 from quilt_gui.pipeline import Pipeline, error_text
 from quilt_gui.widgets.candidate_dialog import CandidateDialog
 from quilt_gui.widgets.canvas import ImageCanvas
@@ -58,6 +58,21 @@ log = logging.getLogger(__name__)
 IMAGE_FILTER = "Images (" + " ".join(f"*{s}" for s in READ_SUFFIXES) + ")"
 PROJECT_FILTER = f"Quilt Studio projects (*{PROJECT_SUFFIX})"
 MAIN_MAP = "albedo"
+
+
+def read_image(path: str):
+    """Worker: load an image and prepare its display copy (the GUI thread only copies it)."""
+    loaded = load_image(path)
+    prepare_display(loaded.pixels)
+    return loaded
+
+
+def read_project(path: str):
+    """Worker: load a project and prepare the display copy of its main map."""
+    project = load_project(path)
+    if project.sources:
+        prepare_display(next(iter(project.sources.values())))
+    return project
 
 
 def recovery_dir() -> Path:
@@ -449,9 +464,9 @@ class MainWindow(QMainWindow):
         if confirm and not self._confirm_discard():
             return
         if path.lower().endswith(PROJECT_SUFFIX):
-            self._read("open", load_project, path, self._on_project_loaded)
+            self._read("open", read_project, path, self._on_project_loaded)
         else:
-            self._read("open", load_image, path, partial(self._on_image_loaded, remember=remember))
+            self._read("open", read_image, path, partial(self._on_image_loaded, remember=remember))
 
     def _read(self, key: str, reader, path: str, on_done) -> None:
         """Run ``reader(path)`` in the background; ``on_done(path, result)``; errors -> message."""
@@ -746,7 +761,7 @@ class MainWindow(QMainWindow):
 
     def load_target(self, path: str) -> None:
         """Load the texture-transfer target in the background."""
-        self._read("open_target", load_image, path, self._on_target_loaded)
+        self._read("open_target", read_image, path, self._on_target_loaded)
 
     def _on_target_loaded(self, path: str, loaded) -> None:
         self.doc.set_transfer_target(loaded.pixels, path)
