@@ -214,16 +214,34 @@ class Document(QObject):
             new = {k: [] for k in WAYPOINT_KEYS}
             self.undo_stack.push(commands.SetWaypoints(self, new, "Clear waypoints"))
 
-    def set_picks(self, picks, *, text: str = "Pick tiles") -> None:
+    def set_picks(self, picks, *, text: str = "Pick tiles") -> commands.SetPicks | None:
+        """Pick these candidates (in this order); returns the undo step, None if unchanged."""
         picks = [int(i) for i in dict.fromkeys(picks) if 0 <= int(i) < len(self.candidates)]
-        if picks != self.picks:
-            self.undo_stack.push(commands.SetPicks(self, picks, text))
+        if picks == self.picks:
+            return None
+        command = commands.SetPicks(self, picks, text)
+        self.undo_stack.push(command)
+        return command
 
-    def toggle_pick(self, index: int) -> None:
+    def toggle_pick(self, index: int) -> commands.SetPicks | None:
         if index in self.picks:
-            self.set_picks([i for i in self.picks if i != index], text="Unpick tile")
-        else:
-            self.set_picks([*self.picks, index], text="Pick tile")
+            return self.set_picks([i for i in self.picks if i != index], text="Unpick tile")
+        return self.set_picks([*self.picks, index], text="Pick tile")
+
+    def retract(self, command) -> bool:
+        """Undo ``command`` and drop it from the history if it is the newest step.
+
+        For a click that turns out to be the first half of a double-click: the double-click
+        leaves neither the pick nor an undo (or redo) step behind.
+        """
+        st = self.undo_stack
+        n = st.count()
+        if command is None or not n or st.index() != n or st.command(n - 1) is not command:
+            return False
+        command.undo()
+        command.setObsolete(True)  # QUndoStack.undo() deletes an obsolete command unapplied
+        st.undo()
+        return True
 
     def set_candidates(
         self,

@@ -69,6 +69,8 @@ class Pipeline(QObject):
         doc.exclusion_changed.connect(self.restart_quilt_if_shown)
         self._quilt_timer = _soon(self, self._restart_quilt)
         self._gen_old = ([], [])
+        self._gen_wanted, self._gen_next = 0, 0  # candidates asked for / shown in index order
+        self._gen_waiting: dict[int, CandidateEntry] = {}  # finished before their turn
         self._quilt_mode = "quilt"  # what a parameter change restarts: "quilt" or "transfer"
 
     # ------------------------------------------------------------------ helpers
@@ -334,6 +336,7 @@ class Pipeline(QObject):
         self._gen_old = (list(doc.candidates), list(doc.picks))
         doc.apply_candidates(keep, [k for _, k in sorted(keep_picks)])
         n = int(doc.params["n_candidates"]) - len(keep)
+        self._gen_wanted, self._gen_next, self._gen_waiting = max(0, n), 0, {}
         if n <= 0:
             self._on_candidates_done([])
             return None
@@ -354,11 +357,21 @@ class Pipeline(QObject):
         )
 
     def _on_candidate_event(self, event) -> None:
+        """Candidates finish in any order; they are shown in the order of their index, so
+        candidate #k is the same tile for the same seed (each waits for the ones before it,
+        at most a worker's head start)."""
         if hasattr(event, "tile") and hasattr(event, "patch_rect"):
-            self.doc.append_candidate(self.entry_from(event))
+            self._gen_waiting[int(event.index)] = self.entry_from(event)
+            while self._gen_next in self._gen_waiting:
+                self.doc.append_candidate(self._gen_waiting.pop(self._gen_next))
+                self._gen_next += 1
 
     def _on_candidates_done(self, _result) -> None:
         doc = self.doc
+        made = self._gen_next
+        for k in sorted(self._gen_waiting):  # after a cancel: the ones that did finish
+            doc.append_candidate(self._gen_waiting.pop(k))
+            made += 1
         doc.set_candidates(
             list(doc.candidates),
             list(doc.picks),
@@ -366,10 +379,11 @@ class Pipeline(QObject):
             old=self._gen_old,
             already_applied=True,
         )
+        what = f"{len(doc.candidates)} candidates"
+        if made < self._gen_wanted:
+            what = f"Generation stopped: {made} of {self._gen_wanted} new candidates made, {what}"
         self.message.emit(
-            "info",
-            f"{len(doc.candidates)} candidates. Click to pick the tiles "
-            "to keep; double-click to open one.",
+            "info", f"{what}. Click to pick the tiles to keep; double-click to open one."
         )
 
     def _on_candidates_error(self, exc) -> None:

@@ -215,9 +215,9 @@ class CandidateView(QListView):
         self.setSelectionMode(QListView.SelectionMode.SingleSelection)
         self.setContextMenuPolicy(Qt.ContextMenuPolicy.CustomContextMenu)
         self.customContextMenuRequested.connect(self._context_menu)
-        self.doubleClicked.connect(self._on_double_clicked)
         self.selectionModel().currentChanged.connect(self._on_current)
         self._anchor: int | None = None
+        self._click = None  # (row, undo step) of the last click's pick toggle
         self.setToolTip("")
         self.setWhatsThis(
             "Click: pick / unpick · Shift+click: pick a range · Space: pick the "
@@ -233,11 +233,6 @@ class CandidateView(QListView):
     def _on_current(self, current, _previous) -> None:
         self.current_changed.emit(current.row() if current.isValid() else -1)
 
-    @Slot(QModelIndex)
-    def _on_double_clicked(self, index) -> None:
-        if index.isValid():
-            self.open_requested.emit(index.row())
-
     def pick_range(self, a: int, b: int) -> None:
         lo, hi = sorted((a, b))
         self.doc.set_picks([*self.doc.picks, *range(lo, hi + 1)], text="Pick tiles")
@@ -248,18 +243,26 @@ class CandidateView(QListView):
         if not index.isValid() or event.button() != Qt.MouseButton.LeftButton:
             return
         row = index.row()
+        self._click = None
         if event.modifiers() & Qt.KeyboardModifier.ShiftModifier and self._anchor is not None:
             self.pick_range(self._anchor, row)
         else:
-            self.doc.toggle_pick(row)
+            self._click = (row, self.doc.toggle_pick(row))
         self._anchor = row
 
     def mouseDoubleClickEvent(self, event) -> None:  # noqa: N802 - Qt API
-        # the first click of a double-click toggled the pick; a double-click only opens
+        """Open the candidate; the pick toggled by the double-click's first click is retracted."""
         index = self.indexAt(event.position().toPoint())
-        if index.isValid():
-            self.doc.toggle_pick(index.row())
-        super().mouseDoubleClickEvent(event)
+        if not index.isValid() or event.button() != Qt.MouseButton.LeftButton:
+            super().mouseDoubleClickEvent(event)
+            return
+        row = index.row()
+        click, self._click = self._click, None
+        if click is not None and click[0] == row:
+            self.doc.retract(click[1])
+        self.setCurrentIndex(index)
+        self.open_requested.emit(row)
+        event.accept()
 
     def keyPressEvent(self, event) -> None:  # noqa: N802 - Qt API
         row = self.current_row()

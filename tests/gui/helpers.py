@@ -23,6 +23,22 @@ def open_sample(qtbot, window: MainWindow, name: str | None = None) -> None:
     wait_idle(qtbot, window)
 
 
+def template(qtbot, window: MainWindow, rect=(150, 120, 128, 112)) -> None:
+    """Draw the tile rectangle and wait for its seamless tile."""
+    window.doc.set_template_rect(rect)
+    wait_idle(qtbot, window)
+    assert window.doc.seamless is not None
+
+
+def generate(qtbot, window: MainWindow, n: int = 30, rect=(150, 120, 128, 112)) -> None:
+    """Template at ``rect`` and ``n`` candidates."""
+    template(qtbot, window, rect)
+    window.doc.set_param("n_candidates", n)
+    window.act_generate.trigger()
+    wait_idle(qtbot, window)
+    assert len(window.doc.candidates) == n
+
+
 def click_candidate(qtbot, window: MainWindow, row: int, modifier=Qt.KeyboardModifier.NoModifier):
     view = window.gallery
     ix = view.model().index(row, 0)

@@ -14,7 +14,7 @@ from PySide6.QtWidgets import QPushButton
 from quilt_gui import settings
 from quilt_gui.widgets.canvas import ImageCanvas
 from quilt_gui.widgets.gallery import CandidateModel
-from tests.gui.helpers import make_window, open_sample, wait_idle
+from tests.gui.helpers import make_window, open_sample, template, wait_idle
 
 
 @pytest.fixture
@@ -22,12 +22,6 @@ def win(qtbot):
     w = make_window(qtbot)
     open_sample(qtbot, w)
     return w
-
-
-def template(qtbot, w, rect=(150, 120, 128, 112)):
-    w.doc.set_template_rect(rect)
-    wait_idle(qtbot, w)
-    assert w.doc.seamless is not None
 
 
 # ---------------------------------------------------------------------- canvas

@@ -1,0 +1,72 @@
+"""Candidates gallery: double-click opens without picking, stable order, stopped generation."""
+
+from __future__ import annotations
+
+from PySide6.QtCore import QEvent, QPointF, Qt
+from PySide6.QtGui import QMouseEvent
+
+from engine.tiles.candidates import candidate_seed
+from tests.gui.helpers import generate, make_window, open_sample, wait_idle
+
+
+def _mouse(view, kind, row) -> None:
+    ix = view.model().index(row, 0)
+    view.scrollTo(ix)
+    pos = QPointF(view.visualRect(ix).center())
+    ev = QMouseEvent(
+        kind,
+        pos,
+        view.viewport().mapToGlobal(pos),
+        Qt.MouseButton.LeftButton,
+        Qt.MouseButton.LeftButton
+        if kind != QEvent.Type.MouseButtonRelease
+        else Qt.MouseButton.NoButton,
+        Qt.KeyboardModifier.NoModifier,
+    )
+    {
+        QEvent.Type.MouseButtonPress: view.mousePressEvent,
+        QEvent.Type.MouseButtonRelease: view.mouseReleaseEvent,
+        QEvent.Type.MouseButtonDblClick: view.mouseDoubleClickEvent,
+    }[kind](ev)
+
+
+def test_double_click_opens_the_candidate_and_leaves_no_pick_or_undo_step(qtbot):
+    w = make_window(qtbot)
+    open_sample(qtbot, w)
+    generate(qtbot, w, 6)
+    g = w.gallery
+    steps = w.doc.undo_stack.count()
+    # a real double-click: press, release, double-click, release
+    T = QEvent.Type
+    for kind in (T.MouseButtonPress, T.MouseButtonRelease, T.MouseButtonDblClick):
+        _mouse(g, kind, 2)
+    _mouse(g, T.MouseButtonRelease, 2)
+    assert 2 in w._dialogs and w._dialogs[2].isVisible()
+    assert w.doc.picks == [] and w.doc.undo_stack.count() == steps
+    assert not w.doc.undo_stack.canRedo()
+    # QTest's double-click sends the double-click event alone
+    qtbot.mouseDClick(
+        g.viewport(), Qt.MouseButton.LeftButton, pos=g.visualRect(g.model().index(4)).center()
+    )
+    assert 4 in w._dialogs and w.doc.picks == []
+    # a plain click still picks
+    _mouse(g, T.MouseButtonPress, 1)
+    _mouse(g, T.MouseButtonRelease, 1)
+    assert w.doc.picks == [1]
+
+
+def test_candidates_are_numbered_by_their_seed_and_a_stop_says_so(qtbot):
+    w = make_window(qtbot)
+    open_sample(qtbot, w)
+    generate(qtbot, w, 12)
+    seed = int(w.doc.params["seed"])
+    assert [e.seed for e in w.doc.candidates] == [candidate_seed(seed, k) for k in range(12)]
+    w.doc.set_param("n_candidates", 400)
+    w.act_generate.trigger()
+    qtbot.waitUntil(lambda: len(w.doc.candidates) >= 4, timeout=20_000)
+    w.act_cancel.trigger()
+    wait_idle(qtbot, w)
+    n = len(w.doc.candidates)
+    assert n < 400
+    assert w.last_message().startswith(f"Generation stopped: {n} of 400 new candidates made")
+    assert w.doc.undo_stack.undoText() == "Generate candidates"
