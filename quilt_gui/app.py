@@ -58,12 +58,22 @@ def dark_palette() -> QPalette:
 
 
 def apply_theme(app: QApplication, theme: str) -> None:
-    """Fusion style with a dark palette ("dark") or Fusion's own light palette ("light")."""
+    """Fusion style with a dark palette ("dark") or Fusion's own light palette ("light").
+
+    Widgets with a style sheet (superqt's slider value labels, for one) keep the palette
+    they were polished with, so they are re-polished: otherwise a switch at run time leaves
+    light-grey numbers on a light background.
+    """
     app.setStyle("Fusion")
     if theme == "light":
         app.setPalette(app.style().standardPalette())
     else:
         app.setPalette(dark_palette())
+    for widget in app.allWidgets():
+        sheet = widget.styleSheet()
+        if sheet:
+            widget.setStyleSheet("")
+            widget.setStyleSheet(sheet)
 
 
 def make_app(argv: list[str] | None = None, *, theme: str | None = None) -> QApplication:

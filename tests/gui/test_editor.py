@@ -361,8 +361,15 @@ def test_autosave_and_recovery_after_a_crash(qtbot, win):
 def test_light_theme_on_request(qtbot, win):
     from PySide6.QtWidgets import QApplication
 
+    label = win.params_panel.widgets["overlap"]._label  # a style-sheeted superqt label
+
+    def text_lightness() -> int:
+        return label.palette().color(label.foregroundRole()).lightness()
+
     win.set_theme("light")
     assert QApplication.palette().window().color().lightness() > 128
+    assert text_lightness() < 128  # dark numbers on the light background
     win.set_theme("dark")
     assert QApplication.palette().window().color().lightness() < 128
+    assert text_lightness() > 128
     assert settings.get("theme") == "dark"
