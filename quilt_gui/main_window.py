@@ -60,6 +60,22 @@ PROJECT_FILTER = f"Quilt Studio projects (*{PROJECT_SUFFIX})"
 MAIN_MAP = "albedo"
 
 
+#: Pillow's colour-model names (engine.io LoadedImage.mode) as the user reads them.
+MODE_NAMES = {
+    "L": "gray",
+    "LA": "gray + alpha",
+    "1": "black-and-white",
+    "P": "palette",
+    "PA": "palette + alpha",
+    "RGBA": "RGB + alpha",
+    "F": "gray (float)",
+}
+
+
+def mode_text(mode: str) -> str:
+    return MODE_NAMES.get(mode, mode)
+
+
 def read_image(path: str):
     """Worker: load an image and prepare its display copy (the GUI thread only copies it)."""
     loaded = load_image(path)
@@ -493,7 +509,7 @@ class MainWindow(QMainWindow):
         self.show_message(
             "info",
             f"Opened {Path(path).name}: {w}×{h}, {loaded.bit_depth}-bit "
-            f"{loaded.mode}. Next: Find best tile (Ctrl+T) or draw the "
+            f"{mode_text(loaded.mode)}. Next: Find best tile (Ctrl+T) or draw the "
             "tile rectangle.",
         )
         self.tabs.setCurrentWidget(self.source_view)

@@ -273,6 +273,29 @@ def test_drop_opens_an_image_and_remembers_it(qtbot, win, tmp_path):
     assert "small texture.png" in win.recent_menu.actions()[0].text()
 
 
+@pytest.mark.parametrize(
+    ("mode", "shown"),
+    [
+        ("L", "8-bit gray"),
+        ("P", "8-bit palette"),
+        ("RGBA", "8-bit RGB + alpha"),
+        ("I;16", "16-bit gray"),
+    ],
+)
+def test_opened_message_names_the_colour_model_in_words(qtbot, win, tmp_path, mode, shown):
+    path = tmp_path / "t.png"
+    rgb = np.random.default_rng(2).integers(0, 256, (40, 50, 3), dtype=np.uint8)
+    im = Image.fromarray(rgb)
+    if mode == "I;16":
+        im = Image.fromarray(rgb[:, :, 0].astype(np.uint16) * 257)
+    else:
+        im = im.convert(mode)
+    im.save(path)
+    with qtbot.waitSignal(win.doc.source_changed, timeout=5000):
+        win.open_path(str(path), confirm=False)
+    assert f"50×40, {shown}." in win.last_message()
+
+
 def test_image_too_small_for_the_tile(qtbot, win, tmp_path):
     tiny = tmp_path / "tiny.png"
     Image.fromarray(np.zeros((24, 24, 3), np.uint8) + 100).save(tiny)
