@@ -203,15 +203,34 @@ def masked_ssd(sample, target, mask, *, threads: int | None = None) -> np.ndarra
 
 @njit(cache=True, nogil=True)
 def _gather_ssd(sample, anchors, ys, xs, values, out):  # pragma: no cover - compiled
+    """out[k] = Σ_m Σ_ch (sample[anchor k + (ys[m], xs[m]), ch] - values[m, ch])² in float64,
+    each sum in this order. Four anchors share a pass: their independent sums overlap in the
+    pipeline instead of waiting on one another (the same additions, the same results)."""
     c = sample.shape[2]
-    for k in range(anchors.shape[0]):
-        ay, ax = anchors[k, 0], anchors[k, 1]
-        acc = 0.0
+    n = anchors.shape[0]
+    for k0 in range(0, n, 4):
+        k1, k2, k3 = min(k0 + 1, n - 1), min(k0 + 2, n - 1), min(k0 + 3, n - 1)
+        y0, x0 = anchors[k0, 0], anchors[k0, 1]
+        y1, x1 = anchors[k1, 0], anchors[k1, 1]
+        y2, x2 = anchors[k2, 0], anchors[k2, 1]
+        y3, x3 = anchors[k3, 0], anchors[k3, 1]
+        a0 = a1 = a2 = a3 = 0.0
         for m in range(ys.shape[0]):
+            u, v = ys[m], xs[m]
             for ch in range(c):
-                d = np.float64(sample[ay + ys[m], ax + xs[m], ch]) - values[m, ch]
-                acc += d * d
-        out[k] = acc
+                t = values[m, ch]
+                d0 = np.float64(sample[y0 + u, x0 + v, ch]) - t
+                d1 = np.float64(sample[y1 + u, x1 + v, ch]) - t
+                d2 = np.float64(sample[y2 + u, x2 + v, ch]) - t
+                d3 = np.float64(sample[y3 + u, x3 + v, ch]) - t
+                a0 += d0 * d0
+                a1 += d1 * d1
+                a2 += d2 * d2
+                a3 += d3 * d3
+        out[k0] = a0
+        out[k1] = a1  # a repeated last anchor writes the same value again
+        out[k2] = a2
+        out[k3] = a3
 
 
 def ssd_at(sample: np.ndarray, anchors: np.ndarray, target: np.ndarray, mask: np.ndarray):
@@ -265,25 +284,65 @@ def select_within_tolerance(errors: np.ndarray, *, tolerance: float, zero_level:
 
 # ---------------------------------------------------------------------------- fast mode
 @njit(cache=True, nogil=True, fastmath=True)
-def _estimates(q, features, base, invalid, out):  # pragma: no cover - compiled
-    """out[i, j] = base[i, j] - 2 Σ_k q[i, k] features[k, j]; inf where invalid[j].
+def _estimates(q, features, base, base_row, invalid, out):  # pragma: no cover - compiled
+    """out[i, j] = base[base_row[i], j] - 2 Σ_k q[i, k] features[k, j]; inf where invalid[j].
 
     A plain loop: single-threaded and bit-identical whatever the batch (a threaded BLAS
     product is both slower at this size on small machines and batch dependent)."""
     n, kk = q.shape
     nn = features.shape[1]
     for i in range(n):
+        row = out[i]
+        b = base[base_row[i]]
         for j in range(nn):
-            out[i, j] = base[i, j]
+            row[j] = b[j]
         for k in range(kk):
             c = -2.0 * q[i, k]
             if c == 0.0:
                 continue
+            f = features[k]
             for j in range(nn):
-                out[i, j] += c * features[k, j]
+                row[j] += c * f[j]
         for j in range(nn):
             if invalid[j]:
-                out[i, j] = np.inf
+                row[j] = np.inf
+
+
+@njit(cache=True, nogil=True)
+def _rank(
+    q, features, base, base_row, invalid, m, anchor_w, sample, targets, masks
+):  # pragma: no cover - compiled
+    """Everything of a fast query after the projections ``q``, in one call without the GIL:
+    the estimates, the ``m`` best finite ones per target, their exact SSDs and their order.
+
+    Returns anchors (n, m, 2), exact errors (n, m) sorted ascending (stable) and the number
+    of valid rows per target (the rest is padding)."""
+    n = q.shape[0]
+    nn = features.shape[1]
+    est = np.empty((n, nn), np.float32)
+    _estimates(q, features, base, base_row, invalid, est)
+    anchors = np.zeros((n, m, 2), np.int64)
+    errors = np.full((n, m), np.inf)
+    counts = np.zeros(n, np.int64)
+    for i in range(n):
+        idx = _smallest(est[i], m)
+        idx = idx[np.isfinite(est[i][idx])]
+        a = np.empty((idx.size, 2), np.int64)
+        for r in range(idx.size):
+            a[r, 0], a[r, 1] = idx[r] // anchor_w, idx[r] % anchor_w
+        ys, xs = np.nonzero(masks[i])
+        vals = np.empty((ys.size, targets.shape[3]), np.float64)
+        for p in range(ys.size):
+            for ch in range(targets.shape[3]):
+                vals[p, ch] = targets[i, ys[p], xs[p], ch]
+        exact = np.empty(idx.size, np.float64)
+        _gather_ssd(sample, a, ys.astype(np.int64), xs.astype(np.int64), vals, exact)
+        order = np.argsort(exact, kind="mergesort")
+        counts[i] = idx.size
+        for r in range(idx.size):
+            anchors[i, r] = a[order[r]]
+            errors[i, r] = exact[order[r]]
+    return anchors, errors, counts
 
 
 @njit(cache=True, nogil=True, fastmath=True)
@@ -416,6 +475,13 @@ class PCAMatcher:
             )
         proj = spectrum.correlate(np.concatenate(kernels))
         self.features = np.ascontiguousarray(proj.reshape(i, -1))  # (K, N)
+        # ‖f‖² of every window summed over the parts of each overlap that parts_for knows
+        shapes = {self.parts_for(*a) for a in ((top, left), (0, left), (top, 0))} - {()}
+        self._base_row = {parts: r for r, parts in enumerate(sorted(shapes))}
+        self._base = np.zeros((len(shapes), na), np.float32)
+        for parts, r in self._base_row.items():
+            for name in parts:
+                self._base[r] += self.norms[name].ravel()
 
     def parts_for(self, top: int, left: int) -> tuple[str, ...]:
         """Parts covered by an overlap with ``top`` rows and ``left`` columns, or () if the
@@ -438,26 +504,27 @@ class PCAMatcher:
         n = len(targets)
         nn = self.features.shape[1]
         q = np.zeros((n, self.features.shape[0]), np.float32)
-        base = np.zeros((n, nn), np.float32)
+        base_row = np.empty(n, np.intp)
         for i, (t, parts) in enumerate(zip(targets, parts_list, strict=True)):
             for name in parts:
                 y0, x0, rh, rw = self.rects[name]
                 a, b = self.offsets[name]
                 q[i, a:b] = self.bases[name] @ t[y0 : y0 + rh, x0 : x0 + rw].ravel()
-                base[i] += self.norms[name].ravel()
+            base_row[i] = self._base_row[tuple(parts)]
         invalid = np.zeros(nn, bool) if valid is None else ~valid.ravel()
-        est = np.empty((n, nn), np.float32)
-        _estimates(q, self.features, base, invalid, est)
-        m = min(int(rerank), nn)
-        out = []
-        for i in range(n):
-            idx = _smallest(est[i], m)
-            idx = idx[np.isfinite(est[i, idx])]
-            anchors = np.column_stack(np.divmod(idx, self.anchor_shape[1]))
-            exact = ssd_at(self.spec.sample, anchors, targets[i], mask_list[i])
-            order = np.argsort(exact, kind="stable")
-            out.append((anchors[order], exact[order]))
-        return out
+        anchors, errors, counts = _rank(
+            q,
+            self.features,
+            self._base,
+            base_row,
+            invalid,
+            min(int(rerank), nn),
+            self.anchor_shape[1],
+            self.spec.sample,
+            np.stack(targets),
+            np.stack(mask_list).astype(bool, copy=False),
+        )
+        return [(a[:k], e[:k]) for a, e, k in zip(anchors, errors, counts, strict=True)]
 
 
 def summed_area(values: np.ndarray) -> np.ndarray:

@@ -143,3 +143,40 @@ def test_masked_ssd_errors():
         masked_ssd(np.zeros((9, 9, 3)), np.zeros((3, 3)), np.ones((3, 3)))
     with pytest.raises(ValueError, match="larger than the sample"):
         masked_ssd(np.zeros((4, 4, 3)), np.zeros((5, 3, 3)), np.ones((5, 3)))
+
+
+def test_pca_query_ranks_by_estimate_reranks_exactly_and_ignores_the_batch():
+    """The re-ranked windows are the ``rerank`` lowest estimates (float64 recomputation, up to
+    float32 round-off), their errors are exact SSDs in ascending order, excluded windows never
+    appear, and a target gets the same answer alone or in a batch."""
+    rng = np.random.default_rng(6)
+    s = rng.random((40, 44, 3), dtype=np.float32)
+    pca = PCAMatcher(SampleSpectrum(s), (12, 12), top=3, left=3, components=4, rng=1)
+    valid = rng.random(pca.anchor_shape) < 0.8
+    targets = [rng.random((12, 12, 3), dtype=np.float32) for _ in range(3)]
+    shapes = [(3, 3), (0, 3), (3, 0)]
+    parts = [pca.parts_for(*a) for a in shapes]
+    masks = [l_mask(12, 12, *a) for a in shapes]
+    batch = pca.query(targets, parts, valid, rerank=10, mask_list=masks)
+    for i, (anchors, errs) in enumerate(batch):
+        alone = pca.query([targets[i]], [parts[i]], valid, rerank=10, mask_list=[masks[i]])[0]
+        np.testing.assert_array_equal(anchors, alone[0])
+        np.testing.assert_array_equal(errs, alone[1])
+        assert len(anchors) == 10 and valid[anchors[:, 0], anchors[:, 1]].all()
+        np.testing.assert_array_equal(errs, ssd_at(s, anchors, targets[i], masks[i]))
+        assert (np.diff(errs) >= 0).all()
+        est = np.zeros(pca.anchor_shape)
+        for name in parts[i]:
+            y0, x0, rh, rw = pca.rects[name]
+            a, b = pca.offsets[name]
+            proj = (
+                pca.bases[name].astype(np.float64) @ targets[i][y0 : y0 + rh, x0 : x0 + rw].ravel()
+            )
+            est += pca.norms[name] - 2 * (proj @ pca.features[a:b]).reshape(pca.anchor_shape)
+        est[~valid] = np.inf
+        cutoff = np.sort(est.ravel())[10]
+        assert (est[anchors[:, 0], anchors[:, 1]] <= cutoff + 1e-4).all()
+    few = np.zeros(pca.anchor_shape, bool)
+    few[5, 7] = few[20, 1] = True  # fewer valid windows than rerank
+    ((anchors, errs),) = pca.query(targets[:1], parts[:1], few, rerank=10, mask_list=masks[:1])
+    assert sorted(map(tuple, anchors.tolist())) == [(5, 7), (20, 1)] and len(errs) == 2
