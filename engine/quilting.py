@@ -291,18 +291,36 @@ def _dependencies(rects, shape, torus: bool):
 
     The predecessors of a block are the last earlier blocks written under its footprint (the
     earlier writers of those pixels precede them in turn); its level is one more than theirs.
-    Blocks of one level neither read nor write each other's pixels.
+    Blocks of one level neither read nor write each other's pixels. The canvas is cut into
+    cells at every block edge, so each footprint is a set of whole cells.
     """
-    last = np.full(shape, -1, dtype=np.int64)
+    cells = [
+        _axis_cells([(r[a], r[a + 2]) for r in rects], n, torus)
+        for a, n in ((0, shape[0]), (1, shape[1]))
+    ]
+    (ry, ny), (rx, nx) = cells
+    last = np.full((ny, nx), -1, dtype=np.int64)
     preds, levels = [], []
     for k, (y, x, h, w) in enumerate(rects):
-        idx = _index(y, x, h, w, shape, torus)
-        p = np.unique(last[idx])
-        p = p[p >= 0]
-        preds.append(p.tolist())
-        levels.append(1 + max((levels[j] for j in preds[-1]), default=-1))
+        idx = np.ix_(ry[y, h], rx[x, w])
+        p = sorted({int(v) for v in last[idx].ravel()} - {-1})
+        preds.append(p)
+        levels.append(1 + max((levels[j] for j in p), default=-1))
         last[idx] = k
     return preds, levels
+
+
+def _axis_cells(spans, n: int, torus: bool):
+    """Cells of one canvas axis of length ``n`` cut at the ends of every span (start, length),
+    and the cells each span covers (wrapping around on a torus): ({span: cells}, count)."""
+    cuts = sorted({0, n} | {s % n for s, _ in spans} | {(s + k) % n for s, k in spans})
+    cell_of = np.searchsorted(cuts, np.arange(n), side="right") - 1
+    covered = {}
+    for s, k in set(spans):
+        if not torus and s + k > n:
+            raise AssertionError("block outside a non-tileable canvas")
+        covered[s, k] = np.unique(cell_of[np.arange(s, s + k) % n])
+    return covered, len(cuts) - 1
 
 
 def _index(y, x, h, w, shape, torus):
@@ -760,21 +778,23 @@ def _run_levels(q: _Quilter, rects, total_label: str):
     pool = ThreadPoolExecutor(max(1, q.threads - 1)) if q.threads > 1 and heavy else None
     futures = {}
 
-    def search(c):
+    def loaded(c):  # the batch's predecessors are placed: read what lies under it now
         batch = [works[k] for k in chunks[c]]
         for wk in batch:
             q.load(wk)
-        q.search(batch)
+        return batch
 
     records: list[BlockRecord] = []
     try:
         if pool is not None:
-            futures = {c: pool.submit(search, c) for c in range(len(chunks)) if not waiting[c]}
+            futures = {
+                c: pool.submit(q.search, loaded(c)) for c in range(len(chunks)) if not waiting[c]
+            }
         done = 0
         for c, members in enumerate(chunks):
             check(q.cancel)
             if pool is None:
-                search(c)
+                q.search(loaded(c))
             else:
                 futures.pop(c).result()
             for k in members:
@@ -787,7 +807,7 @@ def _run_levels(q: _Quilter, rects, total_label: str):
                 for d in dependents[k]:
                     waiting[d] -= 1
                     if not waiting[d] and pool is not None:
-                        futures[d] = pool.submit(search, d)
+                        futures[d] = pool.submit(q.search, loaded(d))
             done += len(members)
             last = c + 1 == len(chunks) or levels[chunks[c + 1][0]] != levels[members[0]]
             if q.stream and last:
