@@ -202,47 +202,73 @@ def masked_ssd(sample, target, mask, *, threads: int | None = None) -> np.ndarra
 
 
 @njit(cache=True, nogil=True)
-def _gather_ssd(sample, anchors, ys, xs, values, out):  # pragma: no cover - compiled
-    """out[k] = Σ_m Σ_ch (sample[anchor k + (ys[m], xs[m]), ch] - values[m, ch])² in float64,
-    each sum in this order. Four anchors share a pass: their independent sums overlap in the
-    pipeline instead of waiting on one another (the same additions, the same results)."""
-    c = sample.shape[2]
+def _gather_ssd(sample, anchors, mask, target, out):  # pragma: no cover - compiled
+    """out[k] = Σ_{mask} Σ_ch (sample[anchor k + (u, v), ch] - target[u, v, ch])² in float64,
+    summed in row-major order of the mask's pixels, channels innermost.
+
+    The mask is read as runs of pixels along its rows, which are contiguous in the sample;
+    four anchors share a pass, so their independent sums overlap in the pipeline instead of
+    waiting on one another (the same additions in the same order, the same results)."""
+    h, w = mask.shape
+    sw, c = sample.shape[1], sample.shape[2]
+    flat = sample.ravel()
+    runs = np.empty((h * w, 3), np.int64)  # (offset in a sample window, length, first value)
+    values = np.empty(h * w * c, np.float64)
+    nr = nv = 0
+    for u in range(h):
+        v = 0
+        while v < w:
+            if not mask[u, v]:
+                v += 1
+                continue
+            v1 = v
+            while v1 < w and mask[u, v1]:
+                for ch in range(c):
+                    values[nv] = target[u, v1, ch]
+                    nv += 1
+                v1 += 1
+            runs[nr, 0], runs[nr, 1] = (u * sw + v) * c, (v1 - v) * c
+            runs[nr, 2] = nv - (v1 - v) * c
+            nr += 1
+            v = v1
     n = anchors.shape[0]
     for k0 in range(0, n, 4):
-        k1, k2, k3 = min(k0 + 1, n - 1), min(k0 + 2, n - 1), min(k0 + 3, n - 1)
-        y0, x0 = anchors[k0, 0], anchors[k0, 1]
-        y1, x1 = anchors[k1, 0], anchors[k1, 1]
-        y2, x2 = anchors[k2, 0], anchors[k2, 1]
-        y3, x3 = anchors[k3, 0], anchors[k3, 1]
+        ks = (k0, min(k0 + 1, n - 1), min(k0 + 2, n - 1), min(k0 + 3, n - 1))
+        b0 = (anchors[ks[0], 0] * sw + anchors[ks[0], 1]) * c
+        b1 = (anchors[ks[1], 0] * sw + anchors[ks[1], 1]) * c
+        b2 = (anchors[ks[2], 0] * sw + anchors[ks[2], 1]) * c
+        b3 = (anchors[ks[3], 0] * sw + anchors[ks[3], 1]) * c
         a0 = a1 = a2 = a3 = 0.0
-        for m in range(ys.shape[0]):
-            u, v = ys[m], xs[m]
-            for ch in range(c):
-                t = values[m, ch]
-                d0 = np.float64(sample[y0 + u, x0 + v, ch]) - t
-                d1 = np.float64(sample[y1 + u, x1 + v, ch]) - t
-                d2 = np.float64(sample[y2 + u, x2 + v, ch]) - t
-                d3 = np.float64(sample[y3 + u, x3 + v, ch]) - t
+        for r in range(nr):
+            off, length, first = runs[r, 0], runs[r, 1], runs[r, 2]
+            for t in range(length):
+                x = values[first + t]
+                d0 = np.float64(flat[b0 + off + t]) - x
+                d1 = np.float64(flat[b1 + off + t]) - x
+                d2 = np.float64(flat[b2 + off + t]) - x
+                d3 = np.float64(flat[b3 + off + t]) - x
                 a0 += d0 * d0
                 a1 += d1 * d1
                 a2 += d2 * d2
                 a3 += d3 * d3
-        out[k0] = a0
-        out[k1] = a1  # a repeated last anchor writes the same value again
-        out[k2] = a2
-        out[k3] = a3
+        out[ks[0]] = a0
+        out[ks[1]] = a1  # a repeated last anchor writes the same value again
+        out[ks[2]] = a2
+        out[ks[3]] = a3
 
 
 def ssd_at(sample: np.ndarray, anchors: np.ndarray, target: np.ndarray, mask: np.ndarray):
     """Exact masked SSD at a few anchors ((k, 2) rows of (y, x)); float64 (k,).
 
     ``Σ_mask Σ_c (sample[y+u, x+v, c] − target[u, v, c])²`` accumulated in float64."""
-    ys, xs = np.nonzero(mask)
     a = np.ascontiguousarray(np.asarray(anchors, dtype=np.int64).reshape(-1, 2))
     out = np.empty(len(a), np.float64)
-    vals = np.ascontiguousarray(target[ys, xs], dtype=np.float64)
     _gather_ssd(
-        np.ascontiguousarray(sample), a, ys.astype(np.int64), xs.astype(np.int64), vals, out
+        np.ascontiguousarray(sample),
+        a,
+        np.ascontiguousarray(mask, dtype=bool),
+        np.asarray(target),
+        out,
     )
     return out
 
@@ -330,13 +356,8 @@ def _rank(
         a = np.empty((idx.size, 2), np.int64)
         for r in range(idx.size):
             a[r, 0], a[r, 1] = idx[r] // anchor_w, idx[r] % anchor_w
-        ys, xs = np.nonzero(masks[i])
-        vals = np.empty((ys.size, targets.shape[3]), np.float64)
-        for p in range(ys.size):
-            for ch in range(targets.shape[3]):
-                vals[p, ch] = targets[i, ys[p], xs[p], ch]
         exact = np.empty(idx.size, np.float64)
-        _gather_ssd(sample, a, ys.astype(np.int64), xs.astype(np.int64), vals, exact)
+        _gather_ssd(sample, a, masks[i], targets[i], exact)
         order = np.argsort(exact, kind="mergesort")
         counts[i] = idx.size
         for r in range(idx.size):
