@@ -707,7 +707,8 @@ class _Quilter:
                         cut, err, overlap, blend=self.blend, width=self.blend_width, rho=self.rho
                     )
             if alpha is None:  # hard cut: exact copies of old and new
-                pixels = np.where(keep[:, :, None], old_full, new)
+                pixels = new.copy()
+                np.copyto(pixels, old_full, where=keep[:, :, None])
             else:
                 a = alpha[:, :, None]
                 pixels = a * old_full + (1 - a) * new
