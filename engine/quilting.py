@@ -70,7 +70,7 @@ from engine.matching import (
     select_within_tolerance,
     ssd_at,
 )
-from engine.stitch import _map_points, from_canonical, l_cut, to_canonical
+from engine.stitch import from_canonical, l_cut, map_points, to_canonical
 
 SELECTIONS = ("best", "random", "sampled", "bhatia")
 MODES = ("exact", "fast")
@@ -401,7 +401,7 @@ def cut_overlap(err, arms, *, method: str, cancel=None, **options) -> _Cut:
             **options,
         )
         keep[rows, cols] |= from_canonical(np.asarray(seam.mask), orient)
-        pts = _map_points(np.asarray(seam.path), orient, strip.shape, inverse=True)
+        pts = map_points(np.asarray(seam.path), orient, strip.shape, inverse=True)
         paths.append(pts + (rows.start, cols.start))
         crit += seam.criterion
         peak = max(peak, seam.peak)

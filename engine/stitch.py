@@ -52,6 +52,7 @@ __all__ = [
     "PatchResult",
     "StitchResult",
     "l_cut",
+    "map_points",
     "patch",
     "patch_cut",
     "stitch",
@@ -77,8 +78,10 @@ def from_canonical(a: np.ndarray, orientation: str) -> np.ndarray:
     return np.swapaxes(a, 0, 1)[::-1]
 
 
-def _map_points(pts: np.ndarray, orientation: str, shape, *, inverse: bool = False):
-    """(row, col) points of a map of ``shape`` to canonical coordinates (or back: ``inverse``)."""
+def map_points(pts: np.ndarray, orientation: str, shape, *, inverse: bool = False) -> np.ndarray:
+    """Map (N, 2) (row, col) points of an (h, w) = ``shape`` map in ``orientation`` to its
+    canonical view (:func:`to_canonical`), or canonical points back with ``inverse`` (``shape``
+    is the map's own shape both ways). Returns (N, 2) intp."""
     h, w = shape
     r, c = pts[:, 0], pts[:, 1]
     if orientation == "left":
@@ -229,13 +232,13 @@ def stitch(
             wp = np.asarray(waypoints, dtype=np.intp).reshape(-1, 2)
         except (TypeError, ValueError):
             raise ValueError(f"waypoints must be (row, col) pairs, got {waypoints!r}") from None
-        wps = [tuple(p) for p in _map_points(wp, orientation, err.shape).tolist()]
+        wps = [tuple(p) for p in map_points(wp, orientation, err.shape).tolist()]
     kw = _seam_kwargs(start, end, wps, cyclic, cancel)
     seam = find_seam(ce, method=method, **kw, **seam_options)
     alpha_c = blend_weights(seam, ce, mode=blend, width=width, rho=rho, cyclic=bool(cyclic))
     alpha = np.ascontiguousarray(from_canonical(alpha_c, orientation))
     mask = np.ascontiguousarray(from_canonical(np.asarray(seam.mask), orientation))
-    path = _map_points(np.asarray(seam.path), orientation, err.shape, inverse=True)
+    path = map_points(np.asarray(seam.path), orientation, err.shape, inverse=True)
     image = composite(alpha, a, b)
     _frozen(image, err, path, mask, alpha)
     return StitchResult(image, err, seam, path, mask, alpha, orientation)

@@ -1,10 +1,11 @@
-"""The compiled old side of an L-cut against the scipy.ndimage construction it replaces."""
+"""engine.stitch helpers: the compiled old side of an L-cut against the scipy.ndimage
+construction it replaces, and the public point mapper."""
 
 import numpy as np
 import pytest
 from scipy import ndimage
 
-from engine.stitch import _old_side_of_barrier, l_cut
+from engine.stitch import ORIENTATIONS, _old_side_of_barrier, l_cut, map_points, to_canonical
 
 
 def old_side_ndimage(barrier, seed_left, seed_top):
@@ -60,3 +61,14 @@ def test_dp_l_cut_mask_is_the_old_side_of_its_path():
         barrier[cut.path[:, 0], cut.path[:, 1]] = True
         assert len(cut.path) == barrier.sum()  # each pixel once
         np.testing.assert_array_equal(cut.mask, old_side_ndimage(barrier, True, True))
+
+
+@pytest.mark.parametrize("orientation", ORIENTATIONS)
+def test_map_points_follow_the_canonical_view(orientation):
+    a = np.arange(5 * 7).reshape(5, 7)
+    canon = to_canonical(a, orientation)
+    pts = np.argwhere(np.ones(a.shape, bool))
+    c = map_points(pts, orientation, a.shape)
+    np.testing.assert_array_equal(canon[c[:, 0], c[:, 1]], a[pts[:, 0], pts[:, 1]])
+    np.testing.assert_array_equal(map_points(c, orientation, a.shape, inverse=True), pts)
+    assert c.dtype == np.intp
