@@ -5,22 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-
-def _nonneg(text: str) -> int:
-    try:
-        v = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
-    if v < 0:
-        raise argparse.ArgumentTypeError(f"must be >= 0, got {v}")
-    return v
-
-
-def _positive(text: str) -> int:
-    v = _nonneg(text)
-    if v < 1:
-        raise argparse.ArgumentTypeError(f"must be >= 1, got {v}")
-    return v
+from engine.cli._args import int_at_least
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -38,18 +23,20 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--name", default=None, help="file-name prefix (default: the project's name)")
     p.add_argument(
         "--atlas-columns",
-        type=_positive,
+        type=int_at_least(1),
         default=None,
         metavar="N",
         help="tiles per atlas row (default: about square, preferring no blank cells)",
     )
     p.add_argument(
-        "--spacing", type=_nonneg, default=0, metavar="N", help="pixels between atlas cells"
+        "--spacing", type=int_at_least(0), default=0, metavar="N", help="pixels between atlas cells"
     )
-    p.add_argument("--margin", type=_nonneg, default=0, metavar="N", help="pixels around the atlas")
+    p.add_argument(
+        "--margin", type=int_at_least(0), default=0, metavar="N", help="pixels around the atlas"
+    )
     p.add_argument(
         "--extrude",
-        type=_nonneg,
+        type=int_at_least(0),
         default=0,
         metavar="N",
         help="pixels of edge bleed around every atlas tile",

@@ -13,19 +13,9 @@ import sys
 import time
 
 from engine.blend import BLEND_MODES
-from engine.cli.export import _positive
+from engine.cli._args import int_at_least, non_negative_float
 from engine.errormap import METRICS
 from engine.seams import METHODS
-
-
-def _nonneg_float(text: str) -> float:
-    try:
-        v = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
-    if not v >= 0:
-        raise argparse.ArgumentTypeError(f"must be >= 0, got {text}")
-    return v
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -41,7 +31,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--method", choices=METHODS, default="dp", help="seam method (default: dp)")
     p.add_argument(
         "--o-max",
-        type=_positive,
+        type=int_at_least(1),
         default=None,
         metavar="N",
         help="largest block of control points moved at once (oscillating only; default 3)",
@@ -50,7 +40,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--blend", choices=BLEND_MODES, default="none", help="blend of --save-composite")
     p.add_argument("--rho", type=int, default=3, help="rho of adaptive blending (default 3)")
     p.add_argument(
-        "--width", type=_nonneg_float, default=4, help="feather width in pixels (default 4)"
+        "--width", type=non_negative_float, default=4, help="feather width in pixels (default 4)"
     )
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--save-mask", metavar="FILE", help="write the mask (white = R1) as a PNG")

@@ -17,7 +17,13 @@ from pathlib import Path
 
 import numpy as np
 
-from engine.cli.tileset import _colour_range, _int_at_least, load_source
+from engine.cli._args import (
+    add_exclusion,
+    add_seam_options,
+    excluded_pixels,
+    int_at_least,
+    non_negative_float,
+)
 
 
 def parse_wxh(text: str) -> tuple[int, int]:
@@ -29,32 +35,6 @@ def parse_wxh(text: str) -> tuple[int, int]:
     if w < 1 or h < 1:
         raise argparse.ArgumentTypeError(f"width and height must be >= 1, got {text!r}")
     return h, w
-
-
-int_at_least = _int_at_least  # an integer argument type with a minimum
-
-
-def non_negative_float(text: str) -> float:
-    try:
-        v = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
-    if not v >= 0:
-        raise argparse.ArgumentTypeError(f"must be >= 0, got {text!r}")
-    return v
-
-
-def seam_option(text: str):
-    """``KEY=VALUE``; the value is read as an int, a float, or kept as text."""
-    key, sep, value = text.partition("=")
-    if not sep or not re.fullmatch(r"[a-z_]+", key):
-        raise argparse.ArgumentTypeError(f"expected KEY=VALUE like o_max=5, got {text!r}")
-    for cast in (int, float):
-        try:
-            return key, cast(value)
-        except ValueError:
-            pass
-    return key, value
 
 
 def add_cut_arguments(p: argparse.ArgumentParser, *, seam_default: str = "dp") -> None:
@@ -69,14 +49,7 @@ def add_cut_arguments(p: argparse.ArgumentParser, *, seam_default: str = "dp") -
         default=seam_default,
         help=f"boundary: straight overlap or a seam method (default {seam_default})",
     )
-    p.add_argument(
-        "--seam-option",
-        type=seam_option,
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
-        help="option of the seam method, e.g. o_max=5, max_run=3, variant=lm",
-    )
+    add_seam_options(p)
     p.add_argument(
         "--blend", choices=BLEND_MODES, default="none", help="softening of the cut (default none)"
     )
@@ -97,19 +70,7 @@ def add_cut_arguments(p: argparse.ArgumentParser, *, seam_default: str = "dp") -
         default=0.1,
         help="draw among windows within 1+T of the best (default 0.1)",
     )
-    p.add_argument(
-        "--exclude-color",
-        type=_colour_range,
-        default=None,
-        metavar="LO:HI",
-        help="never copy sample colours in [LO, HI] per channel, e.g. 0,0,0:0.2,0.2,0.3",
-    )
-    p.add_argument(
-        "--exclude-mask",
-        default=None,
-        metavar="FILE",
-        help="image whose non-black pixels mark sample pixels not to copy",
-    )
+    add_exclusion(p, "sample")
     p.add_argument("--seed", type=int_at_least(0), default=0, help="random seed (default 0)")
     p.add_argument(
         "--threads", type=int_at_least(1), default=None, help="worker threads (default: every core)"
@@ -216,23 +177,10 @@ def drive(gen, printer):
 
 def load_sample_and_exclusion(args):
     """(pixels, bit depth, excluded mask or None) from SAMPLE, --exclude-color/--exclude-mask."""
-    from engine.exclusion import exclusion_mask
     from engine.io import load_image
 
-    pixels, depth = load_source(args.sample)
-    excluded = None
-    if args.exclude_color is not None or args.exclude_mask:
-        painted = None
-        if args.exclude_mask:
-            m = load_image(args.exclude_mask).pixels
-            if m.shape[:2] != pixels.shape[:2]:
-                raise ValueError(
-                    f"{args.exclude_mask}: the mask is {m.shape[1]}x{m.shape[0]}, the sample "
-                    f"{pixels.shape[1]}x{pixels.shape[0]}"
-                )
-            painted = m.max(axis=2) > 0
-        excluded = exclusion_mask(pixels, color_range=args.exclude_color, painted=painted)
-    return pixels, depth, excluded
+    loaded = load_image(args.sample)
+    return loaded.pixels, loaded.bit_depth, excluded_pixels(args, loaded.pixels, "sample")
 
 
 def start(iter_fn, *args, **kwargs):

@@ -27,6 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
+from engine.cli._args import add_exclusion, add_seam_options, excluded_pixels, int_at_least
 from engine.cli.export import add_project_option, save_project_option
 
 FORMAT = "quilt-studio-tileset"
@@ -45,19 +46,6 @@ def _size(text: str):
     if h < 1 or (w is not None and w < 1):
         raise argparse.ArgumentTypeError(f"sizes must be >= 1, got {text!r}")
     return h if w is None else (h, w)
-
-
-def _int_at_least(minimum: int):
-    def parse(text: str) -> int:
-        try:
-            v = int(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
-        if v < minimum:
-            raise argparse.ArgumentTypeError(f"must be >= {minimum}, got {v}")
-        return v
-
-    return parse
 
 
 def _picks(text: str) -> list[int]:
@@ -92,22 +80,8 @@ def _named(kind: str):
     return parse
 
 
-def _colour_range(text: str):
-    """``LO:HI`` with LO/HI one number or comma-separated per-channel numbers in [0, 1]."""
-    try:
-        lo, hi = text.split(":")
-        lo_v = [float(v) for v in lo.split(",")]
-        hi_v = [float(v) for v in hi.split(",")]
-    except ValueError:
-        raise argparse.ArgumentTypeError(
-            f"expected LO:HI like 0,0,0:0.2,0.2,0.25 or 0:0.1, got {text!r}"
-        ) from None
-    return (lo_v[0] if len(lo_v) == 1 else lo_v, hi_v[0] if len(hi_v) == 1 else hi_v)
-
-
 def add_parser(subparsers) -> argparse.ArgumentParser:
     from engine.blend import BLEND_MODES
-    from engine.cli.synth import seam_option  # imported here: synth imports this module
     from engine.errormap import METRICS
     from engine.seams import METHODS
 
@@ -122,7 +96,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--out", required=True, metavar="DIR", help="output folder (created)")
     p.add_argument(
         "--candidates",
-        type=_int_at_least(1),
+        type=int_at_least(1),
         default=30,
         metavar="N",
         help="number of candidate tiles (default 30)",
@@ -149,14 +123,14 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--overlap",
-        type=_int_at_least(2),
+        type=int_at_least(2),
         default=None,
         metavar="N",
         help="w_T, width of the template's border regions (default: tile/10)",
     )
     p.add_argument(
         "--patch-overlap",
-        type=_int_at_least(2),
+        type=int_at_least(2),
         default=None,
         metavar="N",
         help="w_P, the ring the patch cut runs in (default: --overlap)",
@@ -170,27 +144,20 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--margin",
-        type=_int_at_least(0),
+        type=int_at_least(0),
         default=2,
         metavar="N",
         help="outer pixels every candidate keeps from the template (default 2)",
     )
     p.add_argument(
         "--neighbourhood",
-        type=_int_at_least(0),
+        type=int_at_least(0),
         default=5,
         metavar="N",
         help="refine each random patch position within +-N px (default 5)",
     )
     p.add_argument("--seam", choices=METHODS, default="dp", help="seam method (default dp)")
-    p.add_argument(
-        "--seam-option",
-        type=seam_option,
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
-        help="option of the seam method, e.g. o_max=5, max_run=3, variant=lm",
-    )
+    add_seam_options(p)
     p.add_argument("--metric", choices=METRICS, default="euclid", help="error metric")
     p.add_argument(
         "--blend",
@@ -198,9 +165,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         default=None,
         help="blending of every cut (default: none for the template, adaptive for the patches)",
     )
-    p.add_argument("--rho", type=_int_at_least(0), default=3, help="adaptive blending ρ")
-    p.add_argument("--width", type=_int_at_least(0), default=4, help="feather width in px")
-    p.add_argument("--seed", type=_int_at_least(0), default=0, help="random seed (default 0)")
+    p.add_argument("--rho", type=int_at_least(0), default=3, help="adaptive blending ρ")
+    p.add_argument("--width", type=int_at_least(0), default=4, help="feather width in px")
+    p.add_argument("--seed", type=int_at_least(0), default=0, help="random seed (default 0)")
     p.add_argument(
         "--pick",
         type=_picks,
@@ -220,7 +187,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         action="store_true",
         help="allow equal neighbouring tiles in the preview's index matrix",
     )
-    p.add_argument("--workers", type=_int_at_least(1), default=2, help="threads (default 2)")
+    p.add_argument("--workers", type=int_at_least(1), default=2, help="threads (default 2)")
     p.add_argument(
         "--map",
         type=_named("file"),
@@ -237,19 +204,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         metavar="NAME=W",
         help="seam error weight of a map ('main' = SOURCE)",
     )
-    p.add_argument(
-        "--exclude-mask",
-        default=None,
-        metavar="FILE",
-        help="image whose non-black pixels mark source pixels not to use",
-    )
-    p.add_argument(
-        "--exclude-color",
-        type=_colour_range,
-        default=None,
-        metavar="LO:HI",
-        help="exclude source colours in [LO, HI] per channel, e.g. 0,0,0:0.2,0.2,0.3",
-    )
+    add_exclusion(p, "source")
     add_project_option(p)
     p.set_defaults(func=run)
     return p
@@ -285,34 +240,6 @@ def _parse_rect(text: str):
     return tuple(v)
 
 
-def load_source(path):
-    """:func:`engine.io.load_image`, but exact for 16-bit colour PNGs.
-
-    Pillow reads 16-bit RGB(A) PNGs as 8-bit; those are decoded with the exact PNG codec of
-    :mod:`engine.export` instead so that 16-bit in gives 16-bit out. Returns (pixels, depth).
-    """
-    from engine.io import load_image
-
-    loaded = load_image(path)
-    try:
-        with open(path, "rb") as f:
-            head = f.read(33)
-    except OSError:
-        head = b""
-    if (
-        loaded.bit_depth == 8
-        and head.startswith(b"\x89PNG\r\n\x1a\n")
-        and head[12:16] == b"IHDR"
-        and head[24] == 16
-        and head[25] in (2, 6)
-    ):
-        from engine.export._png import decode_png
-
-        q = decode_png(Path(path).read_bytes())
-        return (q.astype(np.float32) / 65535.0), 16
-    return loaded.pixels, loaded.bit_depth
-
-
 def run(args) -> int:
     """Run the command; engine warnings become ``warning:`` lines on stderr (and the manifest)."""
     import warnings
@@ -330,7 +257,6 @@ def run(args) -> int:
 
 def _run(args) -> int:
     from engine.events import Progress
-    from engine.exclusion import exclusion_mask
     from engine.export import quantize
     from engine.export._png import encode_png
     from engine.io import load_image
@@ -344,7 +270,8 @@ def _run(args) -> int:
     )
 
     say = _Reporter()
-    S, depth = load_source(args.source)
+    loaded = load_image(args.source)
+    S, depth = loaded.pixels, loaded.bit_depth
     H, W = S.shape[:2]
     say(f"source {args.source}: {W}x{H}, {S.shape[2]} channel(s), {depth}-bit")
     maps = {}
@@ -353,18 +280,8 @@ def _run(args) -> int:
             raise ValueError(f"--map {name}: duplicate or reserved map name")
         maps[name] = load_image(path).pixels
     weights = dict(args.weight) or None
-    excluded = None
-    if args.exclude_mask or args.exclude_color is not None:
-        painted = None
-        if args.exclude_mask:
-            m = load_image(args.exclude_mask).pixels
-            if m.shape[:2] != (H, W):
-                raise ValueError(
-                    f"{args.exclude_mask}: the mask is {m.shape[1]}x{m.shape[0]}, the source "
-                    f"{W}x{H}"
-                )
-            painted = m[:, :, : max(1, m.shape[2] - (m.shape[2] in (2, 4)))].max(axis=2) > 0
-        excluded = exclusion_mask(S, color_range=args.exclude_color, painted=painted)
+    excluded = excluded_pixels(args, S, "source")
+    if excluded is not None:
         say(f"excluded: {int(excluded.sum())} of {H * W} source pixels")
 
     tmpl_blend = args.blend or "none"

@@ -10,14 +10,13 @@ from __future__ import annotations
 import argparse
 import sys
 
+from engine.cli._args import int_at_least, non_negative_float
 from engine.cli.synth import (
     ProgressPrinter,
     add_cut_arguments,
     cut_options,
     drive,
-    int_at_least,
     load_sample_and_exclusion,
-    non_negative_float,
     start,
 )
 
