@@ -143,9 +143,8 @@ class MainWindow(QMainWindow):
         if checkable:
             a.setCheckable(True)
             a.setChecked(checked)
-            a.toggled.connect(slot)
-        else:
-            a.triggered.connect(slot)
+        if slot is not None:  # None: the view that uses the action connects it
+            (a.toggled if checkable else a.triggered).connect(slot)
         self.addAction(a)
         return a
 
@@ -193,6 +192,14 @@ class MainWindow(QMainWindow):
             "Show each overlap's error map over the source",
             checkable=True,
             checked=settings.get("heat_overlay"),
+        )
+        self.act_preview_grid = A(
+            "Preview &grid overlay",
+            None,
+            "G",
+            "Draw the tile borders over the preview",
+            checkable=True,
+            checked=settings.get("preview_grid"),
         )
         self.act_find = A(
             "&Find best tile",
@@ -249,7 +256,7 @@ class MainWindow(QMainWindow):
     def _make_views(self) -> None:
         doc = self.doc
         self.source_view = SourceView(doc, self.pipeline)
-        self.preview_view = PreviewView(doc, self.act_reroll_layout)
+        self.preview_view = PreviewView(doc, self.act_reroll_layout, self.act_preview_grid)
         self.tabs = QTabWidget()
         self.tabs.setDocumentMode(True)
         self.tabs.addTab(self.source_view, "Source")
@@ -324,7 +331,7 @@ class MainWindow(QMainWindow):
         m = mb.addMenu("&View")
         m.addActions([self.act_fit, self.act_100, self.act_zoom_in, self.act_zoom_out])
         m.addSeparator()
-        m.addAction(self.act_heat)
+        m.addActions([self.act_heat, self.act_preview_grid])
         for dock in self.docks.values():
             m.addAction(dock.toggleViewAction())
         theme = m.addMenu("&Theme")

@@ -150,7 +150,9 @@ class ImageCanvas(QGraphicsView):
         self.setBackgroundBrush(QBrush(QColor(24, 24, 26)))
         self.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
         self._zoom = 1.0
-        self._fit_pending = True
+        self._fit_pending = True  # fit as soon as the view has its real size
+        self.fitted = False  # showing the whole image, not zoomed by the user: refit on resize
+        self._fit_size = None  # the view's size at the last fit
         self._press_pos = None
         self._apply_zoom_hints()
 
@@ -186,6 +188,7 @@ class ImageCanvas(QGraphicsView):
     def set_zoom(self, zoom: float, anchor: QPointF | None = None) -> None:
         """Scale to ``zoom`` keeping the scene point under view position ``anchor`` fixed."""
         zoom = float(min(max(zoom, ZOOM_STEPS[0]), ZOOM_STEPS[-1]))
+        self.fitted = self._fit_pending = False
         if anchor is None:
             anchor = QPointF(self.viewport().rect().center())
         scene_pt = self.mapToScene(anchor.toPoint())
@@ -232,12 +235,16 @@ class ImageCanvas(QGraphicsView):
         self.set_zoom(1.0)
 
     def fit(self) -> None:
-        """Zoom so the whole image is visible, centred."""
+        """Zoom so the whole image is visible, centred (and keep it so on resizes).
+
+        A hidden view (another tab) does not know its size yet: it fits when shown.
+        """
         r = self.image_rect()
         if r.isEmpty():
             return
         vp = self.viewport().rect()
-        if vp.width() < 10 or vp.height() < 10:
+        if not self.isVisible() or vp.width() < 10 or vp.height() < 10:
+            self._fit_pending = True
             return
         z = min((vp.width() - 8) / r.width(), (vp.height() - 8) / r.height())
         if z >= 1:
@@ -246,6 +253,8 @@ class ImageCanvas(QGraphicsView):
         self.setTransform(QTransform.fromScale(self._zoom, self._zoom))
         self.centerOn(r.center())
         self._fit_pending = False
+        self.fitted = True
+        self._fit_size = self.size()
         self._apply_zoom_hints()
         self.zoom_changed.emit(self._zoom)
 
@@ -262,6 +271,13 @@ class ImageCanvas(QGraphicsView):
 
     def resizeEvent(self, event) -> None:  # noqa: N802 - Qt API
         super().resizeEvent(event)
+        # the view's own size, not the viewport's: scroll bars coming and going must not
+        # make a fit -> resize -> fit loop
+        if self._fit_pending or (self.fitted and self.size() != self._fit_size):
+            self.fit()
+
+    def showEvent(self, event) -> None:  # noqa: N802 - Qt API
+        super().showEvent(event)
         if self._fit_pending:
             self.fit()
 

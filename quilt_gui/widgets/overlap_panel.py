@@ -141,6 +141,8 @@ class OverlapPanel(QWidget):
             "vertical": OverlapView(SEAM_COLORS["vertical"]),
         }
         self.labels = {k: QLabel() for k in self.views}
+        for label in self.labels.values():
+            label.setWordWrap(True)  # long texts must not widen the window
         lay = QVBoxLayout(self)
         lay.setContentsMargins(4, 4, 4, 4)
         split = QSplitter(Qt.Orientation.Vertical)
@@ -152,6 +154,7 @@ class OverlapPanel(QWidget):
             bl = QVBoxLayout(box)
             bl.setContentsMargins(0, 0, 0, 0)
             head = QLabel(f"<b>{title}</b>")
+            head.setWordWrap(True)
             bl.addWidget(head)
             bl.addWidget(self.views[which], 1)
             bl.addWidget(self.labels[which])

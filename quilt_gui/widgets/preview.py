@@ -22,7 +22,7 @@ from quilt_gui.widgets.canvas import ImageCanvas, cosmetic_pen
 class PreviewView(QWidget):
     """Canvas of ``doc.preview`` with an optional tile grid and the grid score."""
 
-    def __init__(self, doc: Document, reroll_action=None, parent=None) -> None:
+    def __init__(self, doc: Document, reroll_action=None, grid_action=None, parent=None) -> None:
         super().__init__(parent)
         self.doc = doc
         self.canvas = ImageCanvas()
@@ -40,7 +40,12 @@ class PreviewView(QWidget):
         self.grid_box.setChecked(self.grid)
         self.grid_box.toggled.connect(self.set_grid)
         bar.addWidget(self.grid_box)
+        self.grid_action = grid_action  # the window's toggle (shortcut G), kept in step
+        if grid_action is not None:
+            grid_action.setChecked(self.grid)
+            grid_action.toggled.connect(self.set_grid)
         self.info = QLabel()
+        self.info.setWordWrap(True)  # long texts must not widen the window
         self.info.setToolTip(
             "Grid score: autocorrelation at one tile period minus the source's "
             "own (0 = no visible grid; one tile repeated scores about 1)."
@@ -59,6 +64,8 @@ class PreviewView(QWidget):
         self.grid = bool(on)
         settings.set("preview_grid", self.grid)
         self.grid_box.setChecked(self.grid)
+        if self.grid_action is not None:
+            self.grid_action.setChecked(self.grid)
         self._draw_grid()
 
     @Slot()

@@ -94,6 +94,7 @@ class TiledImageView(QWidget):
         bar.addWidget(self.grid_box)
         bar.addStretch(1)
         self.info = QLabel()
+        self.info.setWordWrap(True)  # long texts must not widen the window
         lay = QVBoxLayout(self)
         lay.setContentsMargins(2, 2, 2, 2)
         lay.addLayout(bar)

@@ -64,6 +64,33 @@ def test_wheel_zoom_keeps_the_pixel_under_the_cursor(qtbot):
     assert c.viewport().rect().contains(r)
 
 
+def test_a_view_fitted_while_hidden_fits_when_shown_and_on_resize(qtbot):
+    from PySide6.QtWidgets import QTabWidget
+
+    tabs = QTabWidget()
+    qtbot.addWidget(tabs)
+    first, hidden = ImageCanvas(), ImageCanvas()
+    tabs.addTab(first, "a")
+    tabs.addTab(hidden, "b")
+    tabs.resize(500, 400)
+    tabs.show()
+    qtbot.waitExposed(tabs)
+    hidden.set_image(np.zeros((300, 200, 3), np.float32), fit=True)
+    tabs.setCurrentWidget(hidden)
+
+    def whole_image_visible() -> bool:
+        r = hidden.mapFromScene(hidden.image_rect()).boundingRect()
+        return hidden.viewport().rect().contains(r)
+
+    qtbot.waitUntil(whole_image_visible, timeout=2000)
+    tabs.resize(500, 250)  # smaller: still fitted
+    qtbot.waitUntil(whole_image_visible, timeout=2000)
+    hidden.set_zoom(2.0)  # the user's zoom sticks
+    tabs.resize(520, 300)
+    qtbot.wait(50)
+    assert hidden.zoom == 2.0
+
+
 def test_zoom_shortcuts_and_pixel_readout(qtbot, win):
     win.source_view.setFocus()
     win.act_100.trigger()
@@ -396,3 +423,25 @@ def test_light_theme_on_request(qtbot, win):
     assert QApplication.palette().window().color().lightness() < 128
     assert text_lightness() > 128
     assert settings.get("theme") == "dark"
+
+
+def test_preview_grid_toggles_with_g_and_stays_in_step(qtbot, win):
+    assert win.act_preview_grid.shortcut().toString() == "G"
+    box = win.preview_view.grid_box
+    assert not box.isChecked()
+    win.act_preview_grid.trigger()  # what the G key does
+    assert box.isChecked() and win.preview_view.grid and settings.get("preview_grid")
+    box.setChecked(False)
+    assert not win.act_preview_grid.isChecked()
+
+
+def test_window_fits_a_1280_px_screen_whatever_the_labels_say(qtbot, win):
+    from tests.gui.helpers import generate
+
+    generate(qtbot, win, 4)
+    win.doc.set_picks([0, 1, 2])
+    wait_idle(qtbot, win)
+    win.show_help()  # the longest banner
+    for tab in (win.source_view, win.preview_view, win.quilt_view):
+        win.tabs.setCurrentWidget(tab)
+        assert win.minimumSizeHint().width() <= 1100, tab
