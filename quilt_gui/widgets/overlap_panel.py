@@ -22,7 +22,12 @@ from quilt_gui.document import Document
 from quilt_gui.imaging import heat_rgba, to_uint8
 from quilt_gui.pipeline import Pipeline
 from quilt_gui.widgets.canvas import ImageCanvas, PixelSetItem
-from quilt_gui.widgets.source_view import SEAM_COLORS, WaypointItem, nearest_waypoint
+from quilt_gui.widgets.source_view import (
+    SEAM_COLORS,
+    WaypointItem,
+    nearest_waypoint,
+    region_rects,
+)
 
 GAP = 3  # pixels between the three panels
 
@@ -171,6 +176,7 @@ class OverlapPanel(QWidget):
         row.addStretch(1)
         row.addWidget(self.clear_button)
         lay.addLayout(row)
+        self.frames: dict[str, tuple | None] = {k: None for k in self.views}  # (rect, w_T) shown
         doc.seamless_changed.connect(self._on_seamless_changed)
         doc.waypoints_changed.connect(self._on_waypoints_changed)
         pipeline.seam_updated.connect(self._on_seam_updated)
@@ -198,8 +204,10 @@ class OverlapPanel(QWidget):
         if s is None:
             for which, v in self.views.items():
                 v.clear()
+                self.frames[which] = None
                 self.labels[which].setText("No tile yet: draw a rectangle or Find best tile.")
             return
+        self.frames = {k: (tuple(s.rect), int(s.overlap)) for k in self.views}
         reg = s.regions
         self.views["horizontal"].show_overlap(
             reg["R_R"], reg["R_L"], s.errors["horizontal"], stacked=False
@@ -215,16 +223,46 @@ class OverlapPanel(QWidget):
             )
         self._on_waypoints_changed()
 
+    def current_frame(self) -> tuple | None:
+        """(rect, w_T) of the document's tile rectangle: what live seams belong to."""
+        rect = self.doc.template_rect
+        return None if rect is None else (tuple(rect), int(self.doc.params["overlap"]))
+
+    def _show_live_frame(self, which: str, frame) -> bool:
+        """Show the overlap of ``frame`` before its result exists; False if it cannot be.
+
+        The left/right overlap comes straight from the source (its error map is quick to
+        compute); the top/bottom one is cut from the left/right stitch, so it waits.
+        """
+        from engine.errormap import error_map
+
+        view, label = self.views[which], self.labels[which]
+        self.frames[which] = frame
+        if which == "vertical" or self.doc.source is None:
+            view.clear()
+            label.setText("searching... (this overlap is taken after the left/right stitch)")
+            return False
+        (rect, overlap), src = frame, self.doc.source.main
+        crops = {}
+        for key in ("R_L", "R_R"):
+            x, y, w, h = region_rects(rect, overlap)[key]
+            crops[key] = src[y : y + h, x : x + w]
+        error = error_map(crops["R_R"], crops["R_L"], metric=self.doc.params["metric"])
+        view.show_overlap(crops["R_R"], crops["R_L"], error, stacked=False)
+        view.set_waypoints(self.doc.waypoints[which])
+        return True
+
     @Slot(object)
     def _on_seam_updated(self, update) -> None:
+        """A live seam of the running job: drawn on its own rectangle's overlap only."""
         v = self.views.get(update.which)
-        if v is None or v.frame_shape is None:
+        frame = self.current_frame()
+        if v is None or frame is None:
             return
-        path = np.asarray(update.path)
-        h, w = v.frame_shape
-        if path.size and (path[:, 0].max() >= h or path[:, 1].max() >= w):
-            return  # a different rectangle: wait for its result
-        v.set_path(path)
+        stale = self.frames[update.which] != frame or v.frame_shape is None
+        if stale and not self._show_live_frame(update.which, frame):
+            return
+        v.set_path(np.asarray(update.path))
         self.labels[update.which].setText(
             f"searching... criterion {update.seam.criterion:.3f}   peak {update.seam.peak:.3f}"
         )

@@ -12,6 +12,7 @@ from PySide6.QtGui import QDropEvent, QWheelEvent
 from PySide6.QtWidgets import QPushButton
 
 from quilt_gui import settings
+from quilt_gui.imaging import to_uint8
 from quilt_gui.widgets.canvas import ImageCanvas
 from quilt_gui.widgets.gallery import CandidateModel
 from tests.gui.helpers import make_window, open_sample, template, wait_idle
@@ -178,6 +179,34 @@ def test_waypoint_click_in_overlap_panel_steers_the_seam(qtbot, win):
     assert (y + row, x + col) in src  # drawn on the source too, at the same pixel
     qtbot.mouseClick(view.viewport(), Qt.MouseButton.RightButton, pos=pos)
     assert win.doc.waypoints["horizontal"] == []
+
+
+def test_live_seam_of_a_new_rectangle_is_drawn_on_its_own_overlap(qtbot, win):
+    from types import SimpleNamespace
+
+    template(qtbot, win, (150, 120, 128, 112))
+    panel, ov = win.overlap_panel, win.doc.params["overlap"]
+    new = (60, 40, 100, 90)  # smaller: the old frame would hold its path
+    win.doc.apply_template_rect(new)  # the seamless job starts; its updates are faked here
+
+    def update(which, path):
+        seam = SimpleNamespace(criterion=1.0, peak=0.5)
+        return SimpleNamespace(which=which, path=np.asarray(path), seam=seam)
+
+    panel._on_seam_updated(update("horizontal", [(r, 3) for r in range(90 + ov)]))
+    view = panel.views["horizontal"]
+    assert view.frame_shape == (90 + ov, ov) and panel.frames["horizontal"] == (new, ov)
+    x, y = new[:2]
+    np.testing.assert_array_equal(
+        view.array[:, :ov, :3],
+        to_uint8(win.doc.source.main[y : y + 90 + ov, x + 100 : x + 100 + ov])[..., :3],
+    )
+    assert view.paths[0].isVisible()
+    panel._on_seam_updated(update("vertical", [(3, c) for c in range(100)]))
+    assert panel.views["vertical"].frame_shape is None  # waits for the left/right stitch
+    assert "searching" in panel.labels["vertical"].text()
+    wait_idle(qtbot, win)
+    assert panel.views["vertical"].frame_shape == (ov, 100)
 
 
 def test_changing_a_parameter_supersedes_and_no_stale_result_is_drawn(qtbot, win):
