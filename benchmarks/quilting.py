@@ -13,10 +13,12 @@ of repeats (the load average is printed: on a shared machine rerun when it is ne
 Samples under 200×200 (job A) run on one thread whatever ``threads`` says
 (:data:`engine.quilting.POOL_MIN_SAMPLE_AREA`). Each output's border ratio along the block grid
 (max over the offsets the cuts run in, :func:`engine.quilting.grid_border_ratio`) is shown
-beside it. Then: the streaming overhead (``quilt`` draining every event vs the same run creating
-none), and the quality figures: grid
-border ratio of best+dp vs best+straight vs random on every bundled sample, and the mean seam
-peak of Long & Mould's minimax at half-block overlap vs dp at the same overlap.
+beside it, and the CPU time OpenBLAS's helper threads spent during the runs (0 when every
+product stays on the calling thread, as it should on a small shared machine). Then: the
+streaming overhead (``quilt`` draining every event vs the same run creating none), and the
+quality figures: grid border ratio of best+dp vs best+straight vs random on every bundled
+sample, and the mean seam peak of Long & Mould's minimax at half-block overlap vs dp at the
+same overlap.
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+import threading
 from pathlib import Path
 
 import numpy as np
@@ -97,8 +100,36 @@ def load_sample(name: str, crop: int) -> np.ndarray:
     return np.ascontiguousarray(px[:crop, :crop, :3])
 
 
+def _threads() -> set[str]:
+    try:
+        return set(os.listdir("/proc/self/task")) - {str(threading.get_native_id())}
+    except OSError:  # no /proc
+        return set()
+
+
+BLAS_THREADS = _threads()
+"""Threads alive once numpy and scipy are imported: OpenBLAS's helper threads (numpy's and
+scipy's libraries each start theirs; FFT worker pools start later, on first use)."""
+
+
+def blas_cpu_seconds() -> float | None:
+    """CPU seconds used so far by :data:`BLAS_THREADS` (None without /proc)."""
+    if not BLAS_THREADS:
+        return None
+    total = 0
+    for tid in BLAS_THREADS:
+        try:
+            with open(f"/proc/self/task/{tid}/stat") as f:
+                fields = f.read().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        total += int(fields[11]) + int(fields[12])  # utime + stime, in clock ticks
+    return total / os.sysconf("SC_CLK_TCK")
+
+
 def speed(args) -> None:
     print(f"## Speed (sample {args.sample}; load average {os.getloadavg()[0]:.2f})\n")
+    blas_before = blas_cpu_seconds()
     rows = []
     for job in args.jobs:
         j = JOBS[job]
@@ -161,6 +192,11 @@ def speed(args) -> None:
             rows,
         )
     )
+    if blas_before is not None:
+        print(
+            "\nCPU time of OpenBLAS's helper threads during these runs: "
+            f"{blas_cpu_seconds() - blas_before:.2f} s (the engine's products stay on one thread)"
+        )
     print()
 
 
