@@ -33,7 +33,8 @@ class CandidateEntry:
 
     ``maps`` holds the tile per material map (main map first); ``patch_rect`` is the
     patch source in source pixels (x, y, w, h) and ``patch_origin`` its (row, col);
-    ``loop`` the closed seam pixels (row, col) in tile coordinates.
+    ``target_rect`` where that window lies in the tile (x, y, w, h); ``loop`` the closed
+    seam pixels (row, col) in tile coordinates.
     """
 
     maps: dict[str, np.ndarray]
@@ -45,6 +46,7 @@ class CandidateEntry:
     locked: bool = False
     weight: float = 1.0
     loop: np.ndarray | None = None
+    target_rect: tuple[int, int, int, int] | None = None
 
     @property
     def tile(self) -> np.ndarray:
@@ -469,6 +471,8 @@ class Document(QObject):
                     "weight": e.weight,
                     "scores": dict(e.scores),
                     "patch_rect": list(e.patch_rect) if e.patch_rect else None,
+                    "target_rect": list(e.target_rect) if e.target_rect else None,
+                    "loop": None if e.loop is None else np.asarray(e.loop).tolist(),
                 },
             )
             for e in self.candidates
@@ -516,12 +520,13 @@ class Document(QObject):
         }
         entries = []
         for c in project.candidates:
-            pr = c.params.get("patch_rect")
             entries.append(
                 CandidateEntry(
                     maps=dict(c.maps),
                     patch_origin=c.patch_origin,
-                    patch_rect=tuple(pr) if isinstance(pr, list) and len(pr) == 4 else None,
+                    patch_rect=_rect(c.params.get("patch_rect")),
+                    target_rect=_rect(c.params.get("target_rect")),
+                    loop=_points(c.params.get("loop")),
                     seed=c.seed,
                     score=c.score,
                     scores=dict(c.params.get("scores") or {}),
@@ -544,6 +549,22 @@ class Document(QObject):
         self.preview_changed.emit()
         self.path_changed.emit()
         self.mark_saved()
+
+
+def _rect(value) -> tuple[int, int, int, int] | None:
+    """An (x, y, w, h) rectangle read from a project's JSON, None if it is not one."""
+    if isinstance(value, list) and len(value) == 4 and all(isinstance(v, int) for v in value):
+        return tuple(value)
+    return None
+
+
+def _points(value) -> np.ndarray | None:
+    """(N, 2) int (row, col) points read from a project's JSON, None if they are not."""
+    try:
+        a = np.asarray(value, dtype=np.int64)
+    except (TypeError, ValueError):
+        return None
+    return a if a.ndim == 2 and a.shape[1] == 2 and len(a) else None
 
 
 def _tile_maps(seamless, names: list[str]) -> dict[str, np.ndarray] | None:

@@ -301,6 +301,7 @@ class Pipeline(QObject):
             maps=maps,
             patch_origin=tuple(int(v) for v in c.patch_origin),
             patch_rect=tuple(int(v) for v in c.patch_rect),
+            target_rect=tuple(int(v) for v in c.target_rect),
             seed=c.seed,
             score=float(c.scores["criterion"]) / loop_len,
             scores=dict(c.scores),

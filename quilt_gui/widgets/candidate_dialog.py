@@ -1,16 +1,47 @@
-"""One candidate opened large: the tile (wrapped), its closed seam, scores, pick/lock/re-roll."""
+"""One candidate opened large: the tile (wrapped) with its closed seam, the patch source
+with the same seam, the scores, and pick / lock / re-roll."""
 
 from __future__ import annotations
 
 import numpy as np
 from PySide6.QtCore import Qt, Signal, Slot
-from PySide6.QtWidgets import QDialog, QHBoxLayout, QLabel, QPushButton, QVBoxLayout
+from PySide6.QtWidgets import (
+    QDialog,
+    QHBoxLayout,
+    QLabel,
+    QPushButton,
+    QSplitter,
+    QVBoxLayout,
+    QWidget,
+)
 
-from quilt_gui.document import Document
-from quilt_gui.widgets.canvas import PixelSetItem
+from quilt_gui.document import CandidateEntry, Document
+from quilt_gui.widgets.canvas import ImageCanvas, PixelSetItem
 from quilt_gui.widgets.tile_view import TiledImageView
 
 LOOP_COLOR = "#ff8c3f"
+
+#: The engine's candidate scores as the dialog names them (fractions shown as percentages).
+SCORE_LABELS = {
+    "criterion": ("Seam criterion (sum of the error along the seam)", False),
+    "peak": ("Seam peak (largest error on the seam)", False),
+    "band_error": ("Mean error in the ring where the seam may run", False),
+    "changed": ("Pixels that differ from the template", True),
+    "coverage": ("Share of the tile inside the seam (patch pixels)", True),
+}
+
+
+def score_lines(entry: CandidateEntry) -> list[str]:
+    """The candidate's figures, one line each, in words."""
+    lines = []
+    if entry.score is not None:
+        lines.append(f"Mean error along the closed seam: <b>{entry.score:.4f}</b>")
+    for key, value in entry.scores.items():
+        if not isinstance(value, float):
+            continue
+        label, percent = SCORE_LABELS.get(key, (key, False))
+        lines.append(f"{label}: {value:.0%}" if percent else f"{label}: {value:.4g}")
+    return lines
 
 
 class CandidateDialog(QDialog):
@@ -27,11 +58,34 @@ class CandidateDialog(QDialog):
         self.view = TiledImageView()
         self.loop_item = PixelSetItem(LOOP_COLOR)
         self.view.canvas.add_item(self.loop_item)
+        self.view.canvas.setToolTip("The candidate tile; orange: its closed seam")
+        self.patch_view = ImageCanvas()
+        self.patch_view.hide_scrollbars()
+        self.patch_view.setToolTip(
+            "Where the patch comes from in the source, with the same seam: inside it the "
+            "tile shows these pixels"
+        )
+        self.patch_loop = PixelSetItem(LOOP_COLOR)
+        self.patch_view.add_item(self.patch_loop)
+        patch_box = QWidget()
+        pl = QVBoxLayout(patch_box)
+        pl.setContentsMargins(2, 2, 2, 2)
+        self.patch_label = QLabel()
+        self.patch_label.setWordWrap(True)
+        pl.addWidget(QLabel("<b>Patch source</b>"))
+        pl.addWidget(self.patch_view, 1)
+        pl.addWidget(self.patch_label)
+        split = QSplitter(Qt.Orientation.Horizontal)
+        split.addWidget(self.view)
+        split.addWidget(patch_box)
+        split.setSizes([560, 300])
         self.info = QLabel()
         self.info.setWordWrap(True)
         self.pick_button = QPushButton()
+        self.pick_button.setToolTip("Keep this tile in the set (Space in the gallery)")
         self.pick_button.clicked.connect(self._toggle_pick)
         self.lock_button = QPushButton()
+        self.lock_button.setToolTip("A locked tile survives Generate and cannot be re-rolled (L)")
         self.lock_button.clicked.connect(self._toggle_lock)
         self.reroll_button = QPushButton("Re-roll")
         self.reroll_button.setToolTip("A new random patch for this candidate (R)")
@@ -44,43 +98,60 @@ class CandidateDialog(QDialog):
         row.addStretch(1)
         row.addWidget(close)
         lay = QVBoxLayout(self)
-        lay.addWidget(self.view, 1)
+        lay.addWidget(split, 1)
         lay.addWidget(self.info)
         lay.addLayout(row)
-        self.resize(620, 680)
-        self.view.repeat_buttons.idClicked.connect(self._place_loop)
+        self.resize(900, 640)
+        self.view.repeats_changed.connect(self._place_loop)
         doc.candidate_changed.connect(self._on_changed)
         doc.candidates_reset.connect(self._on_reset)
         doc.picks_changed.connect(self._refresh_buttons)
         self.set_index(index)
 
+    def entry(self) -> CandidateEntry | None:
+        cands = self.doc.candidates
+        return cands[self.index] if 0 <= self.index < len(cands) else None
+
     def set_index(self, index: int) -> None:
         self.index = index
-        if not 0 <= index < len(self.doc.candidates):
+        e = self.entry()
+        if e is None:
             self.close()
             return
-        e = self.doc.candidates[index]
         self.setWindowTitle(f"Candidate #{index + 1}")
         self.view.set_tile(np.asarray(e.tile))
         self._place_loop()
-        lines = []
-        if e.score is not None:
-            lines.append(f"Mean error along the closed seam: <b>{e.score:.4f}</b>")
-        lines += [f"{k}: {v:.4g}" for k, v in e.scores.items() if isinstance(v, float)]
-        if e.patch_rect is not None:
-            x, y, w, h = e.patch_rect
-            lines.append(
-                f"Patch source: {w}×{h} at ({x}, {y}) — the orange rectangle on the "
-                "source; drag it to rebuild this candidate from another place."
-            )
+        self._show_patch(e)
+        lines = score_lines(e)
         if e.seed is not None:
             lines.append(f"Seed {e.seed}")
         self.info.setText("<br>".join(lines))
         self._refresh_buttons()
 
+    def _show_patch(self, e: CandidateEntry) -> None:
+        """The patch's source window, with the seam mapped from tile to source pixels."""
+        src = self.doc.source
+        if e.patch_rect is None or src is None:
+            self.patch_view.set_image(None)
+            self.patch_loop.hide()
+            self.patch_label.setText("No patch source recorded.")
+            return
+        x, y, w, h = e.patch_rect
+        self.patch_view.set_image(src.main[y : y + h, x : x + w], fit=True)
+        if e.loop is not None and e.target_rect is not None:
+            tx, ty = e.target_rect[:2]
+            self.patch_loop.set_points(np.asarray(e.loop) - (ty, tx))
+            self.patch_loop.show()
+        else:
+            self.patch_loop.hide()
+        self.patch_label.setText(
+            f"{w}×{h} at ({x}, {y}): the orange rectangle on the source; drag it there to "
+            "rebuild this candidate from another place."
+        )
+
     @Slot()
     def _place_loop(self, *_args) -> None:
-        e = self.doc.candidates[self.index] if 0 <= self.index < len(self.doc.candidates) else None
+        e = self.entry()
         if e is None or e.loop is None or self.view.tile is None:
             self.loop_item.hide()
             return
@@ -91,9 +162,9 @@ class CandidateDialog(QDialog):
 
     @Slot()
     def _refresh_buttons(self) -> None:
-        if not 0 <= self.index < len(self.doc.candidates):
+        e = self.entry()
+        if e is None:
             return
-        e = self.doc.candidates[self.index]
         self.pick_button.setText("Unpick" if self.index in self.doc.picks else "Pick")
         self.lock_button.setText("Unlock" if e.locked else "Lock")
         self.reroll_button.setEnabled(not e.locked)

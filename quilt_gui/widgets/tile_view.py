@@ -6,7 +6,7 @@ import threading
 import weakref
 
 import numpy as np
-from PySide6.QtCore import QLineF, Qt, Slot
+from PySide6.QtCore import QLineF, Qt, Signal, Slot
 from PySide6.QtGui import QColor
 from PySide6.QtWidgets import (
     QButtonGroup,
@@ -65,6 +65,8 @@ def tile_metrics(tile: np.ndarray, source: np.ndarray, *, cancel=None) -> dict:
 class TiledImageView(QWidget):
     """An image repeated n x n with optional grid lines (shared by the tile and candidates)."""
 
+    repeats_changed = Signal(int)
+
     def __init__(self, parent=None) -> None:
         super().__init__(parent)
         self.canvas = ImageCanvas()
@@ -107,6 +109,7 @@ class TiledImageView(QWidget):
         self.repeat_buttons.button(self.repeats).setChecked(True)
         settings.set("tile_repeats", self.repeats)
         self._redraw(fit=True)
+        self.repeats_changed.emit(self.repeats)
 
     @Slot(bool)
     def set_grid(self, on: bool) -> None:

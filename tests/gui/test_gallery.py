@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 from PySide6.QtCore import QEvent, QPointF, Qt
 from PySide6.QtGui import QMouseEvent
 
@@ -70,3 +71,35 @@ def test_candidates_are_numbered_by_their_seed_and_a_stop_says_so(qtbot):
     assert n < 400
     assert w.last_message().startswith(f"Generation stopped: {n} of 400 new candidates made")
     assert w.doc.undo_stack.undoText() == "Generate candidates"
+
+
+def test_candidate_dialog_shows_seam_on_tile_and_patch_source_and_keeps_it_in_projects(
+    qtbot, tmp_path
+):
+    w = make_window(qtbot)
+    open_sample(qtbot, w)
+    generate(qtbot, w, 3)
+    e = w.doc.candidates[1]
+    dlg = w.open_candidate(1)
+    h, w_ = e.tile.shape[:2]
+    dlg.view.repeat_buttons.button(1).click()  # 1x1: the seam sits on the only tile
+    assert dlg.loop_item.sceneBoundingRect().right() <= w_ + 1
+    dlg.view.repeat_buttons.button(3).click()
+    assert dlg.loop_item.sceneBoundingRect().left() >= w_ - 1
+    x, y, pw, ph = e.patch_rect
+    np.testing.assert_array_equal(dlg.patch_view.array, w.doc.source.main[y : y + ph, x : x + pw])
+    tx, ty = e.target_rect[:2]
+    inside = dlg.patch_loop.points
+    assert inside.min() >= 0 and (inside[:, 0] < ph).all() and (inside[:, 1] < pw).all()
+    np.testing.assert_array_equal(inside, e.loop - (ty, tx))
+    assert "Pixels that differ from the template" in dlg.info.text()
+    dlg.close()
+    path = str(tmp_path / "p.quiltproj")
+    assert w.save_to(path, wait=True)
+    with qtbot.waitSignal(w.doc.path_changed, timeout=10_000):
+        w.open_path(path, confirm=False)
+    wait_idle(qtbot, w)
+    back = w.doc.candidates[1]
+    np.testing.assert_array_equal(back.loop, e.loop)
+    assert back.target_rect == e.target_rect
+    assert w.open_candidate(1).loop_item.isVisible()
