@@ -385,6 +385,7 @@ class MainWindow(QMainWindow):
         self.gallery.current_changed.connect(self._on_gallery_current)
         self.source_view.patch_moved.connect(self._on_patch_moved)
         self.tabs.currentChanged.connect(self._on_tab_changed)
+        self.quilt_view.selection_changed.connect(self._show_criteria)
         for canvas in self.canvases():
             canvas.hovered.connect(partial(self._on_hover, canvas))
         self.source_view.set_heat_visible(self.act_heat.isChecked())
@@ -801,6 +802,7 @@ class MainWindow(QMainWindow):
         self.params_panel.show_groups(QUILT_GROUPS if quilting else TILESET_GROUPS)
         for key in ("overlaps", "tile", "gallery"):
             self.docks[key].setVisible(not quilting)
+        self._show_criteria()
 
     # ------------------------------------------------------------------ view actions
     def current_canvas(self) -> ImageCanvas:
@@ -866,7 +868,16 @@ class MainWindow(QMainWindow):
         self._show_criteria()
         self._update_actions()
 
+    @Slot()
     def _show_criteria(self) -> None:
+        """The seam criterion of what is in front: the template's seams, or the inspected
+        quilting block's cut in the Quilting tab."""
+        if self.tabs.currentWidget() is self.quilt_view:
+            rec = self.quilt_view.selected_block()
+            has_cut = rec is not None and len(rec.path)
+            text = f"block #{rec.index + 1} seam {rec.criterion:.3f}" if has_cut else ""
+            self.criterion_label.setText(text)
+            return
         parts = [f"{k[0].upper()} {v:.3f}" for k, v in sorted(self._criteria.items())]
         self.criterion_label.setText("seam " + " · ".join(parts) if parts else "")
 

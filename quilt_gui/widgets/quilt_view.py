@@ -9,7 +9,7 @@ block's sample window, its placed pixels and its overlap error map, with the sea
 from __future__ import annotations
 
 import numpy as np
-from PySide6.QtCore import QEvent, QRectF, Qt, QTimer, Slot
+from PySide6.QtCore import QEvent, QRectF, Qt, QTimer, Signal, Slot
 from PySide6.QtGui import QColor, QImage, QPainter
 from PySide6.QtWidgets import (
     QGraphicsItem,
@@ -67,6 +67,8 @@ def wrapped_pieces(start: int, size: int, total: int) -> list[tuple[int, int]]:
 
 class QuiltView(QWidget):
     """Sample | output, and the block inspector."""
+
+    selection_changed = Signal()  # the inspected block changed (``selected``)
 
     def __init__(self, doc: Document, actions=(), parent=None) -> None:
         super().__init__(parent)
@@ -333,6 +335,7 @@ class QuiltView(QWidget):
             self.selected = None
             self.inspector.clear()
             self.source_rect.hide()
+            self.selection_changed.emit()
             return
         rec = self.doc.quilt_blocks[index]
         out = self.doc.quilt_output
@@ -366,3 +369,9 @@ class QuiltView(QWidget):
             f"{', right ' + str(rt) if rt else ''} · {seam}{match} · chosen among "
             f"{rec.candidates} windows"
         )
+        self.selection_changed.emit()
+
+    def selected_block(self):
+        """The engine record of the inspected block, or None."""
+        i = self.selected
+        return None if i is None or i >= len(self.doc.quilt_blocks) else self.doc.quilt_blocks[i]

@@ -39,6 +39,12 @@ def test_blocks_stream_in_and_a_click_inspects_one(qtbot):
     assert w.quilt_view.inspector.frame_shape == tuple(sel.size)
     assert f"Block #{sel.index + 1}" in w.quilt_view.info.text()
     assert w.quilt_view.source_rect.rect().getRect() == tuple(float(v) for v in sel.source)
+    # the status bar's seam criterion is the inspected block's here, the template's elsewhere
+    cut = next(b for b in res.blocks if len(b.path))
+    w.quilt_view.select(cut.index)
+    assert w.criterion_label.text() == f"block #{cut.index + 1} seam {cut.criterion:.3f}"
+    w.tabs.setCurrentWidget(w.source_view)
+    assert "block" not in w.criterion_label.text()
 
 
 def test_parameter_change_restarts_quilting_without_stale_blocks(qtbot):
