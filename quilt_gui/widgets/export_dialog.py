@@ -3,6 +3,7 @@ background. Non-modal; errors are shown in the dialog and as a message, never a 
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 from PySide6.QtCore import Signal, Slot
@@ -36,6 +37,33 @@ def _spin(lo: int, hi: int, value: int, tip: str, special: str | None = None) ->
     if special:
         s.setSpecialValueText(special)
     return s
+
+
+def folder_problem(folder: str, *, overwrite: bool) -> str | None:
+    """Why the bundle cannot go into ``folder`` (in the dialog's words), or None.
+
+    Checked before the export starts, so the user reads about the Overwrite box rather
+    than the engine's keyword, and about a file in the way rather than "File exists".
+    """
+    path = Path(folder).expanduser()
+    if path.exists() and not path.is_dir():
+        return f"{path} is a file, not a folder: choose a folder to export into."
+    if path.is_dir():
+        if not overwrite and any(path.iterdir()):
+            return (
+                f"The folder {path} is not empty: tick “Overwrite an existing bundle” or "
+                "choose another folder."
+            )
+        parent = path
+    else:
+        parent = path.parent
+        while not parent.exists() and parent != parent.parent:
+            parent = parent.parent
+        if not parent.is_dir():
+            return f"{path} cannot be created: {parent} is a file, not a folder."
+    if not os.access(parent, os.W_OK | os.X_OK):
+        return f"{parent} is not writable: choose another folder."
+    return None
 
 
 class ExportDialog(QDialog):
@@ -168,8 +196,13 @@ class ExportDialog(QDialog):
     def export(self) -> jobs.Job | None:
         """Start the export in the background."""
         folder = self.folder.text().strip()
-        if not folder:
-            self._fail("Choose a folder to export into.")
+        problem = (
+            folder_problem(folder, overwrite=self.overwrite.isChecked())
+            if folder
+            else "Choose a folder to export into."
+        )
+        if problem:
+            self._fail(problem)
             return None
         try:
             project = self.doc.to_project()

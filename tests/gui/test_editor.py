@@ -388,6 +388,16 @@ def test_unwritable_folder_for_export_and_save(qtbot, win, tmp_path):
     dlg.folder.setText(str(tmp_path / "ok"))
     with qtbot.waitSignal(dlg.exported, timeout=10_000):
         dlg.export()
+    # again into the same folder: the dialog names its own check box, not an API keyword
+    assert dlg.export() is None
+    assert "not empty: tick “Overwrite an existing bundle”" in dlg.status.text()
+    a_file = tmp_path / "ok" / next(p.name for p in (tmp_path / "ok").iterdir())
+    dlg.folder.setText(str(a_file / "sub"))
+    assert dlg.export() is None and "is a file, not a folder" in dlg.status.text()
+    dlg.overwrite.setChecked(True)
+    dlg.folder.setText(str(tmp_path / "ok"))
+    with qtbot.waitSignal(dlg.exported, timeout=10_000):
+        dlg.export()
 
 
 # ---------------------------------------------------------------------- closing and recovery
