@@ -154,9 +154,12 @@ PARAMS: tuple[Param, ...] = (
     ),
     _P(
         "patch_overlap",
-        0,
+        8,
         "Patch ring w_P",
-        "Width of the ring in which the closed patch seam runs (px); 0 = the template overlap.",
+        "Width of the ring along the tile border in which the closed patch seam runs (px); "
+        "0 = the template overlap w_T.\nEverything outside the seam is the template, the same "
+        "in every tile, so a narrow ring shows less of a grid: 8 px instead of w_T = 16 halves "
+        "the preview's grid score on the samples, for a seam error about 25 % higher.",
         "Candidates",
         0,
         256,
