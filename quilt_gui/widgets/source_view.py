@@ -26,7 +26,8 @@ from quilt_gui.widgets.canvas import (
 from quilt_gui.widgets.rect_item import EditableRect
 
 REGION_COLORS = {"R_L": "#3fc1ff", "R_R": "#3fc1ff", "R_T": "#ff5fd2", "R_B": "#ff5fd2"}
-SEAM_COLORS = {"horizontal": "#7dff5f", "vertical": "#ffe14d"}
+# both stand out on the heat map (black, purple, red, orange, pale yellow)
+SEAM_COLORS = {"horizontal": "#7dff5f", "vertical": "#4de8ff"}
 WAYPOINT_COLOR = "#ffffff"
 
 
