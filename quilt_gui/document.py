@@ -169,12 +169,18 @@ class Document(QObject):
         return [self.candidates[i] for i in self.picks]
 
     # ------------------------------------------------------------------ user edits (undoable)
-    def set_param(self, key: str, value: Any, *, merge_id: int | None = None) -> None:
-        """Change one parameter; consecutive changes with the same ``merge_id`` are one step."""
-        value = params.BY_KEY[key].coerce(value)
+    def set_param(
+        self, key: str, value: Any, *, merge_id: int | None = None, text: str | None = None
+    ) -> None:
+        """Change one parameter; consecutive changes with the same ``merge_id`` are one step.
+
+        The undo step is named after the parameter's label ("Change Seam method")."""
+        p = params.BY_KEY[key]
+        value = p.coerce(value)
         if self.params.get(key) == value:
             return
-        self.undo_stack.push(commands.SetParams(self, {key: value}, merge_id=merge_id))
+        text = text or f"Change {p.label}"
+        self.undo_stack.push(commands.SetParams(self, {key: value}, merge_id=merge_id, text=text))
 
     def set_params(self, values: dict, *, text: str = "Change parameters") -> None:
         values = {k: params.BY_KEY[k].coerce(v) for k, v in values.items()}

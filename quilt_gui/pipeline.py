@@ -568,7 +568,7 @@ class Pipeline(QObject):
     def reroll_layout(self) -> None:
         """A new random layout for the preview (one undo step: the layout seed changes)."""
         seed = int(np.random.default_rng().integers(2**31 - 1))
-        self.doc.set_param("layout_seed", seed)
+        self.doc.set_param("layout_seed", seed, text="Re-roll layout")
 
 
 def make_preview(tiles, source, *, rows, cols, seed, no_equal_neighbours, weights, cancel=None):

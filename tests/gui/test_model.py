@@ -69,6 +69,7 @@ def test_slider_drag_is_one_undo_step(qtbot):
         doc.set_param("overlap", v, merge_id=mid)
     doc.set_param("rho", 5)
     assert doc.undo_stack.count() == 2
+    assert doc.undo_stack.text(0) == "Change Overlap w_T"  # the label, not the key
     doc.undo_stack.undo()
     doc.undo_stack.undo()
     assert doc.params["overlap"] == params.DEFAULTS["overlap"]
