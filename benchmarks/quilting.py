@@ -15,10 +15,10 @@ Samples under 200×200 (job A) run on one thread whatever ``threads`` says
 (max over the offsets the cuts run in, :func:`engine.quilting.grid_border_ratio`) is shown
 beside it, and the CPU time OpenBLAS's helper threads spent during the runs (0 when every
 product stays on the calling thread, as it should on a small shared machine). Then: the
-streaming overhead (``quilt`` draining every event vs the same run creating none), and the
-quality figures: grid border ratio of best+dp vs best+straight vs random on every bundled
-sample, and the mean seam peak of Long & Mould's minimax at half-block overlap vs dp at the
-same overlap.
+streaming overhead (``quilt`` draining every event vs the same run creating none, the two run
+in turn), and the quality figures: grid border ratio of best+dp vs best+straight vs random on
+every bundled sample, and the mean seam peak of Long & Mould's minimax at half-block overlap
+vs dp at the same overlap.
 """
 
 from __future__ import annotations
@@ -27,6 +27,7 @@ import argparse
 import os
 import sys
 import threading
+import time
 from pathlib import Path
 
 import numpy as np
@@ -200,6 +201,18 @@ def speed(args) -> None:
     print()
 
 
+def alternating_medians(fns, repeats: int) -> list[float]:
+    """Median wall time of each function, the functions run in turn ``repeats`` times (a change
+    of the machine's load hits all of them alike, unlike timing one after the other)."""
+    times = [[] for _ in fns]
+    for _ in range(repeats):
+        for fn, ts in zip(fns, times, strict=True):
+            t0 = time.perf_counter()
+            fn()
+            ts.append(time.perf_counter() - t0)
+    return [float(np.median(ts)) for ts in times]
+
+
 def streaming(args) -> None:
     print("## Streaming overhead (exact, 1 thread; quilt() drains every event vs no events)\n")
     rows = []
@@ -207,15 +220,12 @@ def streaming(args) -> None:
         j = JOBS[job]
         s = load_sample(args.sample, j["crop"])
         kw = dict(block=j["block"], overlap=j["overlap"], rng=0, threads=1)
-        t_stream, _ = median_time(
-            lambda s=s, j=j, kw=kw: quilt(s, j["out"], **kw),
-            min_repeats=args.repeats,
-            max_time=args.max_time,
-        )
-        t_plain, _ = median_time(
-            lambda s=s, j=j, kw=kw: _quilt_unstreamed(s, j["out"], **kw),
-            min_repeats=args.repeats,
-            max_time=args.max_time,
+        t_stream, t_plain = alternating_medians(
+            [
+                lambda s=s, j=j, kw=kw: quilt(s, j["out"], **kw),
+                lambda s=s, j=j, kw=kw: _quilt_unstreamed(s, j["out"], **kw),
+            ],
+            max(args.repeats, 7),
         )
         rows.append(
             [job, f"{t_plain:.3f}", f"{t_stream:.3f}", f"{100 * (t_stream / t_plain - 1):+.1f} %"]
