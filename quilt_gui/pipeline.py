@@ -556,7 +556,10 @@ class Pipeline(QObject):
         self._error(exc)
 
     def _on_quilt_cancel(self) -> None:
-        self.message.emit("info", f"Quilting cancelled after {len(self.doc.quilt_blocks)} blocks.")
+        what = "Texture transfer" if self._quilt_mode == "transfer" else "Quilting"
+        n = len(self.doc.quilt_blocks)
+        where = " of this pass" if self._quilt_mode == "transfer" else ""
+        self.message.emit("info", f"{what} cancelled after {n} blocks{where}.")
 
     @Slot()
     def _restart_quilt(self) -> None:

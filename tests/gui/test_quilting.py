@@ -114,6 +114,13 @@ def test_texture_transfer_streams_passes_and_follows_the_target(qtbot, tmp_path)
     w.doc.set_param("alpha_ramp", False)  # a parameter change re-runs the transfer
     wait_idle(qtbot, w)
     assert w.doc.quilt_result is not res and len(w.doc.quilt_result.iterations) == 2
+    w.doc.set_transfer_target(w.doc.source.main)  # 512 px: long enough to stop midway
+    w.doc.set_params({"iterations": 3, "block": 32})
+    running = lambda: w.jobs.get("quilt") is not None and len(w.doc.quilt_blocks) > 0  # noqa: E731
+    qtbot.waitUntil(running, timeout=10_000)
+    w.act_cancel.trigger()
+    wait_idle(qtbot, w)
+    assert w.last_message().startswith("Texture transfer cancelled after")
 
 
 def test_painted_exclusion_is_one_undo_step_and_never_copied(qtbot):
