@@ -211,3 +211,19 @@ class SetPainted(QUndoCommand):
 
     def undo(self) -> None:
         self.doc.apply_painted(self.old)
+
+
+class SetMapWeights(QUndoCommand):
+    """The seam-error weights of the material maps (one step per change)."""
+
+    def __init__(self, doc: Document, weights: dict, text: str) -> None:
+        super().__init__(text)
+        self.doc = doc
+        self.new = dict(weights)
+        self.old = dict(doc.map_weights)
+
+    def redo(self) -> None:
+        self.doc.apply_map_weights(self.new)
+
+    def undo(self) -> None:
+        self.doc.apply_map_weights(self.old)

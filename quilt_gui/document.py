@@ -90,6 +90,7 @@ class Document(QObject):
 
     source_changed = Signal()
     maps_changed = Signal()
+    map_weights_changed = Signal()
     params_changed = Signal(object)  # frozenset of changed keys
     template_changed = Signal()  # template rectangle
     waypoints_changed = Signal()
@@ -117,6 +118,7 @@ class Document(QObject):
         self.params: dict[str, Any] = dict(params.DEFAULTS)
         self.template_rect: tuple[int, int, int, int] | None = None
         self.waypoints: dict[str, list[tuple[int, int]]] = {k: [] for k in WAYPOINT_KEYS}
+        self.map_weights: dict[str, float] = {}  # seam-error weight per map; {} = main only
         self.seamless = None  # engine SeamlessTile (derived)
         self.candidates: list[CandidateEntry] = []
         self.picks: list[int] = []
@@ -285,6 +287,31 @@ class Document(QObject):
                 index, replace(entry, weight=float(weight)), text="Change tile weight"
             )
 
+    def set_map_weight(self, name: str, weight: float) -> None:
+        """How much map ``name`` counts in the seam error (main map 1, others 0 by default)."""
+        if self.source is None or name not in self.source.maps:
+            raise ValueError(f"no material map named {name!r}")
+        weight = max(0.0, float(weight))
+        if self.map_weight(name) == weight:
+            return
+        new = {**self.map_weights, name: weight}
+        self.undo_stack.push(commands.SetMapWeights(self, new, f"Seam weight of {name}"))
+
+    def map_weight(self, name: str) -> float:
+        default = 1.0 if self.source is not None and name == self.source.main_name else 0.0
+        return float(self.map_weights.get(name, default))
+
+    def engine_weights(self) -> dict[str, float] | None:
+        """The ``weights`` of the engine's seam calls ("main" is the source), None when only
+        the main map counts (the engine's default)."""
+        if self.source is None:
+            return None
+        names = list(self.source.maps)
+        w = {("main" if n == names[0] else n): self.map_weight(n) for n in names}
+        if w["main"] == 1.0 and not any(v for k, v in w.items() if k != "main"):
+            return None
+        return w
+
     def set_layout(self, layout: np.ndarray | None, *, text: str = "Re-roll layout") -> None:
         self.undo_stack.push(commands.SetLayout(self, layout, text))
 
@@ -300,6 +327,10 @@ class Document(QObject):
     def apply_waypoints(self, waypoints: dict) -> None:
         self.waypoints = {k: list(waypoints.get(k, [])) for k in WAYPOINT_KEYS}
         self.waypoints_changed.emit()
+
+    def apply_map_weights(self, weights: dict) -> None:
+        self.map_weights = {k: float(v) for k, v in weights.items()}
+        self.map_weights_changed.emit()
 
     def apply_picks(self, picks: list[int]) -> None:
         self.picks = list(picks)
@@ -417,6 +448,7 @@ class Document(QObject):
         self.name = safe_name(name or Path(source.path).stem or "tileset")
         self.template_rect = None
         self.waypoints = {k: [] for k in WAYPOINT_KEYS}
+        self.map_weights = {}
         self.seamless = None
         self.candidates, self.picks, self.layout = [], [], None
         self.preview, self.grid_score = None, None
@@ -427,6 +459,7 @@ class Document(QObject):
         self.maps_changed.emit()
         self.template_changed.emit()
         self.waypoints_changed.emit()
+        self.map_weights_changed.emit()
         self.seamless_changed.emit()
         self.candidates_reset.emit()
         self.picks_changed.emit()
@@ -495,6 +528,7 @@ class Document(QObject):
             name=self.name,
             source_paths=dict(self.source.paths),
             map_kinds=dict(self.source.kinds),
+            map_weights={k: v for k, v in self.map_weights.items() if k in self.source.maps},
             bit_depth=self.source.bit_depth,
             parameters=dict(self.params),
             seeds={"candidates": self.params["seed"], "layout": self.params["layout_seed"]},
@@ -524,6 +558,7 @@ class Document(QObject):
         self.waypoints = {
             k: [tuple(p) for p in project.waypoints.get(k, [])] for k in WAYPOINT_KEYS
         }
+        self.map_weights = {k: float(v) for k, v in project.map_weights.items()}
         entries = []
         for c in project.candidates:
             entries.append(
@@ -549,6 +584,7 @@ class Document(QObject):
         self.params_changed.emit(frozenset(self.params))
         self.template_changed.emit()
         self.waypoints_changed.emit()
+        self.map_weights_changed.emit()
         self.candidates_reset.emit()
         self.picks_changed.emit()
         self.layout_changed.emit()

@@ -59,6 +59,7 @@ class Pipeline(QObject):
         self._seamless_timer = _soon(self, self._start_seamless)
         doc.source_changed.connect(self._on_source_changed)
         doc.maps_changed.connect(self.schedule_seamless)
+        doc.map_weights_changed.connect(self.schedule_seamless)
         doc.template_changed.connect(self.schedule_seamless)
         doc.waypoints_changed.connect(self.schedule_seamless)
         doc.params_changed.connect(self._on_params_changed)
@@ -201,6 +202,7 @@ class Pipeline(QObject):
             rho=p["rho"],
             waypoints=wps or None,
             maps=extra or None,
+            weights=doc.engine_weights(),
             **params.seam_options(p, p["method"]),
         )
         inputs = (
@@ -277,6 +279,7 @@ class Pipeline(QObject):
             width=p["width"],
             rho=p["rho"],
             maps=extra or None,
+            weights=self.doc.engine_weights(),
             **params.seam_options(p, p["method"]),
         )
 

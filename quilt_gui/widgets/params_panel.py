@@ -13,6 +13,7 @@ from PySide6.QtCore import Qt, Slot
 from PySide6.QtWidgets import (
     QCheckBox,
     QComboBox,
+    QDoubleSpinBox,
     QFormLayout,
     QGroupBox,
     QHBoxLayout,
@@ -47,7 +48,8 @@ SLIDERS = frozenset(
         "q_rho",
     }
 )
-TILESET_GROUPS = ("Template", "Seam", "Seam options", "Candidates", "Preview")
+MATERIALS = "Material maps"
+TILESET_GROUPS = ("Template", "Seam", MATERIALS, "Seam options", "Candidates", "Preview")
 QUILT_GROUPS = ("Quilting", "Seam options", "Transfer")
 
 
@@ -89,6 +91,10 @@ class ParamsPanel(QScrollArea):
                 form.addRow(row)
             lay.addWidget(box)
             self.groups[group] = box
+            if group == "Seam":
+                self.materials = MaterialWeights(doc)
+                lay.addWidget(self.materials)
+                self.groups[MATERIALS] = self.materials
         lay.addStretch(1)
         self.setWidget(body)
         self.setMinimumWidth(body.sizeHint().width() + 24)
@@ -101,6 +107,8 @@ class ParamsPanel(QScrollArea):
         """Show only these groups (the tile-set or the quilting mode)."""
         for name, box in self.groups.items():
             box.setVisible(name in groups)
+        self.materials.wanted = MATERIALS in groups
+        self.materials.refresh()
 
     # ------------------------------------------------------------------ widgets
     def _make_widget(self, p: params.Param) -> QWidget:
@@ -182,3 +190,55 @@ class ParamsPanel(QScrollArea):
                     w.setText(str(v))
                 else:
                     w.setValue(v)
+
+
+class MaterialWeights(QGroupBox):
+    """How much each material map counts in the seam error (shown once a map is attached).
+
+    Default: the main map alone (weight 1, the others 0); a height or normal map with some
+    weight steers the cuts around its own edges too. Every change is one undo step.
+    """
+
+    def __init__(self, doc: Document, parent=None) -> None:
+        super().__init__(MATERIALS, parent)
+        self.doc = doc
+        self.wanted = True  # the tile-set mode shows it (when there is more than one map)
+        self.spins: dict[str, QDoubleSpinBox] = {}
+        self.form = QFormLayout(self)
+        self.form.setLabelAlignment(Qt.AlignmentFlag.AlignRight)
+        self.setToolTip(
+            "Seam error = weighted mix of the maps' errors; the cuts, patches and blends "
+            "are applied to every map alike."
+        )
+        doc.source_changed.connect(self.refresh)
+        doc.maps_changed.connect(self.refresh)
+        doc.map_weights_changed.connect(self.refresh)
+        self.refresh()
+
+    @Slot()
+    def refresh(self) -> None:
+        src = self.doc.source
+        names = list(src.maps) if src is not None else []
+        if list(self.spins) != names:
+            while self.form.rowCount():
+                self.form.removeRow(0)
+            self.spins = {}
+            for name in names:
+                spin = QDoubleSpinBox()
+                spin.setRange(0.0, 10.0)
+                spin.setSingleStep(0.1)
+                spin.setDecimals(2)
+                spin.setKeyboardTracking(False)
+                spin.setToolTip(f"Weight of the {name} map in the seam error (0 = ignored)")
+                spin.valueChanged.connect(partial(self._edit, name))
+                kind = src.kinds.get(name, "")
+                label = QLabel(f"{name} ({kind})" if kind and kind != name else name)
+                self.form.addRow(label, spin)
+                self.spins[name] = spin
+        for name, spin in self.spins.items():
+            with signals_blocked(spin):
+                spin.setValue(self.doc.map_weight(name))
+        self.setVisible(self.wanted and len(names) > 1)
+
+    def _edit(self, name: str, value: float) -> None:
+        self.doc.set_map_weight(name, value)

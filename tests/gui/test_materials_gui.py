@@ -80,3 +80,44 @@ def test_options_persist_between_sessions(qtbot):
     assert settings.get("parameters")["overlap"] == 21
     w2 = make_window(qtbot)
     assert w2.doc.params["overlap"] == 21 and w2.params_panel.value("overlap") == 21
+
+
+def test_seam_weights_of_the_maps_steer_the_cut_undo_and_survive_a_reopen(qtbot, tmp_path):
+    from engine.tiles import make_seamless
+
+    w = make_window(qtbot)
+    open_sample(qtbot, w)
+    box = w.params_panel.materials
+    assert not box.isVisible()  # one map: nothing to weigh
+    height = np.random.default_rng(3).integers(0, 256, w.doc.source.shape, dtype=np.uint8)
+    path = tmp_path / "cobbles_height.png"
+    Image.fromarray(height).save(path)
+    with qtbot.waitSignal(w.doc.maps_changed, timeout=5000):
+        w.attach_map(str(path))
+    assert box.isVisible() and list(box.spins) == ["albedo", "height"]
+    assert box.spins["albedo"].value() == 1.0 and box.spins["height"].value() == 0.0
+    rect = (150, 120, 128, 112)
+    w.doc.set_template_rect(rect)
+    wait_idle(qtbot, w)
+    plain = w.doc.seamless.paths["horizontal"].copy()
+    box.spins["height"].setValue(2.0)  # what typing 2 and Enter does
+    assert w.doc.undo_stack.undoText() == "Seam weight of height"
+    wait_idle(qtbot, w)
+    src = w.doc.source
+    expected = make_seamless(
+        src.main,
+        rect,
+        overlap=w.doc.params["overlap"],
+        blend=w.doc.params["blend"],
+        maps={"height": src.maps["height"]},
+        weights={"main": 1.0, "height": 2.0},
+    )
+    np.testing.assert_array_equal(w.doc.seamless.paths["horizontal"], expected.paths["horizontal"])
+    assert not np.array_equal(plain, expected.paths["horizontal"])
+    project = str(tmp_path / "w.quiltproj")
+    assert w.save_to(project, wait=True)
+    w.doc.undo_stack.undo()
+    assert box.spins["height"].value() == 0.0 and w.doc.engine_weights() is None
+    with qtbot.waitSignal(w.doc.path_changed, timeout=10_000):
+        w.open_path(project, confirm=False)
+    assert w.doc.map_weights == {"height": 2.0} and box.spins["height"].value() == 2.0
