@@ -841,8 +841,11 @@ class MainWindow(QMainWindow):
                 "Wheel: zoom about the cursor · drag: pan · Ctrl+0 fit · Ctrl+1 100 % · "
                 "drag the yellow rectangle or its handles, arrow keys nudge (Shift: 10 px) · "
                 "Ctrl+click an overlap (or click in the overlaps panel): waypoint, right-click "
-                "removes · gallery: click picks, Shift+click picks a range, Space, Enter opens, "
-                "L locks, R re-rolls · Esc cancels the running job."
+                "removes · H heat overlay · gallery: click picks, Shift+click picks a range, "
+                "Space, Ctrl+A all, Enter or double-click opens, L locks, R re-rolls, "
+                "right-click: preview weight · drag the orange patch rectangle to rebuild a "
+                "candidate · Ctrl+R re-rolls the layout, G its grid · Esc cancels the running "
+                "job."
             ),
         )
 
