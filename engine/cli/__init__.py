@@ -43,7 +43,7 @@ def main(argv: list[str] | None = None) -> int:
 
     try:
         return int(args.func(args) or 0)
-    except (ImageError, ValueError, OSError) as exc:
+    except (ImageError, ValueError, TypeError, OSError) as exc:  # engine validation errors
         print(f"quilt-studio {args.command}: error: {exc}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:

@@ -13,7 +13,7 @@ import sys
 import time
 
 from engine.blend import BLEND_MODES
-from engine.cli._args import int_at_least, non_negative_float
+from engine.cli._args import add_seam_options, int_at_least, non_negative_float
 from engine.errormap import METRICS
 from engine.seams import METHODS
 
@@ -36,6 +36,21 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         metavar="N",
         help="largest block of control points moved at once (oscillating only; default 3)",
     )
+    add_seam_options(p)
+    p.add_argument(
+        "--start", type=int_at_least(0), metavar="COL", help="pin the path's column in the top row"
+    )
+    p.add_argument(
+        "--end", type=int_at_least(0), metavar="COL", help="pin the path's column in the bottom row"
+    )
+    p.add_argument(
+        "--waypoint",
+        type=_point,
+        action="append",
+        default=[],
+        metavar="ROW,COL",
+        help="a pixel the path must pass through (repeatable)",
+    )
     p.add_argument("--metric", choices=METRICS, default="euclid", help="error metric")
     p.add_argument("--blend", choices=BLEND_MODES, default="none", help="blend of --save-composite")
     p.add_argument("--rho", type=int, default=3, help="rho of adaptive blending (default 3)")
@@ -52,6 +67,14 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     )
     p.set_defaults(func=run)
     return p
+
+
+def _point(text: str) -> tuple[int, int]:
+    try:
+        row, col = (int(v) for v in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected ROW,COL like 12,3, got {text!r}") from None
+    return row, col
 
 
 def run(args) -> int:
@@ -75,9 +98,18 @@ def run(args) -> int:
     if r1.shape[2] != r2.shape[2]:
         r1, r2 = to_rgb(r1), to_rgb(r2)
     err = error_map(r1, r2, metric=args.metric)
-    options = {} if args.o_max is None else {"o_max": args.o_max}
+    options = dict(args.seam_option)
+    if args.o_max is not None:
+        options["o_max"] = args.o_max
     t0 = time.perf_counter()
-    seam = find_seam(err, method=args.method, **options)
+    seam = find_seam(
+        err,
+        method=args.method,
+        start=args.start,
+        end=args.end,
+        waypoints=tuple(args.waypoint),
+        **options,
+    )
     elapsed = time.perf_counter() - t0
     depth = max(a.bit_depth, b.bit_depth)
     if args.save_mask:

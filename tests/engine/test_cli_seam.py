@@ -120,3 +120,25 @@ def test_installed_entry_point(overlap):
     assert done.returncode == 0, done.stderr
     res = json.loads(done.stdout)
     assert res["method"] == "dp" and len(res["path"]) == 64
+
+
+def test_seam_cli_pins_waypoints_and_method_options(tmp_path, capsys):
+    import json
+
+    import numpy as np
+
+    from engine.cli import main
+    from engine.io import save_image
+
+    rng = np.random.default_rng(5)
+    r1, r2 = tmp_path / "a.png", tmp_path / "b.png"
+    save_image(r1, rng.random((30, 10, 3)))
+    save_image(r2, rng.random((30, 10, 3)))
+    argv = [str(r1), str(r2), "--json", "--start", "2", "--end", "7", "--waypoint", "15,4"]
+    assert main(["seam", *argv, "--method", "oscillating", "--seam-option", "init=argmin"]) == 0
+    path = json.loads(capsys.readouterr().out)["path"]
+    assert [0, 2] in path  # pinned top (an oscillating row may hold a horizontal run)
+    assert [15, 4] in path
+    assert path[-1][0] == 29 and [29, 7] in path
+    assert main(["seam", str(r1), str(r2), "--seam-option", "bogus=1"]) == 1
+    assert "bogus" in capsys.readouterr().err
