@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 from PySide6.QtCore import QRectF, Qt, Signal, Slot
-from PySide6.QtGui import QBrush, QColor
-from PySide6.QtWidgets import QGraphicsEllipseItem
+from PySide6.QtGui import QBrush, QColor, QPen
+from PySide6.QtWidgets import QGraphicsEllipseItem, QGraphicsItem
 
 from quilt_gui.commands import new_merge_id
 from quilt_gui.document import Document
@@ -21,7 +21,6 @@ from quilt_gui.widgets.canvas import (
     ImageCanvas,
     PixelSetItem,
     ShadeItem,
-    cosmetic_pen,
 )
 from quilt_gui.widgets.rect_item import EditableRect
 
@@ -43,13 +42,25 @@ def region_rects(rect, overlap: int) -> dict[str, tuple[int, int, int, int]]:
 
 
 class WaypointItem(QGraphicsEllipseItem):
-    """A ring around a waypoint pixel (cosmetic pen, centred on the pixel)."""
+    """A ring of constant screen size (12 px) centred on a waypoint pixel, white on black so
+    it shows at any zoom and on any colour."""
+
+    RADIUS = 6.0
 
     def __init__(self, row: int, col: int) -> None:
-        super().__init__(QRectF(col - 0.5, row - 0.5, 2.0, 2.0))
-        self.setPen(cosmetic_pen(QColor(WAYPOINT_COLOR), 2))
-        self.setBrush(QBrush(QColor(255, 255, 255, 90)))
+        r = self.RADIUS
+        super().__init__(QRectF(-r, -r, 2 * r, 2 * r))
+        self.setFlag(QGraphicsItem.GraphicsItemFlag.ItemIgnoresTransformations, True)
+        self.setPos(col + 0.5, row + 0.5)
+        self.setPen(QPen(QColor(WAYPOINT_COLOR), 2))
+        self.setBrush(Qt.BrushStyle.NoBrush)
         self.setZValue(35)
+        halo = QGraphicsEllipseItem(QRectF(-r - 1.5, -r - 1.5, 2 * r + 3, 2 * r + 3), self)
+        halo.setPen(QPen(QColor(0, 0, 0, 200), 1.5))
+        halo.setFlag(QGraphicsItem.GraphicsItemFlag.ItemStacksBehindParent, True)
+        dot = QGraphicsEllipseItem(QRectF(-1.5, -1.5, 3, 3), self)
+        dot.setPen(Qt.PenStyle.NoPen)
+        dot.setBrush(QBrush(QColor(WAYPOINT_COLOR)))
 
 
 class SourceView(ImageCanvas):
