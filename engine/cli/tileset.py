@@ -27,7 +27,13 @@ from pathlib import Path
 
 import numpy as np
 
-from engine.cli._args import add_exclusion, add_seam_options, excluded_pixels, int_at_least
+from engine.cli._args import (
+    add_exclusion,
+    add_seam_options,
+    excluded_pixels,
+    int_at_least,
+    non_negative_float,
+)
 from engine.cli.export import add_project_option, save_project_option
 
 FORMAT = "quilt-studio-tileset"
@@ -120,6 +126,14 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         default=None,
         metavar="X,Y,W,H",
         help="use this tile rectangle instead of searching one",
+    )
+    p.add_argument(
+        "--joint-weight",
+        type=non_negative_float,
+        default=None,
+        metavar="L",
+        help="weight of the tile's natural wrap joint in the template search, so the tile edge "
+        "falls where the texture is calm (default 0.5; 0 = strip mismatch only, as in the paper)",
     )
     p.add_argument(
         "--overlap",
@@ -267,7 +281,9 @@ def _run(args) -> int:
         iter_find_template,
         iter_make_seamless,
         random_layout,
+        template_cost,
     )
+    from engine.tiles.template import JOINT_WEIGHT
 
     say = _Reporter()
     loaded = load_image(args.source)
@@ -294,12 +310,13 @@ def _run(args) -> int:
     warn_list: list[str] = []
 
     # 1. template rectangle
+    joint = JOINT_WEIGHT if args.joint_weight is None else args.joint_weight
     if args.rect:
         rect = _parse_rect(args.rect)
         from engine.tiles import default_overlap
 
         overlap = args.overlap or default_overlap((rect[3], rect[2]))
-        cost = None
+        cost = template_cost(S, rect, overlap=overlap, excluded=excluded, joint_weight=joint)[0]
         say(f"template: fixed rectangle {rect}, overlap {overlap}")
     else:
 
@@ -309,7 +326,12 @@ def _run(args) -> int:
 
         tmpl = _run_events(
             iter_find_template(
-                S, tile_min=tile_min, tile_max=tile_max, overlap=args.overlap, excluded=excluded
+                S,
+                tile_min=tile_min,
+                tile_max=tile_max,
+                overlap=args.overlap,
+                excluded=excluded,
+                joint_weight=joint,
             ),
             on_template,
         )
@@ -441,6 +463,7 @@ def _run(args) -> int:
     parameters = {
         "tile_min": tile_min,
         "tile_max": tile_max,
+        "joint_weight": joint,
         "overlap": overlap,
         "patch_overlap": args.patch_overlap or overlap,
         "patch_size": args.patch_size or [int(rect[3]), int(rect[2])],

@@ -55,6 +55,10 @@ ARGS = [
 ]
 
 
+def S_exact(paths):
+    return load_image(paths["rgb8"]).pixels
+
+
 def png(path):
     return decode_png(path.read_bytes())
 
@@ -239,7 +243,13 @@ def test_fixed_rect_and_colour_exclusion(src, tmp_path):
         == 0
     )
     man = json.loads((out / "manifest.json").read_text())
-    assert man["template"]["rect"] == [10, 12, 50, 48] and man["template"]["cost"] is None
+    assert man["template"]["rect"] == [10, 12, 50, 48]
+    from engine.tiles import template_cost
+
+    expected = template_cost(
+        S_exact(src), (10, 12, 50, 48), overlap=6, excluded=np.all(S_exact(src) <= 0.15, axis=2)
+    )[0]
+    assert man["template"]["cost"] == pytest.approx(expected)  # a fixed rectangle is scored too
     assert man["parameters"]["patch_overlap"] == 5
     assert png(out / "template.png").shape == (48, 50, 3)
     S = png(src["rgb8"]).astype(np.float32) / 255
@@ -249,3 +259,19 @@ def test_fixed_rect_and_colour_exclusion(src, tmp_path):
         x, y, w, h = t["source_rect"]
         assert not dark[y : y + h, x : x + w].any()
     assert main(["tileset", str(src["rgb8"]), "--out", str(out), "--rect", "1,2,3"]) == 1
+
+
+def test_joint_weight_is_passed_to_the_search_and_recorded(src, tmp_path):
+    from engine.tiles import find_template
+
+    S = S_exact(src)
+    for weight in ("0", "2"):
+        out = tmp_path / f"w{weight}"
+        assert (
+            main(["tileset", str(src["rgb8"]), "--out", str(out), *ARGS, "--joint-weight", weight])
+            == 0
+        )
+        man = json.loads((out / "manifest.json").read_text())
+        assert man["parameters"]["joint_weight"] == float(weight)
+        t = find_template(S, tile_min=48, tile_max=56, joint_weight=float(weight))
+        assert man["template"]["rect"] == list(t.rect)
