@@ -12,3 +12,8 @@ def sample_path(name: str = DEFAULT_SAMPLE) -> Path:
     if name not in SAMPLE_NAMES:
         raise ValueError(f"unknown sample {name!r}; choose from {', '.join(SAMPLE_NAMES)}")
     return Path(str(files("resources") / "samples" / f"{name}.png"))
+
+
+def icon_path() -> Path:
+    """Filesystem path of the application icon (PNG)."""
+    return Path(str(files("resources") / "icons" / "quilt-studio.png"))
