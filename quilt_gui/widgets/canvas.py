@@ -149,6 +149,10 @@ class ImageCanvas(QGraphicsView):
         self.setMouseTracking(True)
         self.setBackgroundBrush(QBrush(QColor(24, 24, 26)))
         self.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
+        # files dropped on an image go to the window (open them); a QGraphicsView accepts
+        # drops for its scene by default and would swallow them
+        self.setAcceptDrops(False)
+        self.viewport().setAcceptDrops(False)
         self._zoom = 1.0
         self._fit_pending = True  # fit as soon as the view has its real size
         self.fitted = False  # showing the whole image, not zoomed by the user: refit on resize

@@ -352,6 +352,14 @@ def test_opened_message_names_the_colour_model_in_words(qtbot, win, tmp_path, mo
     assert f"50×40, {shown}." in win.last_message()
 
 
+def test_files_dropped_on_any_image_view_reach_the_window(win):
+    # Qt delivers a drag to the innermost widget that accepts drops; a QGraphicsView does
+    # by default and ignores files, so a drop on the source image did nothing
+    assert win.acceptDrops()
+    for canvas in win.canvases():
+        assert not canvas.acceptDrops() and not canvas.viewport().acceptDrops(), canvas
+
+
 def test_image_too_small_for_the_tile(qtbot, win, tmp_path):
     tiny = tmp_path / "tiny.png"
     Image.fromarray(np.zeros((24, 24, 3), np.uint8) + 100).save(tiny)
