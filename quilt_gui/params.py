@@ -520,6 +520,18 @@ def coerce_all(values: dict) -> dict:
     return out
 
 
+def seam_option_keys(method: str) -> frozenset[str]:
+    """The "Seam options" parameters that seam ``method`` uses (the others do nothing)."""
+    from engine.seams import OPTIONS
+
+    allowed = OPTIONS.get(method, {})
+    names = {
+        "variant": "minimax_variant" if method == "minimax" else "osc_variant",
+        "init": "osc_init",
+    }
+    return frozenset(names.get(k, k) for k in allowed if names.get(k, k) in BY_KEY)
+
+
 def seam_options(p: dict, method: str) -> dict:
     """The options seam ``method`` takes (engine.seams.OPTIONS), from the parameters."""
     from engine.seams import OPTIONS

@@ -100,6 +100,7 @@ class ParamsPanel(QScrollArea):
         self.setMinimumWidth(body.sizeHint().width() + 24)
         self.setWidgetResizable(True)
         self.setHorizontalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+        self._quilting = False
         doc.params_changed.connect(self._on_params_changed)
         self._on_params_changed(frozenset(params.DEFAULTS))
 
@@ -109,6 +110,18 @@ class ParamsPanel(QScrollArea):
             box.setVisible(name in groups)
         self.materials.wanted = MATERIALS in groups
         self.materials.refresh()
+        self._quilting = "Quilting" in groups
+        self._enable_seam_options()
+
+    def _enable_seam_options(self) -> None:
+        """Only the options of the seam method in use are editable (the mode's method)."""
+        method = self.doc.params["q_method" if self._quilting else "method"]
+        used = params.seam_option_keys(method)
+        for p in params.PARAMS:
+            if p.group == "Seam options":
+                w = self.widgets[p.key]
+                w.setEnabled(p.key in used)
+                w.setToolTip(p.tip if p.key in used else f"{p.tip}\n(not used by {method})")
 
     # ------------------------------------------------------------------ widgets
     def _make_widget(self, p: params.Param) -> QWidget:
@@ -190,6 +203,8 @@ class ParamsPanel(QScrollArea):
                     w.setText(str(v))
                 else:
                     w.setValue(v)
+        if keys & {"method", "q_method"}:
+            self._enable_seam_options()
 
 
 class MaterialWeights(QGroupBox):

@@ -492,3 +492,16 @@ def test_window_fits_a_1280_px_screen_whatever_the_labels_say(qtbot, win):
     for tab in (win.source_view, win.preview_view, win.quilt_view):
         win.tabs.setCurrentWidget(tab)
         assert win.minimumSizeHint().width() <= 1100, tab
+
+
+def test_only_the_options_of_the_seam_method_in_use_are_editable(qtbot, win):
+    wid = win.params_panel.widgets
+    assert not wid["o_max"].isEnabled() and not wid["max_run"].isEnabled()  # dp
+    win.doc.set_param("method", "oscillating")
+    assert wid["o_max"].isEnabled() and wid["osc_init"].isEnabled()
+    assert not wid["max_run"].isEnabled() and not wid["levels"].isEnabled()
+    win.doc.set_param("q_method", "resistance")
+    win.tabs.setCurrentWidget(win.quilt_view)  # quilting: its own seam method counts
+    assert wid["max_run"].isEnabled() and not wid["o_max"].isEnabled()
+    win.tabs.setCurrentWidget(win.source_view)
+    assert wid["o_max"].isEnabled()
