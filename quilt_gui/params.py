@@ -495,10 +495,11 @@ BY_KEY: dict[str, Param] = {p.key: p for p in PARAMS}
 GROUPS: tuple[str, ...] = tuple(dict.fromkeys(p.group for p in PARAMS))
 DEFAULTS: dict[str, Any] = {p.key: p.default for p in PARAMS}
 
+#: The options of the seam methods (which ones a method uses: :func:`seam_option_keys`).
+SEAM_OPTION_KEYS = frozenset(p.key for p in PARAMS if p.group == "Seam options")
 #: Parameters whose change invalidates the seamless tile (and everything after it).
-SEAMLESS_KEYS = frozenset(
-    {"overlap", "method", "metric", "blend", "width", "rho"}
-    | {p.key for p in PARAMS if p.group == "Seam options"}
+SEAMLESS_KEYS = (
+    frozenset({"overlap", "method", "metric", "blend", "width", "rho"}) | SEAM_OPTION_KEYS
 )
 CANDIDATE_KEYS = frozenset(
     {"n_candidates", "patch_size", "patch_overlap", "margin", "neighbourhood", "seed"}

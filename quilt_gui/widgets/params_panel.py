@@ -114,14 +114,24 @@ class ParamsPanel(QScrollArea):
         self._enable_seam_options()
 
     def _enable_seam_options(self) -> None:
-        """Only the options of the seam method in use are editable (the mode's method)."""
-        method = self.doc.params["q_method" if self._quilting else "method"]
-        used = params.seam_option_keys(method)
-        for p in params.PARAMS:
-            if p.group == "Seam options":
-                w = self.widgets[p.key]
-                w.setEnabled(p.key in used)
-                w.setToolTip(p.tip if p.key in used else f"{p.tip}\n(not used by {method})")
+        """Only the options in use are editable: those of the seam method of the mode, the
+        feather width with feather blending, rho with adaptive blending."""
+        p = self.doc.params
+        method = p["q_method" if self._quilting else "method"]
+        unused = {
+            k: f"not used by {method}"
+            for k in (q.key for q in params.PARAMS if q.group == "Seam options")
+            if k not in params.seam_option_keys(method)
+        }
+        for blend, width, rho in (("blend", "width", "rho"), ("q_blend", "q_width", "q_rho")):
+            if p[blend] != "feather":
+                unused[width] = "only for feather blending"
+            if p[blend] != "adaptive":
+                unused[rho] = "only for adaptive blending"
+        for key in params.SEAM_OPTION_KEYS | {"width", "rho", "q_width", "q_rho"}:
+            w, tip = self.widgets[key], params.BY_KEY[key].tip
+            w.setEnabled(key not in unused)
+            w.setToolTip(f"{tip}\n({unused[key]})" if key in unused else tip)
 
     # ------------------------------------------------------------------ widgets
     def _make_widget(self, p: params.Param) -> QWidget:
@@ -203,7 +213,7 @@ class ParamsPanel(QScrollArea):
                     w.setText(str(v))
                 else:
                     w.setValue(v)
-        if keys & {"method", "q_method"}:
+        if keys & {"method", "q_method", "blend", "q_blend"}:
             self._enable_seam_options()
 
 

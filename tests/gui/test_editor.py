@@ -505,3 +505,7 @@ def test_only_the_options_of_the_seam_method_in_use_are_editable(qtbot, win):
     assert wid["max_run"].isEnabled() and not wid["o_max"].isEnabled()
     win.tabs.setCurrentWidget(win.source_view)
     assert wid["o_max"].isEnabled()
+    assert wid["rho"].isEnabled() and not wid["width"].isEnabled()  # adaptive blending
+    win.doc.set_param("blend", "feather")
+    assert wid["width"].isEnabled() and not wid["rho"].isEnabled()
+    assert "only for adaptive blending" in wid["rho"].toolTip()
