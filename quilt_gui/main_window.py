@@ -57,6 +57,9 @@ log = logging.getLogger(__name__)
 
 IMAGE_FILTER = "Images (" + " ".join(f"*{s}" for s in READ_SUFFIXES) + ")"
 PROJECT_FILTER = f"Quilt Studio projects (*{PROJECT_SUFFIX})"
+OPEN_FILTER = (
+    "Images and projects (" + " ".join(f"*{s}" for s in (*READ_SUFFIXES, PROJECT_SUFFIX)) + ")"
+)
 MAIN_MAP = "albedo"
 
 
@@ -473,7 +476,7 @@ class MainWindow(QMainWindow):
     def open_dialog(self) -> None:
         path = self.ask_open_path(
             "Open image or project",
-            f"{IMAGE_FILTER};;{PROJECT_FILTER};;All files (*)",
+            f"{OPEN_FILTER};;{IMAGE_FILTER};;{PROJECT_FILTER};;All files (*)",
             "last_open_dir",
         )
         if path:

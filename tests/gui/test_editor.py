@@ -509,3 +509,11 @@ def test_only_the_options_of_the_seam_method_in_use_are_editable(qtbot, win):
     win.doc.set_param("blend", "feather")
     assert wid["width"].isEnabled() and not wid["rho"].isEnabled()
     assert "only for adaptive blending" in wid["rho"].toolTip()
+
+
+def test_open_dialog_lists_images_and_projects_together(win, monkeypatch):
+    asked = []
+    monkeypatch.setattr(win, "ask_open_path", lambda caption, filters, key: asked.append(filters))
+    win.open_dialog()
+    first = asked[0].split(";;")[0]
+    assert "*.png" in first and "*.quiltproj" in first
