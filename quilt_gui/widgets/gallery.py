@@ -32,6 +32,8 @@ SCORE_ROLE = Qt.ItemDataRole.UserRole + 3
 ENTRY_ROLE = Qt.ItemDataRole.UserRole + 4
 
 PICK_COLOR = QColor(255, 190, 40)
+#: How often a picked tile appears in the preview layout, relative to the others.
+PREVIEW_WEIGHTS = (0.0, 0.25, 0.5, 1.0, 2.0, 4.0)
 
 
 class CandidateModel(QAbstractListModel):
@@ -319,8 +321,9 @@ class CandidateView(QListView):
         for a in (pick, lock, reroll, large):
             menu.addAction(a)
         weights = menu.addMenu("Preview weight")
-        for w in (0.25, 0.5, 1.0, 2.0, 4.0):
-            a = weights.addAction(f"{w:g}")
+        weights.setToolTipsVisible(True)
+        for w in PREVIEW_WEIGHTS:
+            a = weights.addAction(f"{w:g}" if w else "0 (kept, not in the preview)")
             a.setCheckable(True)
             a.setChecked(abs(entry.weight - w) < 1e-9)
             a.triggered.connect(partial(self._set_weight, row, w))
