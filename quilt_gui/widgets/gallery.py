@@ -75,6 +75,8 @@ class CandidateModel(QAbstractListModel):
                 lines.append(f"patch from row {e.patch_origin[0]}, col {e.patch_origin[1]}")
             if e.seed is not None:
                 lines.append(f"seed {e.seed}")
+            if e.weight != 1.0:
+                lines.append(f"preview weight {e.weight:g}")
             lines.append("locked" if e.locked else "")
             return "\n".join(s for s in lines if s)
         if role == PICK_ROLE:
@@ -186,6 +188,12 @@ class CandidateDelegate(QStyledItemDelegate):
             f.setBold(True)
             painter.setFont(f)
             painter.drawText(badge, Qt.AlignmentFlag.AlignCenter, str(pick))
+        entry = index.data(ENTRY_ROLE)
+        if entry is not None and entry.weight != 1.0:
+            tag = QRect(r.right() - 44, r.bottom() - 44, 40, 18)
+            painter.fillRect(tag, QColor(40, 40, 40, 200))
+            painter.setPen(QColor(255, 255, 255))
+            painter.drawText(tag, Qt.AlignmentFlag.AlignCenter, f"×{entry.weight:g}")
         if index.data(LOCKED_ROLE):
             lock = QRect(r.right() - 24, r.y() + 4, 20, 18)
             painter.fillRect(lock, QColor(40, 40, 40, 200))

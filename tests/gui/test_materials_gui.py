@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 from PIL import Image
+from PySide6.QtCore import Qt
 
 from engine.materials import decode_normals
 from quilt_gui import settings
@@ -70,6 +71,8 @@ def test_preview_weight_zero_removes_a_tile_from_the_layout(qtbot):
     w.doc.set_weight(1, 0.0)  # candidate 1 is the second picked tile (id 1)
     wait_idle(qtbot, w)
     assert 1 not in set(np.unique(w.doc.layout))
+    tip = w.gallery.model().index(1).data(Qt.ItemDataRole.ToolTipRole)
+    assert "preview weight 0" in tip  # also drawn as a ×0 tag on the thumbnail
 
 
 def test_options_persist_between_sessions(qtbot):
