@@ -7,10 +7,11 @@ import logging
 import sys
 
 from PySide6.QtCore import QCoreApplication
-from PySide6.QtGui import QColor, QPalette
+from PySide6.QtGui import QColor, QIcon, QPalette
 from PySide6.QtWidgets import QApplication
 
 from quilt_gui import jobs, settings
+from resources import icon_path
 
 APP_NAME = "Quilt Studio"
 ORG_NAME = "QuiltStudio"
@@ -79,6 +80,7 @@ def apply_theme(app: QApplication, theme: str) -> None:
 def make_app(argv: list[str] | None = None, *, theme: str | None = None) -> QApplication:
     app = QApplication.instance() or QApplication(argv or [sys.argv[0]])
     set_names()
+    app.setWindowIcon(QIcon(str(icon_path())))
     apply_theme(app, theme or settings.get("theme"))
     app.aboutToQuit.connect(_on_about_to_quit)
     return app

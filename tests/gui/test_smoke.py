@@ -22,3 +22,12 @@ def test_entry_point_sends_subcommands_to_the_cli():
         [sys.executable, "-m", "quilt_gui", "--help"], capture_output=True, text=True, timeout=60
     )
     assert out.returncode == 0 and "SUBCOMMAND" in out.stdout
+
+
+def test_application_has_its_icon(qtbot):
+    from PySide6.QtWidgets import QApplication
+
+    from quilt_gui.app import make_app
+
+    make_app()
+    assert not QApplication.windowIcon().isNull()
