@@ -119,7 +119,9 @@ def _waypoints(waypoints, h: int, w: int) -> list[tuple[int, int]]:
             if isinstance(v, bool) or not isinstance(v, numbers.Integral):
                 raise TypeError(f"waypoints must hold integer (row, col) pairs, got {p!r}")
         if not (0 <= r < h and 0 <= c < w):
-            raise ValueError(f"waypoint {(int(r), int(c))} lies outside the {h}x{w} error map")
+            raise ValueError(
+                f"waypoint {(int(r), int(c))} lies outside the error map ({h} rows x {w} columns)"
+            )
         out.add((int(r), int(c)))
     pts = sorted(out)
     for a, b in zip(pts, pts[1:], strict=False):

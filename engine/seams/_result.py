@@ -12,7 +12,14 @@ class Seam:
     Attributes
     ----------
     path : (N, 2) int ndarray
-        The path pixels as (row, col), from the top row to the bottom row.
+        The path pixels as (row, col), from the top row to the bottom row, each pixel once.
+        ``dp``, ``dijkstra``, ``minimax`` and ``resistance`` give a walk: consecutive pixels
+        are 8-neighbours (``dp``: one pixel per row). The control-point methods
+        (``oscillating``, ``oscillating-optimal``) give a pixel set listed row by row, columns
+        ascending: row j holds ``mu_j .. c_j`` (ALGORITHMS §1.1), which is 8-connected as a set
+        but not a walk in that order (where the cut steps left by more than one column, the
+        listing jumps from ``c_j`` back to the first pixel of row j + 1). Draw such a path as
+        pixels, or as a polyline through the control points ``c_j`` (each row's last pixel).
     mask : (h, w) bool ndarray
         True where the output pixel comes from R1 (the left region); path
         pixels belong to R1.
@@ -23,7 +30,8 @@ class Seam:
     method : str
         The method key that produced it.
 
-    Streamed seams (thousands per second from the oscillating search) may be built lazily:
+    The arrays are read-only (writable inputs are copied first). Streamed seams (thousands
+    per second from the oscillating search) may be built lazily:
     ``path``, ``mask``, ``criterion`` and ``peak`` are then computed on first access from a
     private copy of the control points (same values as an eager build).
     """
@@ -32,8 +40,8 @@ class Seam:
 
     def __init__(self, path, mask, criterion, peak, method: str = ""):
         for name, value in (
-            ("_path", path),
-            ("_mask", mask),
+            ("_path", _read_only(path)),
+            ("_mask", _read_only(mask)),
             ("_criterion", float(criterion)),
             ("_peak", float(peak)),
             ("method", method),
@@ -99,6 +107,15 @@ class Seam:
             f"Seam(method={self.method!r}, shape={self.shape}, pixels={len(self.path)}, "
             f"criterion={self.criterion:.6g}, peak={self.peak:.6g})"
         )
+
+
+def _read_only(a) -> np.ndarray:
+    """``a`` itself when it is a read-only array, else a read-only copy."""
+    if isinstance(a, np.ndarray) and not a.flags.writeable:
+        return a
+    out = np.array(a)
+    out.setflags(write=False)
+    return out
 
 
 def mask_from_columns(cols: np.ndarray, width: int) -> np.ndarray:

@@ -228,6 +228,80 @@ def test_oscillating_monotone_and_locally_optimal(init, variant, cyclic, o_max):
             assert final.criterion <= find_seam(e, cyclic=cyclic).criterion + 1e-9
 
 
+def literal_oscillating(e, c, o_max, variant, cyclic, frozen=frozenset()):
+    """ALGORITHMS §1.2's loop written out with the full criterion (no incremental update):
+    block moves in loop order (o = 1..o_max, j ascending; cyclic blocks wrap), first
+    improvement by more than tau = 1e-9 eps kept; then ``faithful`` restarts at o = 1, j = 0,
+    ``resume`` at o = 1 and the current j; stop after a full cycle without improvement.
+    Returns the control points after every accepted move."""
+    h, w = e.shape
+    o_max = min(o_max, h)
+    seq = [
+        (o, j)
+        for o in range(1, o_max + 1)
+        for j in (range(h if o < h else 1) if cyclic else range(h - o + 1))
+    ]
+    c = np.array(c)
+    eps = osc_eps(e, c, cyclic)
+    accepted, pos, idle = [], 0, 0
+    while idle < len(seq):
+        o, j = seq[pos]
+        rows = [(j + t) % h for t in range(o)]
+        moved = False
+        if not frozen.intersection(rows):
+            for i in range(w):
+                d = c.copy()
+                d[rows] = i
+                v = osc_eps(e, d, cyclic)
+                if v < eps - 1e-9 * eps:
+                    c, eps, moved = d, v, True
+                    accepted.append(c.copy())
+                    break
+        if moved:
+            pos, idle = (j if variant == "resume" else 0), 0
+        else:
+            pos, idle = (pos + 1) % len(seq), idle + 1
+    return accepted
+
+
+@pytest.mark.parametrize("variant", ["faithful", "resume"])
+@pytest.mark.parametrize("cyclic", [False, True])
+def test_oscillating_replays_the_literal_loop_move_by_move(variant, cyclic):
+    """Every streamed improvement is exactly the next move of the loop as printed (integer
+    maps: exact sums; float maps too), from every start, with frozen points."""
+    rng = np.random.default_rng(11)
+    for trial in range(40):
+        h, w = int(rng.integers(2, 12)), int(rng.integers(2, 8))
+        e = rng.random((h, w)) if trial % 2 else rng.integers(0, 20, (h, w)).astype(float)
+        o_max = int(rng.integers(1, 5))
+        kw = {"start": int(rng.integers(w))} if trial % 3 == 0 else {}
+        for init in INITS:
+            ups = list(
+                iter_find_seam(
+                    e,
+                    method="oscillating",
+                    o_max=o_max,
+                    variant=variant,
+                    init=init,
+                    cyclic=cyclic,
+                    **kw,
+                )
+            )
+            got = [controls_of(u.seam) for u in ups[:-1]]
+            k0 = 1
+            if init == "dp" and cyclic:  # the open cut, then the closed one when better
+                closed = find_seam(e, method="dp", cyclic=True, **kw).path[:, 1]
+                eps0 = osc_eps(e, got[0], True)
+                if osc_eps(e, closed, True) < eps0 - 1e-9 * eps0:
+                    np.testing.assert_array_equal(got[1], closed)
+                    k0 = 2
+            frozen = {0} if kw else set()
+            want = literal_oscillating(e, got[k0 - 1], o_max, variant, cyclic, frozen)
+            assert len(got) - k0 == len(want), (trial, init)
+            for a, b in zip(got[k0:], want, strict=True):
+                np.testing.assert_array_equal(a, b)
+
+
 def test_oscillating_dp_start_streams_the_closed_cut_on_cyclic_maps():
     closed_better = 0
     for seed in range(12):
@@ -309,16 +383,22 @@ def test_oscillating_default_within_15_percent_of_optimum_on_sample_overlaps(
 ):
     """Acceptance: the default setting stays within 15 % of ``oscillating-optimal`` on average
     over the bundled samples' overlaps. Measured (``python -m benchmarks.seams --quality``):
-    +0.7 to +2.3 % per set; from the paper's start (``init="argmin"``) +31 to +65 %."""
+    +0.7 to +2.3 % per set; from the paper's start (``init="argmin"``) +31 to +65 %. The DP
+    cut alone is already within the line (+1.8 to +8.8 %): the search must still improve on
+    it, or the line would not test the search."""
     from benchmarks.seams import gaps
 
     assert set(overlap_sets) == {"random strips", "template", "patch ring", "quilting"}
     for name, (overlaps, opt) in overlap_sets.items():
         g, _ = gaps(overlaps, opt)
-        assert np.all(g >= -1e-9)
+        g0, _ = gaps(overlaps, opt, start_only=True)  # the DP cut it starts from
+        assert np.all(g >= -1e-9) and np.all(g <= g0 + 1e-9)
         record_property(f"oscillating_default_gap_{name}", float(g.mean()))
         print(f"oscillating default vs optimum, {name} ({len(g)}): +{100 * g.mean():.1f} %")
         assert g.mean() <= 0.15, name
+        # the moves do part of the work: from the start's +1.8 / 8.8 / 3.8 / 3.9 % (random
+        # strips / template / patch ring / quilting) down to +0.7 / 2.1 / 2.3 / 1.8 %
+        assert g.mean() < 0.8 * g0.mean(), name
 
 
 def test_oscillating_paper_start_misses_the_15_percent_line(overlap_sets):
