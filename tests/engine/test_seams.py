@@ -719,6 +719,7 @@ def test_seam_is_immutable_picklable_and_lazy_seams_match_eager():
         s.path[0, 0] = 1
     t = pickle.loads(pickle.dumps(s))
     assert np.array_equal(t.path, s.path) and t.criterion == s.criterion and t.method == s.method
+    assert not t.path.flags.writeable and not t.mask.flags.writeable
     assert "oscillating" in repr(s) and s.shape == (40, 9)
 
 
