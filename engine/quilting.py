@@ -209,12 +209,18 @@ def grid_border_ratio(result: QuiltResult, *, reduce: str = "max") -> float:
     The joints are not straight lines after a cut, so the ratio is measured on the grid lines
     shifted by every offset 0..band (the strip the cuts run in) and the largest (``"max"``) or
     the mean (``"mean"``) is returned; a straight overlap's joint lies at offset 0.
+
+    A tileable output is measured as the torus it is (the image tiled 2 × 2): at the real
+    block positions (evenly spaced, not multiples of ``step``), the wrap line included.
     """
     from engine.metrics import grid_border_ratio as gbr
 
     choice(reduce, "reduce", ("max", "mean"))
     vals = []
     for k in range(result.band + 1):
+        if getattr(result, "tileable", False):
+            vals.append(_torus_grid_ratio(result.image, _torus_lines(result), k))
+            continue
         try:
             vals.append(gbr(result.image, result.step, offset=(k, k)))
         except ValueError:  # no grid line inside the image at this offset
@@ -222,6 +228,33 @@ def grid_border_ratio(result: QuiltResult, *, reduce: str = "max") -> float:
     if not vals:
         raise ValueError("the output has no block grid line inside it")
     return float(max(vals) if reduce == "max" else np.mean(vals))
+
+
+def _torus_lines(result: QuiltResult) -> tuple[np.ndarray, np.ndarray]:
+    """Row and column positions where the blocks of a tileable result start."""
+    (H, W), (bh, bw) = result.image.shape[:2], result.block
+    if result.select == "bhatia":
+        return np.arange(0, H, bh), np.arange(0, W, bw)
+    return (
+        np.array(axis_positions(H, bh, result.overlap, True)),
+        np.array(axis_positions(W, bw, result.overlap, True)),
+    )
+
+
+def _torus_grid_ratio(image: np.ndarray, lines, offset: int) -> float:
+    """Mean |step| across the lines ``lines + offset`` (rows, cols; modulo the size, so the
+    wrap joint counts) over the mean |step| between every other pair of neighbours."""
+    x = colour_channels(image).astype(np.float64)
+    ratios = []
+    for a, starts in ((x, lines[1]), (x.transpose(1, 0, 2), lines[0])):
+        n = a.shape[1]
+        steps = np.abs(np.roll(a, -1, axis=1) - a).mean(axis=2)  # i: column i -> (i + 1) % n
+        on = np.zeros(n, dtype=bool)
+        on[(starts + offset - 1) % n] = True
+        if on.any() and (~on).any():
+            den = steps[:, ~on].mean()
+            ratios.append(steps[:, on].mean() / den if den > 0 else 1.0)
+    return float(np.mean(ratios))
 
 
 # ------------------------------------------------------------------------------ helpers

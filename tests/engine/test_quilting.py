@@ -1,13 +1,14 @@
 import numpy as np
 import pytest
 
-from engine import quilting
+from engine import metrics, quilting
 from engine.cancel import Cancelled, CancelToken
 from engine.events import Progress
 from engine.exclusion import exclusion_mask
 from engine.matching import ZERO_ERROR_FRACTION, error_floor
 from engine.metrics import wrap_border_ratio
 from engine.quilting import BlockPlaced, grid_border_ratio, iter_quilt, quilt
+from resources import SAMPLE_NAMES
 
 
 @pytest.fixture(scope="module")
@@ -97,35 +98,73 @@ def test_best_choice_is_within_tolerance_of_brute_force(cobbles):
     assert checked == len(res.blocks) - 1
 
 
-@pytest.mark.parametrize("kw", [{}, {"mode": "fast"}, {"select": "bhatia", "seam": "resistance"}])
+@pytest.mark.parametrize(
+    "kw",
+    [
+        {},
+        {"mode": "fast"},
+        {"select": "sampled", "candidates": 40},
+        {"select": "random", "seam": "minimax"},
+        {"tileable": True, "seam": "dijkstra"},
+        {"adaptive_threshold": 0.004, "min_block": 13},
+        {"select": "bhatia", "seam": "resistance"},
+    ],
+)
 def test_same_seed_same_output_for_any_thread_count(cobbles, kw, monkeypatch):
     monkeypatch.setattr(quilting, "POOL_MIN_SAMPLE_AREA", 0)  # use the pool even for this sample
-    a = quilt(cobbles, (100, 120), block=24, overlap=6, rng=7, threads=1, **kw)
-    b = quilt(cobbles, (100, 120), block=24, overlap=6, rng=7, threads=2, **kw)
+    a, b, d = (
+        quilt(cobbles, (100, 120), block=24, overlap=6, rng=7, threads=t, **kw) for t in (1, 2, 3)
+    )
     c = quilt(cobbles, (100, 120), block=24, overlap=6, rng=8, threads=2, **kw)
-    np.testing.assert_array_equal(a.image, b.image)
-    assert [r.source for r in a.blocks] == [r.source for r in b.blocks]
+    for other in (b, d):
+        np.testing.assert_array_equal(a.image, other.image)
+        assert [r.source for r in a.blocks] == [r.source for r in other.blocks]
     assert not np.array_equal(a.image, c.image)
+    if "adaptive_threshold" in kw:
+        assert max(r.depth for r in a.blocks) >= 1
 
 
-def test_quality_order_best_dp_straight_random(cobbles):
-    """Grid border ratio: best+dp is close to the texture's own (<= 1.3) and beats a straight
-    overlap, which beats random blocks (the benchmark repeats this on full-size jobs)."""
-    kw = dict(block=24, overlap=4, rng=0)
-    dp = grid_border_ratio(quilt(cobbles, (120, 120), seam="dp", **kw))
-    straight = grid_border_ratio(quilt(cobbles, (120, 120), seam="straight", **kw))
-    rnd = grid_border_ratio(quilt(cobbles, (120, 120), select="random", seam="straight", **kw))
+def bundled(name: str, crop: int) -> np.ndarray:
+    from engine.io import load_image
+    from resources import sample_path
+
+    px = load_image(sample_path(name)).pixels[:crop, :crop]
+    return np.ascontiguousarray(np.repeat(px, 3, axis=2) if px.shape[2] == 1 else px[..., :3])
+
+
+@pytest.mark.parametrize("name", SAMPLE_NAMES)
+def test_quality_order_best_dp_straight_random(name):
+    """Grid border ratio on every bundled sample: best+dp is close to the texture's own
+    (<= 1.3) and clearly beats a straight overlap, which beats random blocks (mean of two seeds;
+    the benchmark repeats this on job A's 512 px outputs)."""
+    s = bundled(name, 128)
+
+    def ratio(**kw):
+        return np.mean(
+            [
+                grid_border_ratio(quilt(s, (224, 224), block=32, overlap=6, rng=k, **kw))
+                for k in range(2)
+            ]
+        )
+
+    dp = ratio(seam="dp")
+    straight = ratio(seam="straight")
+    rnd = ratio(select="random", seam="straight")
     assert dp <= 1.3
-    assert dp < straight < rnd
+    assert 1.2 * dp < straight < rnd
 
 
-def test_minimax_half_overlap_lowers_the_seam_peaks(cobbles):
+@pytest.mark.parametrize("name", SAMPLE_NAMES)
+def test_minimax_half_overlap_lowers_the_seam_peaks(name):
+    """Long & Mould: over all seams of a run at half-block overlap, minimax's mean peak error is
+    lower than dp's (the benchmark prints both figures)."""
+    s = bundled(name, 96)
     kw = dict(block=24, overlap=12, rng=0, metric="euclid")
-    dp = quilt(cobbles, (90, 90), seam="dp", **kw)
-    mm = quilt(cobbles, (90, 90), seam="minimax", **kw)
+    dp = quilt(s, (96, 96), seam="dp", **kw)
+    mm = quilt(s, (96, 96), seam="minimax", **kw)
     peak_dp = np.nanmean([r.peak for r in dp.blocks])
     peak_mm = np.nanmean([r.peak for r in mm.blocks])
-    assert peak_mm < peak_dp
+    assert peak_mm < 0.95 * peak_dp
 
 
 @pytest.mark.parametrize(
@@ -156,12 +195,26 @@ def test_excluded_colour_never_reaches_the_output(kw):
         assert not ex[y : y + h, x : x + w].any()
 
 
-def test_tileable_output_wraps_seamlessly(cobbles):
-    plain = quilt(cobbles, (100, 110), block=24, overlap=6, rng=2)
-    tiled = quilt(cobbles, (100, 110), block=24, overlap=6, rng=2, tileable=True)
-    assert wrap_border_ratio(plain.image) > 2.0
-    assert wrap_border_ratio(tiled.image) < 1.4
-    assert any(r.arms[3] for r in tiled.blocks) and any(r.arms[2] for r in tiled.blocks)
+@pytest.mark.parametrize(
+    "kw",
+    [{}, {"select": "sampled", "candidates": 30}, {"select": "bhatia", "seam": "resistance"}],
+)
+def test_tileable_output_wraps_seamlessly(cobbles, kw):
+    """The output tiled 2 x 2 shows no joint at the wrap (engine.metrics on the tiled image),
+    and none along the block grid measured on the torus at the real block positions."""
+    kw = {"block": 24, "overlap": 6, "rng": 2, **kw}
+    plain = quilt(cobbles, (100, 110), **kw)
+    tiled = quilt(cobbles, (100, 110), tileable=True, **kw)
+    for res, lo, hi in ((plain, 2.0, np.inf), (tiled, 0.0, 1.4)):
+        twice = np.tile(res.image, (2, 2, 1))
+        assert lo < metrics.grid_border_ratio(twice, res.image.shape[:2]) < hi
+        assert lo < wrap_border_ratio(res.image) < hi
+    assert grid_border_ratio(tiled) <= 1.4
+    if kw.get("select") != "bhatia":
+        assert any(r.arms[3] for r in tiled.blocks) and any(r.arms[2] for r in tiled.blocks)
+        # the torus grid sees joints that are there: a straight overlap's
+        straight = quilt(cobbles, (100, 110), tileable=True, seam="straight", **kw)
+        assert grid_border_ratio(straight) > 1.5 * grid_border_ratio(tiled)
 
 
 def test_adaptive_block_size_splits_only_bad_blocks(cobbles):
