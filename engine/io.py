@@ -281,6 +281,17 @@ def _to_array(im: Image.Image, fail) -> tuple[np.ndarray, int, str]:
 
 
 # ----------------------------------------------------------------------------- writing
+def _write_problem(folder: Path, exc: OSError) -> str:
+    """Why ``folder`` cannot take a new file: a file in the way of its path, else the OS's
+    reason."""
+    for q in (folder, *folder.parents):
+        if q.exists():
+            if not q.is_dir():
+                return f"{q} is a file, not a folder"
+            break
+    return exc.strerror or str(exc)
+
+
 def save_image(path, pixels, *, bit_depth: int = 8) -> Path:
     """Write float (H, W[, C]) pixels in [0, 1] (or uint8/uint16) to an image file, atomically.
 
@@ -314,7 +325,7 @@ def save_image(path, pixels, *, bit_depth: int = 8) -> Path:
         p.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(dir=p.parent, prefix=f".{p.name}.", suffix=suffix)
     except OSError as exc:
-        raise ImageError(f"{p}: cannot write ({exc.strerror or exc})") from None
+        raise ImageError(f"{p}: cannot write ({_write_problem(p.parent, exc)})") from None
     os.close(fd)
     try:
         if suffix in (".tif", ".tiff"):
