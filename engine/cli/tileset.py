@@ -159,9 +159,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument(
         "--margin",
         type=int_at_least(0),
-        default=2,
+        default=None,
         metavar="N",
-        help="outer pixels every candidate keeps from the template (default 2)",
+        help="outer pixels every candidate keeps from the template (default 2, at most w_P - 1)",
     )
     p.add_argument(
         "--neighbourhood",
@@ -258,15 +258,38 @@ def run(args) -> int:
     """Run the command; engine warnings become ``warning:`` lines on stderr (and the manifest)."""
     import warnings
 
+    if args.pick is not None and max(args.pick) >= args.candidates:
+        bad = [k for k in args.pick if k >= args.candidates]
+        raise ValueError(f"--pick {bad} out of range: --candidates is {args.candidates}")
+    out = Path(args.out)
+    created = not out.exists()
+    _check_out(out)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
             code = _run(args)
         except TypeError as exc:  # a bad --seam-option, named by the engine
             raise ValueError(str(exc)) from None
-    for w in caught:
-        print(f"quilt-studio tileset: warning: {w.message}", file=sys.stderr)
+        finally:
+            if created and out.is_dir() and not any(out.iterdir()):
+                out.rmdir()  # nothing written: leave no empty folder behind
+    for text in dict.fromkeys(str(w.message) for w in caught):  # each once, in order
+        print(f"quilt-studio tileset: warning: {text}", file=sys.stderr)
     return code
+
+
+def _check_out(out: Path) -> None:
+    """Create the --out folder and make sure files can be written there, before any work."""
+    import tempfile
+
+    from engine.io import _write_problem
+
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=out):
+            pass
+    except OSError as exc:
+        raise ValueError(f"--out {out}: cannot write there ({_write_problem(out, exc)})") from None
 
 
 def _run(args) -> int:
@@ -299,6 +322,11 @@ def _run(args) -> int:
     excluded = excluded_pixels(args, S, "source")
     if excluded is not None:
         say(f"excluded: {int(excluded.sum())} of {H * W} source pixels")
+        if excluded.all():
+            raise ValueError(
+                f"--exclude-color / --exclude-mask exclude every pixel of {args.source}: "
+                "no tile can be taken from it"
+            )
 
     tmpl_blend = args.blend or "none"
     cand_blend = args.blend or "adaptive"
@@ -363,6 +391,8 @@ def _run(args) -> int:
 
     # 3. candidates
     n = args.candidates
+    ring = args.patch_overlap or overlap
+    margin = args.margin if args.margin is not None else min(2, ring - 1)
 
     def on_candidate(ev):
         if isinstance(ev, CandidateTile):
@@ -382,7 +412,7 @@ def _run(args) -> int:
             n,
             patch_size=args.patch_size,
             patch_overlap=args.patch_overlap,
-            margin=args.margin,
+            margin=margin,
             neighbourhood=args.neighbourhood,
             method=args.seam,
             **dict(args.seam_option),
@@ -420,9 +450,8 @@ def _run(args) -> int:
         for m in ["main", *maps]
     }
 
-    # 5. files
+    # 5. files (the folder was checked before the work)
     out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
 
     def write(stem: str, images: dict) -> dict:
         files = {}
@@ -467,7 +496,7 @@ def _run(args) -> int:
         "overlap": overlap,
         "patch_overlap": args.patch_overlap or overlap,
         "patch_size": args.patch_size or [int(rect[3]), int(rect[2])],
-        "margin": args.margin,
+        "margin": margin,
         "neighbourhood": args.neighbourhood,
         "seam": args.seam,
         "seam_options": dict(args.seam_option),

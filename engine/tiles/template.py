@@ -122,11 +122,13 @@ def as_size(value, name: str) -> tuple[int, int]:
 
 
 def default_overlap(tile_min, tile_max=None) -> int:
-    """w_T ≈ 1/10 of the expected tile size (the mean of the range), at least 2."""
+    """w_T ≈ 1/10 of the expected tile size (the mean of the range), at least 2 and at most
+    half the smallest tile side (a wide range such as 40..400 would otherwise get a w_T
+    that ``tile_min`` cannot hold)."""
     lo = as_size(tile_min, "tile_min")
     hi = as_size(tile_max if tile_max is not None else tile_min, "tile_max")
     expected = (lo[0] + lo[1] + hi[0] + hi[1]) / 4.0
-    return max(2, int(round(expected / 10.0)))
+    return max(2, min(int(round(expected / 10.0)), min(lo) // 2))
 
 
 def _excluded_mask(excluded, shape: tuple[int, int]) -> np.ndarray | None:

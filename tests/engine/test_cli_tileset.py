@@ -195,6 +195,49 @@ def test_bad_input_gives_clear_errors(src, tmp_path, capsys):
     assert any("flat" in w for w in man["warnings"])
 
 
+def test_bad_sources_outputs_and_options_fail_before_any_work(src, tmp_path, capsys):
+    """Every refusal names the file or the option; nothing is computed or left behind."""
+    blocker = tmp_path / "afile"
+    blocker.write_text("x")
+    argv = ["tileset", str(src["rgb8"]), *ARGS]
+    assert main([*argv, "--out", str(blocker / "sub")]) == 1
+    err = capsys.readouterr().err
+    assert f"--out {blocker / 'sub'}: cannot write there ({blocker} is a file" in err
+    assert "candidate" not in err  # refused before the work, not after it
+    out = tmp_path / "o"
+    assert main([*argv, "--out", str(out), "--pick", "1,7"]) == 1
+    assert "--pick [7] out of range: --candidates is 5" in capsys.readouterr().err
+    assert not out.exists()
+    bad = {"empty.png": b"", "corrupt.png": encode_png(np.zeros((9, 9), np.uint8))[:40]}
+    for name, data in bad.items():
+        (tmp_path / name).write_bytes(data)
+        assert main(["tileset", str(tmp_path / name), "--out", str(out)]) == 1
+        err = capsys.readouterr().err
+        assert f"{name}: the file is" in err and err.count("\n") == 1, err
+        assert not out.exists()  # the folder made for the run is removed again
+    assert main(["tileset", str(tmp_path), "--out", str(out)]) == 1
+    assert "is a folder, not an image" in capsys.readouterr().err
+    assert main([*argv, "--out", str(out), "--exclude-color", "0:1"]) == 1
+    assert "--exclude-color / --exclude-mask exclude every pixel" in capsys.readouterr().err
+    # a tile range that does not fit the source is clamped with a warning, printed once
+    wide = ["--candidates", "2", "--tile-min", "40", "--tile-max", "400"]
+    assert main(["tileset", str(src["rgb8"]), "--out", str(out), *wide]) == 0
+    err = capsys.readouterr().err
+    assert err.count("warning: tile_max 400x400 plus overlap") == 1
+
+
+def test_small_source_gets_a_margin_that_fits_its_ring(tmp_path, capsys):
+    """30 x 30 px with the defaults: tiles 8..15, w_T = w_P = 2, so the margin is 1."""
+    rng = np.random.default_rng(0)
+    (tmp_path / "s.png").write_bytes(encode_png(rng.integers(0, 256, (30, 30, 3), np.uint8)))
+    out = tmp_path / "o"
+    assert main(["tileset", str(tmp_path / "s.png"), "--out", str(out), "--candidates", "2"]) == 0
+    man = json.loads((out / "manifest.json").read_text())
+    assert man["parameters"]["patch_overlap"] == 2 and man["parameters"]["margin"] == 1
+    assert main(["tileset", str(tmp_path / "s.png"), "--out", str(out), "--margin", "2"]) == 1
+    assert "margin must be smaller than patch_overlap" in capsys.readouterr().err
+
+
 def test_installed_command_runs(src, tmp_path):
     out = tmp_path / "cmd"
     r = subprocess.run(

@@ -216,6 +216,8 @@ def test_default_overlap_is_a_tenth_of_the_tile():
     assert default_overlap(256) == 26
     assert default_overlap(200, 300) == 25
     assert default_overlap((10, 12)) == 2
+    assert default_overlap(40, 400) == 20  # 22 would not fit twice in the smallest tile
+    assert find_template(periodic(shape=(120, 130)), tile_min=8, tile_max=88).overlap == 4
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         t = find_template(periodic(), tile_min=20, tile_max=30)
