@@ -3,6 +3,7 @@ import pytest
 
 from engine import quilting
 from engine.cancel import Cancelled, CancelToken
+from engine.io import load_image
 from engine.quilting import BlockPlaced, quilt
 from engine.transfer import (
     IterationDone,
@@ -11,6 +12,7 @@ from engine.transfer import (
     transfer,
     transfer_schedule,
 )
+from resources import SAMPLE_NAMES, sample_path
 
 
 @pytest.fixture(scope="module")
@@ -43,7 +45,10 @@ def test_alpha_one_reduces_to_plain_synthesis(cobbles):
 @pytest.mark.parametrize("target", [disc(120, 120), gradient(120, 120)], ids=["disc", "gradient"])
 @pytest.mark.parametrize("kind", ["luminance", "blurred"])
 def test_correspondence_error_falls_with_each_iteration(cobbles, target, kind):
-    """Default schedule: blocks 30, 20, 13 and α 0.1, 0.5, 0.9."""
+    """Default schedule (blocks 30, 20, 13; α 0.1, 0.5, 0.9) on cobblestones, 120 px targets:
+    the error falls at every pass (seeds 0..7 of every case here, measured when this was
+    written; the test runs seed 0). Not a law of the method: the last pass weighs texture 9:1
+    against correspondence and often raises the error a little on other settings (next test)."""
     res = transfer(cobbles, target, block=30, iterations=3, correspondence=kind, rng=0)
     errs = [it.correspondence_error for it in res.iterations]
     assert len(errs) == 3
@@ -52,6 +57,22 @@ def test_correspondence_error_falls_with_each_iteration(cobbles, target, kind):
     plain = quilt(cobbles, target.shape, block=30, rng=0).image
     cs = correspondence_map(target, kind=kind)
     assert errs[-1] < 0.6 * np.mean((correspondence_map(plain, kind=kind) - cs) ** 2)
+
+
+@pytest.mark.parametrize("name", SAMPLE_NAMES)
+def test_correspondence_error_falls_on_every_sample_while_alpha_stays_moderate(name):
+    """On every bundled sample the error falls at each of N = 3 passes with α rising 0.1 → 0.7
+    (seeds 0..7, disc and gradient: 80 of 80 cases, measured; the test runs seed 1). With the
+    default ramp to α = 0.9 the same runs fail in 40 of 80 cases, always on the last pass
+    (+0.1 to +6.4 %), as do 6 of 8 seeds with N = 4 on the 120 px disc: the last pass trades
+    correspondence for texture coherence. That is the α schedule's nature (ending at 0.7 removes
+    it), so the acceptance line holds for moderate final α, not for the paper's 0.9 in general."""
+    px = load_image(sample_path(name)).pixels[:80, :80]
+    s = np.repeat(px, 3, axis=2) if px.shape[2] == 1 else px[..., :3]
+    for target in (disc(96, 96), gradient(96, 96)):
+        res = transfer(s, target, block=24, iterations=3, alpha=(0.1, 0.7), rng=1)
+        errs = [it.correspondence_error for it in res.iterations]
+        assert errs[0] > errs[1] > errs[2], errs
 
 
 def test_same_seed_same_transfer_for_any_thread_count(cobbles, monkeypatch):
@@ -142,3 +163,55 @@ def test_transfer_cancel_and_errors(cobbles):
         iter_transfer(cobbles, disc(), block=24, correspondence="edges")
     with pytest.raises(ValueError, match="larger than the output"):
         iter_transfer(cobbles, disc(10, 10), block=24)
+
+
+def test_second_iteration_cost_with_the_previous_term_by_brute_force(cobbles):
+    """Iteration 2: cost = α (overlap SSD / (|M| C) + SSD to iteration 1's output / (h w C))
+    + (1 − α) SSD(correspondence) / (h w), for every window; the records hold it divided by
+    the overlap term's weight (the largest weight when a block has no overlap)."""
+    sample = cobbles[:36, :36].astype(np.float64)
+    target = disc(26, 26)
+    events = list(
+        iter_transfer(
+            cobbles[:36, :36],
+            target,
+            block=12,
+            overlap=3,
+            alpha=(0.3, 0.6),
+            iterations=2,
+            rng=5,
+            threads=1,
+        )
+    )
+    done = [i for i, e in enumerate(events) if isinstance(e, IterationDone)]
+    prev = events[done[0]].image.astype(np.float64)
+    placed = [e.record for e in events[done[0] + 1 :] if isinstance(e, BlockPlaced)]
+    b, a, c = 8, 0.6, 3
+    cs, ct = correspondence_map(sample), correspondence_map(target)
+    n = 36 - b + 1
+    win = np.lib.stride_tricks.sliding_window_view(sample, (b, b, c))[:, :, 0]  # (n, n, b, b, c)
+    cwin = np.lib.stride_tricks.sliding_window_view(cs, (b, b))
+    assert win.shape[:2] == (n, n)
+    canvas = np.zeros((26, 26, 3))
+    filled = np.zeros((26, 26), bool)
+    for r in placed[:3]:
+        (y0, x0), (h, w) = r.position, r.size
+        assert (h, w) == (b, b)
+        m = filled[y0 : y0 + h, x0 : x0 + w]
+        old = canvas[y0 : y0 + h, x0 : x0 + w]
+        ssd_prev = ((win - prev[y0 : y0 + h, x0 : x0 + w]) ** 2).sum(axis=(2, 3, 4))
+        ssd_corr = ((cwin - ct[y0 : y0 + h, x0 : x0 + w]) ** 2).sum(axis=(2, 3))
+        w_prev, w_corr = a / (h * w * c), (1 - a) / (h * w)
+        cost = w_prev * ssd_prev + w_corr * ssd_corr
+        ref = max(w_prev, w_corr)
+        if m.any():
+            cost += a / (m.sum() * c) * ((win - old) ** 2)[:, :, m].sum(axis=(2, 3))
+            ref = a / (m.sum() * c)
+        assert r.best_error * ref == pytest.approx(cost.min(), rel=1e-4)
+        assert (w_prev * ssd_prev).mean() > 0.05 * cost.mean()  # the term is not negligible
+        x, y = r.source[:2]
+        assert r.match_error * ref == pytest.approx(cost[y, x], rel=1e-4)
+        canvas[y0 : y0 + h, x0 : x0 + w][~r.keep_old if r.keep_old is not None else ...] = sample[
+            y : y + h, x : x + w
+        ][~r.keep_old if r.keep_old is not None else ...]
+        filled[y0 : y0 + h, x0 : x0 + w] = True
