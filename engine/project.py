@@ -288,6 +288,15 @@ def _as_float(a, what: str) -> np.ndarray:
 # ---------------------------------------------------------------- consistency
 
 
+def _finite_number(v) -> bool:
+    if isinstance(v, bool) or not isinstance(v, numbers.Real):
+        return False
+    try:
+        return math.isfinite(v)
+    except OverflowError:  # an int beyond the float range
+        return False
+
+
 def _check_project(p: Project, where: str) -> None:
     """Cross-field checks shared by building, saving and loading; raises ValueError."""
     if not isinstance(p, Project):
@@ -326,14 +335,8 @@ def _check_project(p: Project, where: str) -> None:
         if m not in p.sources or k not in MAP_KINDS:
             raise ValueError(f"{where}: map_kinds has a bad entry {m!r}: {k!r}")
     for m, w in p.map_weights.items():
-        if (
-            m not in p.sources
-            or isinstance(w, bool)
-            or not isinstance(w, numbers.Real)
-            or not math.isfinite(w)
-            or w < 0
-        ):
-            raise ValueError(f"{where}: map_weights has a bad entry {m!r}: {w!r}")
+        if m not in p.sources or not _finite_number(w) or w < 0:
+            raise ValueError(f"{where}: map_weights has a bad entry {m!r}: {w!r:.40}")
     if p.template_rect is not None:
         r = p.template_rect
         if (
@@ -386,13 +389,15 @@ def _check_project(p: Project, where: str) -> None:
                 f"{where}: candidates[{i}].patch_origin must be (row, col) integers or None"
             )
         if c.seed is not None and (
-            isinstance(c.seed, bool) or not isinstance(c.seed, numbers.Integral)
+            isinstance(c.seed, bool)
+            or not isinstance(c.seed, numbers.Integral)
+            or not 0 <= c.seed < 2**64
         ):
-            raise ValueError(f"{where}: candidates[{i}].seed must be an integer or None")
-        if c.score is not None and (
-            isinstance(c.score, bool) or not isinstance(c.score, numbers.Real)
-        ):
-            raise ValueError(f"{where}: candidates[{i}].score must be a number or None")
+            raise ValueError(
+                f"{where}: candidates[{i}].seed must be an integer in [0, 2**64) or None"
+            )
+        if c.score is not None and not _finite_number(c.score):
+            raise ValueError(f"{where}: candidates[{i}].score must be a finite number or None")
         if not isinstance(c.locked, bool) or not isinstance(c.params, dict):
             raise ValueError(f"{where}: candidates[{i}].locked must be a bool and params a dict")
     n = len(p.candidates)
@@ -660,9 +665,13 @@ def load_project(
             fail("missing project.json (not a Quilt Studio project)")
         raw = read("project.json", MAX_JSON_BYTES)
         try:
-            doc = json.loads(raw.decode("utf-8"))
+            doc = json.loads(raw.decode("utf-8"), parse_constant=_no_constant)
         except (UnicodeDecodeError, json.JSONDecodeError) as exc:
             fail(f"project.json is not valid JSON ({exc})")
+        except _NotJSON as exc:
+            fail(f"project.json is not valid JSON ({exc} is not a JSON number)")
+        except RecursionError:
+            fail("project.json is nested too deeply; refused")
         project = _from_doc(
             doc, fail, lambda entry: _read_image(entry, read, fail, max_pixels, max_entry_bytes)
         )
@@ -671,6 +680,15 @@ def load_project(
     except (TypeError, ValueError) as exc:
         fail(str(exc))
     return project
+
+
+class _NotJSON(ValueError):
+    pass
+
+
+def _no_constant(name: str):
+    """NaN / Infinity / -Infinity: Python's extension, not JSON (and nothing we write)."""
+    raise _NotJSON(name)
 
 
 def _read_image(entry, read, fail, max_pixels, cap) -> np.ndarray:

@@ -64,6 +64,9 @@ __all__ = [
 BUNDLE_FORMAT = "quilt-studio-bundle"
 BUNDLE_VERSION = 1
 _SAFE_NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]*$")
+MAX_PREVIEW_PIXELS = 2**26
+"""Largest preview assembled from the layout (8192 x 8192): a hostile or mistaken layout must
+not exhaust the memory."""
 
 
 class ExportError(OSError):
@@ -537,6 +540,13 @@ def export_bundle(
         atlases[m] = fname
     previews = {}
     if preview is None and mat is not None:
+        px = mat.shape[0] * th * mat.shape[1] * tw
+        if px > MAX_PREVIEW_PIXELS:
+            raise ValueError(
+                f"the layout preview would be {mat.shape[1] * tw}x{mat.shape[0] * th} px, over "
+                f"the limit of {MAX_PREVIEW_PIXELS:,} pixels: use a smaller layout or pass a "
+                "preview image"
+            )
         preview = {m: assemble_layout([qt[m] for qt in q_tiles], mat) for m in maps}
     for m, img in (preview or {}).items():
         fname = f"{name}_preview_{m}.{tile_format}"

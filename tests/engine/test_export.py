@@ -392,6 +392,9 @@ def test_bundle_validates_inputs(tmp_path):
         )
     with pytest.raises(ValueError, match="spacing"):
         export_bundle(tmp_path / "x", name="a", tiles=tiles, spacing=-1)
+    # a layout whose preview would not fit in memory (here 12 000 x 10 800 px) is refused
+    with pytest.raises(ValueError, match="layout preview would be 12000x10800 px"):
+        export_bundle(tmp_path / "x", name="a", tiles=tiles, index_matrix=np.zeros((900, 1200)))
     assert not (tmp_path / "x").exists()
 
 
@@ -479,6 +482,51 @@ def test_unwritable_system_folder_real():
         export_bundle("/sys/fs/quilt_bundle", name="a", tiles=make_tiles(1))
     assert "nothing was written" in str(info.value)
     assert not Path("/sys/fs/quilt_bundle").exists()
+
+
+@pytest.fixture
+def tmpfs(tmp_path):
+    """Mount small tmpfs file systems under ``tmp_path`` (root only; unmounted afterwards):
+    a real full disk and a real read-only folder, which root's permissions cannot fake."""
+    import subprocess
+
+    if not hasattr(os, "geteuid") or os.geteuid() != 0:
+        pytest.skip("mounting a tmpfs needs root (the permission-based tests cover other users)")
+    mounted = []
+
+    def mount(name: str, options: str) -> Path:
+        point = tmp_path / name
+        point.mkdir()
+        res = subprocess.run(
+            ["mount", "-t", "tmpfs", "-o", options, "tmpfs", str(point)], capture_output=True
+        )
+        if res.returncode:
+            pytest.skip(f"cannot mount a tmpfs here: {res.stderr.decode().strip()}")
+        mounted.append(point)
+        return point
+
+    yield mount
+    for point in mounted:
+        subprocess.run(["umount", str(point)], capture_output=True)
+
+
+def test_real_full_disk_and_read_only_file_system(tmpfs):
+    tiles = make_tiles(12, h=64, w=64)  # ~300 kB of PNGs
+    full = tmpfs("full", "size=128k")
+    with pytest.raises(ExportError, match="disk is full") as info:
+        export_bundle(full / "b", name="a", tiles=tiles, index_matrix=np.zeros((3, 4), int))
+    assert info.value.errno == errno.ENOSPC and list(full.iterdir()) == []
+    # replacing a bundle that fits by one that does not keeps the old one, byte for byte
+    export_bundle(full / "b", name="a", tiles=make_tiles(2, h=8, w=8))
+    before = {p.name: p.read_bytes() for p in (full / "b").iterdir()}
+    with pytest.raises(ExportError, match="disk is full"):
+        export_bundle(full / "b", name="a", tiles=tiles, overwrite=True)
+    assert {p.name: p.read_bytes() for p in (full / "b").iterdir()} == before
+    assert [p.name for p in full.iterdir()] == ["b"]
+    ro = tmpfs("ro", "size=128k,ro")
+    with pytest.raises(ExportError, match="read-only file system"):
+        export_bundle(ro / "b", name="a", tiles=make_tiles(1))
+    assert list(ro.iterdir()) == []
 
 
 @pytest.mark.parametrize("maps", [("albedo", "height"), ("rgba",)])

@@ -246,6 +246,12 @@ def test_corrupt_entry_is_refused(tmp_path, good):
         (lambda d: d.__setitem__("bit_depth", 12), "bit_depth must be 8 or 16"),
         (lambda d: d["candidates"][1].__setitem__("locked", "yes"), "candidates[1].locked"),
         (lambda d: d["candidates"][1].__setitem__("seed", 1.5), "candidates[1].seed"),
+        (lambda d: d["candidates"][1].__setitem__("seed", -1), "candidates[1].seed"),
+        (lambda d: d["candidates"][1].__setitem__("seed", 2**64), "candidates[1].seed"),
+        (lambda d: d["candidates"][1].__setitem__("score", 10**400), "candidates[1].score"),
+        (lambda d: d["candidates"][1].__setitem__("score", float("nan")), "NaN is not a JSON"),
+        (lambda d: d["parameters"].__setitem__("x", float("-inf")), "-Infinity is not a JSON"),
+        (lambda d: d.__setitem__("map_weights", {"albedo": 10**400}), "map_weights"),
         (lambda d: d.__setitem__("layout", [[0, 1], [2]]), "layout"),
         (lambda d: d.__setitem__("layout", [[0, 7]]), "layout cells"),
         (lambda d: d.__setitem__("template_rect", [1, 2, 3]), "template_rect"),
@@ -274,6 +280,10 @@ def test_not_json_and_not_zip(tmp_path, good):
     with zipfile.ZipFile(bad, "w") as zf:
         zf.writestr("project.json", b"{not json")
     expect_refused(bad, "not valid JSON")
+    deep = tmp_path / "deep.quiltproj"  # 1 MB of brackets: Python's parser would recurse out
+    with zipfile.ZipFile(deep, "w", zipfile.ZIP_DEFLATED) as zf:
+        zf.writestr("project.json", b"[" * 2**19 + b"]" * 2**19)
+    expect_refused(deep, "nested too deeply")
     (tmp_path / "plain.quiltproj").write_text("hello")
     expect_refused(tmp_path / "plain.quiltproj", "not a zip")
     (tmp_path / "empty.quiltproj").write_bytes(b"")
