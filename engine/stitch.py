@@ -17,6 +17,7 @@ same cut can be applied to other co-registered maps (normal, height, ...) with `
 
 from __future__ import annotations
 
+import math
 import numbers
 from dataclasses import dataclass
 from typing import NamedTuple
@@ -659,11 +660,7 @@ def patch_cut(
     labels, _ = ndimage.label(~barrier)
     border = np.concatenate([labels[0], labels[-1], labels[:, 0], labels[:, -1]])
     mask = ~np.isin(labels, np.unique(border[border > 0]))
-    if blend == "none":
-        alpha = mask.astype(np.float32)
-    else:
-        _, idx = ndimage.distance_transform_edt(~barrier, return_indices=True)
-        alpha = ramp_from_mask(mask, b_at[idx[0], idx[1]])
+    alpha = mask.astype(np.float32) if blend == "none" else _ring_ramp(mask, barrier, b_at, wp)
     if m:
         alpha[:m] = 0
         alpha[-m:] = 0
@@ -674,6 +671,40 @@ def patch_cut(
     return PatchCut(
         alpha, mask, loop, (tl, tr, br, bl), sides, float(values.sum()), float(values.max()), d
     )
+
+
+def _loop_ramp(mask: np.ndarray, barrier: np.ndarray, b_at: np.ndarray) -> np.ndarray:
+    """EDT ramp of ``mask`` whose half-width is read at the loop pixel nearest to each pixel."""
+    _, idx = ndimage.distance_transform_edt(~barrier, return_indices=True)
+    return ramp_from_mask(mask, b_at[idx[0], idx[1]])
+
+
+def _ring_ramp(mask: np.ndarray, barrier: np.ndarray, b_at: np.ndarray, ring: int) -> np.ndarray:
+    """:func:`_loop_ramp` computed only where it can differ from the hard mask.
+
+    The loop lies in the outer ``ring`` pixels and a pixel is blended only within ``b`` of the
+    mask's boundary, so everything further than ``ring + r`` from the window border (``r``:
+    the largest half-width plus a few pixels of slack for the nearest-pixel look-ups) is hard.
+    The ramp is computed on four border strips of width ``ring + 2 r``, each kept where every
+    pixel within ``r`` of it lies in the strip (what the distance transforms see there is what
+    they see in the whole window); windows too small for that get the whole-window ramp.
+    """
+    ph, pw = mask.shape
+    r = math.ceil(float(b_at.max())) + 3
+    d = ring + 2 * r
+    if 4 * d * max(ph, pw) >= ph * pw:
+        return _loop_ramp(mask, barrier, b_at)
+    alpha = mask.astype(np.float32)
+    k = d - r  # rows (columns) of a strip whose r-neighbourhood lies inside it
+    every = slice(None)
+    for src, dst, part in (
+        ((slice(0, d), every), (slice(0, k), every), (slice(0, k), every)),
+        ((slice(ph - d, ph), every), (slice(ph - k, ph), every), (slice(d - k, d), every)),
+        ((every, slice(0, d)), (every, slice(0, k)), (every, slice(0, k))),
+        ((every, slice(pw - d, pw)), (every, slice(pw - k, pw)), (every, slice(d - k, d))),
+    ):
+        alpha[dst] = _loop_ramp(mask[src], barrier[src], b_at[src])[part]
+    return alpha
 
 
 def _side_half_widths(seam: Seam, ce: np.ndarray, blend: str, width: float, rho: int):

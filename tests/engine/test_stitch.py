@@ -362,6 +362,34 @@ def test_patch_cut_follows_low_error_and_applies_to_other_maps():
     np.testing.assert_array_equal(cut.apply(m1, m2), np.where(cut.mask, m1, m2).astype(np.float32))
 
 
+def test_patch_ramp_on_border_strips_equals_the_whole_window_ramp(monkeypatch):
+    """The blend ramp is computed on four border strips (the loop lies in the ring): the same
+    alpha, bit for bit, as the distance transforms of the whole window."""
+    import engine.stitch as st
+
+    rng = np.random.default_rng(21)
+    strips = []
+    ring_ramp = st._ring_ramp
+
+    def spy(mask, barrier, b_at, ring):
+        whole = st._loop_ramp(mask, barrier, b_at)
+        fast = ring_ramp(mask, barrier, b_at, ring)
+        d = ring + 2 * (st.math.ceil(float(b_at.max())) + 3)
+        strips.append(4 * d * max(mask.shape) < mask.size)  # the strips path was taken
+        np.testing.assert_array_equal(fast, whole)
+        return fast
+
+    monkeypatch.setattr(st, "_ring_ramp", spy)
+    for k in range(6):
+        ph, pw = (int(v) for v in rng.integers(150, 260, 2))
+        q = ndimage.gaussian_filter(rng.random((ph, pw, 3)), (1.5, 1.5, 0))
+        u = ndimage.gaussian_filter(rng.random((ph, pw, 3)), (1.5, 1.5, 0))
+        method = ("dp", "dijkstra", "oscillating")[k % 3]
+        for blend in ("adaptive", "feather"):
+            patch_cut(q, u, ring=int(rng.integers(4, 14)), method=method, blend=blend, width=9)
+    assert len(strips) == 12 and all(strips)
+
+
 def test_patch_bad_input():
     q, u = pair(40, 40)
     with pytest.raises(ValueError, match="margin must be smaller than ring"):
