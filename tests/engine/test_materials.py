@@ -194,3 +194,54 @@ def test_apply_cut_validates(overlap):
     # declaring a 3-channel map as "color" blends it linearly instead
     lin = apply_cut(r1, r2, a, kinds={"normal": "color"})
     assert np.allclose(lin["normal"], 0.5 * r1["normal"] + 0.5 * r2["normal"], atol=1e-6)
+
+
+# ------------------------------------------------------------------ through the tile pipeline
+
+
+def test_exported_material_tiles_share_every_cut_and_keep_unit_normals(tmp_path):
+    """Seamless tile + candidates with a normal and a height map, exported as a bundle: every
+    exported normal has unit length within 8-bit quantization, and every map is cut at the
+    same pixels. The maps are functions of the albedo pixel (normal = f(rgb), height = g(rgb)),
+    so with hard cuts f(albedo) == normal holds at every exported pixel exactly iff every map
+    took each pixel from the same place; with the patches' cut blended it fails only inside
+    their blend bands (the template is cut hard in both runs)."""
+    from engine.export import export_bundle
+    from engine.export._png import decode_png
+    from engine.tiles.candidates import candidates
+    from engine.tiles.seamless import make_seamless
+
+    def q8(a):
+        return quantize(a, 8, dither=False).astype(np.float32) / 255
+
+    def f_normal(rgb):
+        v = 2 * rgb.astype(np.float64) - 1
+        v[..., 2] = np.abs(v[..., 2]) + 0.3
+        return q8(encode_normals(v / np.linalg.norm(v, axis=-1, keepdims=True)))
+
+    def g_height(rgb):
+        return q8(rgb.mean(axis=-1, keepdims=True))
+
+    g = np.random.default_rng(4)
+    albedo = q8(np.clip(g.normal(0.5, 0.15, (72, 72, 3)), 0, 1))
+    maps = {"normal": f_normal(albedo), "height": g_height(albedo)}
+    tmpl = make_seamless(albedo, (8, 8, 40, 36), overlap=8, maps=maps, blend="none")
+    for blend in ("none", "adaptive"):  # the patches' cut: hard, or blended
+        cands = candidates(albedo, tmpl, 4, maps=maps, blend=blend, rng=1, workers=1)
+        tiles = [{"albedo": c.tile, **c.maps} for c in cands]
+        out = tmp_path / blend
+        man = export_bundle(out, name="m", tiles=tiles, normal_convention="opengl")
+        assert man["normal_convention"] == "opengl"
+        for c, entry in zip(cands, man["tiles"], strict=True):
+            codes = {m: decode_png((out / entry["files"][m]).read_bytes()) for m in tiles[0]}
+            read = {m: (v / np.float32(255)).astype(np.float32) for m, v in codes.items()}
+            length = np.linalg.norm(decode_normals(read["normal"]), axis=2)
+            assert np.abs(length - 1).max() < np.sqrt(3) / 255 + 2e-3  # source's own rounding
+            same = np.all(codes["normal"] == quantize(f_normal(read["albedo"]), 8), axis=2)
+            same &= np.all(codes["height"] == quantize(g_height(read["albedo"]), 8), axis=2)
+            assert (~np.all(read["albedo"] == tmpl.tile, axis=2)).mean() > 0.2  # a real patch
+            if blend == "none":
+                assert same.all()
+            else:
+                band = (c.alpha > 0) & (c.alpha < 1)
+                assert band.any() and same[~band].all() and not same[band].all()
