@@ -458,7 +458,9 @@ def l_cut(
 
     The old region is the cut plus everything on its outer (top-left) side; new pockets the
     cut encloses join the old side, so old and new are each one 4-connected region when the
-    block has an interior outside the overlaps.
+    block has an interior outside the overlaps. The cut's own pixels are old, as R1 keeps the
+    path in every :class:`engine.seams.Seam` mask (ALGORITHMS §2.3 gives them to the new block,
+    §0 to R1: one pixel of difference along the cut).
     """
     e = np.ascontiguousarray(as_error_map(error))
     bh, bw = e.shape

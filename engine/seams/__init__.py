@@ -351,7 +351,8 @@ def find_seam(error, *, method: str = "dp", **kwargs) -> Seam:
 def warmup() -> None:
     """Compile (or load from the numba cache) every seam kernel on a tiny input.
 
-    The GUI calls this in a worker thread at start-up.
+    About 0.2 s with a warm cache (a first compile takes seconds). Call it in a worker thread at
+    start-up so that the first seam a person asks for is not delayed by it.
     """
     rng = np.random.default_rng(0)
     e = rng.random((4, 3))

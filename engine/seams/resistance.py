@@ -3,11 +3,17 @@
 From the start pixel the walk repeatedly steps to the cheapest allowed neighbour among down,
 down-left, down-right, left and right (never up). A step's cost is the error of the pixel
 stepped on, or, given the new block's colours ``image``, the colour distance between the two
-pixels (Bhatia's intra-block step). Allowed: inside the map, not visited before, no more than
-``max_run`` consecutive pixels in one row or one column, and — towards a pinned point (end or
-waypoint) — inside the cone of pixels from which it stays reachable. When nothing is allowed the
+pixels (Bhatia's intra-block step; ALGORITHMS §4 makes that the default and the error the
+option: the error map is all a seam method is given, so here it is the default). Allowed:
+inside the map, not visited before, no more than ``max_run`` consecutive pixels in one row or
+one column, and — towards a pinned point (end or waypoint) — inside the cone of pixels from
+which it stays reachable. When nothing is allowed the
 walk steps down (diagonally towards a pinned point when the cone demands it). The walk ends on
 reaching the bottom row, or the pinned end point.
+
+One walk from the top row down, not §4's two lines from the block's corners that meet: an
+overlap strip's ends are free, so nothing has to meet; ``start`` / ``end`` pin a corner-to-corner
+cut (as :mod:`engine.quilting` does for Bhatia's blocks).
 """
 
 from __future__ import annotations
