@@ -252,7 +252,8 @@ def test_connectability_and_variety_on_samples():
     """Acceptance: 30 candidates per sample; all ordered pairs, h and v: median border
     ratio <= 1.2 and max <= 1.6; an 8x8 preview of 8 picked tiles has a grid score at most
     0.35 x that of the template repeated."""
-    for name in ("brick", "cobblestones", "gravel", "lichen"):
+    assert len(resources.SAMPLE_NAMES) >= 5  # brick, grass, gravel, cobblestones, lichen
+    for name in resources.SAMPLE_NAMES:
         S = load_image(resources.sample_path(name)).pixels
         st = make_seamless(S, find_template(S, tile_min=256, tile_max=256))
         cands = candidates(S, st, 30, rng=0, workers=2)
