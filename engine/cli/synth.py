@@ -75,6 +75,13 @@ def add_cut_arguments(p: argparse.ArgumentParser, *, seam_default: str = "dp") -
     p.add_argument(
         "--threads", type=int_at_least(1), default=None, help="worker threads (default: every core)"
     )
+    p.add_argument(
+        "--bit-depth",
+        type=int,
+        choices=(8, 16),
+        default=None,
+        help="output bits per channel (default: the sample's; 16 -> 8 is dithered)",
+    )
     p.add_argument("-o", "--output", required=True, metavar="OUT.png", help="output image")
 
 
@@ -176,11 +183,45 @@ def drive(gen, printer):
 
 
 def load_sample_and_exclusion(args):
-    """(pixels, bit depth, excluded mask or None) from SAMPLE, --exclude-color/--exclude-mask."""
+    """(pixels, output bit depth, excluded mask or None) from SAMPLE, --bit-depth and
+    --exclude-color/--exclude-mask; the output paths are checked first (not after the run).
+    Sets ``args.dither`` when a 16-bit sample is written at 8 bits."""
     from engine.io import load_image
 
     loaded = load_image(args.sample)
-    return loaded.pixels, loaded.bit_depth, excluded_pixels(args, loaded.pixels, "sample")
+    depth = args.bit_depth or loaded.bit_depth
+    args.dither = depth < loaded.bit_depth
+    check_output(args.output, depth, loaded.pixels.shape[2])
+    seams = getattr(args, "save_seams", None)
+    if seams and Path(seams).suffix.lower() != ".json":
+        check_output(seams, 8, 3)
+    return loaded.pixels, depth, excluded_pixels(args, loaded.pixels, "sample")
+
+
+def check_output(path: str, depth: int, channels: int) -> None:
+    """Refuse an output :func:`engine.io.save_image` could not write, before any work."""
+    from engine.io import WRITE_SUFFIXES
+
+    suffix = Path(path).suffix.lower()
+    if suffix not in WRITE_SUFFIXES:
+        raise ValueError(
+            f"{path}: unsupported output format {suffix or '(no suffix)'} "
+            f"(use one of {', '.join(WRITE_SUFFIXES)})"
+        )
+    if depth == 16 and suffix not in (".png", ".tif", ".tiff"):
+        raise ValueError(f"{path}: 16-bit output needs .png or .tif (or --bit-depth 8)")
+    if channels in (2, 4) and suffix in (".jpg", ".jpeg", ".bmp"):
+        raise ValueError(f"{path}: {suffix} cannot store the sample's alpha; use .png or .tif")
+
+
+def save_output(args, image, depth: int) -> None:
+    """Write the result at ``depth`` bits; a 16-bit sample reduced to 8 bits is dithered."""
+    from engine.export import quantize
+    from engine.io import save_image
+
+    if args.dither:
+        image = quantize(image, 8, dither=True, rng=args.seed)
+    save_image(args.output, image, bit_depth=depth)
 
 
 def start(iter_fn, *args, **kwargs):
@@ -207,7 +248,6 @@ def cut_options(args) -> dict:
 
 
 def run(args) -> int:
-    from engine.io import save_image
     from engine.quilting import grid_border_ratio, iter_quilt
 
     sample, depth, excluded = load_sample_and_exclusion(args)
@@ -227,7 +267,7 @@ def run(args) -> int:
         **cut_options(args),
     )
     res = drive(gen, ProgressPrinter("synth"))
-    save_image(args.output, res.image, bit_depth=depth)
+    save_output(args, res.image, depth)
     if args.save_seams:
         save_seams(args.save_seams, res)
     ratio = grid_border_ratio(res) if min(res.image.shape[:2]) > max(res.step) else float("nan")
@@ -267,8 +307,13 @@ def save_seams(path: str, res) -> None:
             "seam": res.seam,
             "blocks": blocks,
         }
-        p.parent.mkdir(parents=True, exist_ok=True)
-        p.write_text(json.dumps(doc))
+        from engine.cli.tileset import _write_bytes
+
+        try:
+            p.parent.mkdir(parents=True, exist_ok=True)
+            _write_bytes(p, json.dumps(doc).encode("utf-8"))  # atomic: all or nothing
+        except OSError as exc:
+            raise OSError(f"{p}: cannot write ({exc.strerror or exc})") from None
         return
     img = np.repeat(res.image[..., :1], 3, axis=2) if res.image.shape[2] < 3 else res.image[..., :3]
     img = img.copy()

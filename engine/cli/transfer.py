@@ -17,6 +17,7 @@ from engine.cli.synth import (
     cut_options,
     drive,
     load_sample_and_exclusion,
+    save_output,
     start,
 )
 
@@ -91,7 +92,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def run(args) -> int:
-    from engine.io import load_image, save_image
+    from engine.io import load_image
     from engine.transfer import iter_transfer
 
     sample, depth, excluded = load_sample_and_exclusion(args)
@@ -110,7 +111,7 @@ def run(args) -> int:
         **cut_options(args),
     )
     res = drive(gen, ProgressPrinter("transfer"))
-    save_image(args.output, res.image, bit_depth=depth)
+    save_output(args, res.image, depth)
     errs = ", ".join(f"{it.correspondence_error:.4f}" for it in res.iterations)
     print(
         f"quilt-studio transfer: wrote {args.output} ({res.image.shape[1]}x{res.image.shape[0]}, "

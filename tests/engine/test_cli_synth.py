@@ -1,8 +1,11 @@
 import json
+import time
 
 import numpy as np
 import pytest
+from scipy import ndimage
 
+from engine import metrics
 from engine.cli import main
 from engine.io import load_image, save_image
 
@@ -83,30 +86,50 @@ def test_synth_exclude_color_and_bhatia(sample_png, tmp_path):
     assert not ((px[..., 0] > 0.9) & (px[..., 1] < 0.1)).any()
 
 
-def test_synth_keeps_16_bit_and_tileable(tmp_path):
+def test_synth_keeps_16_bit_exact_copies_and_tileable(tmp_path):
+    """16-bit in, 16-bit out, every value an exact copy of a sample pixel (hard cuts); the
+    tileable output tiled 2 x 2 shows no wrap joint; 8 bits only on request, dithered."""
+    rng = np.random.default_rng(1)
+    q = (ndimage.uniform_filter(rng.random((48, 48, 3)), (5, 5, 1)) * 65535).astype(np.uint16)
+    src = tmp_path / "s16.png"
+    save_image(src, q, bit_depth=16)
+    out = tmp_path / "o16.png"
+    argv = ["synth", str(src), "--size", "72x60", "--block", "16", "--tileable", "--seed", "2"]
+    argv += ["--mode", "fast"]
+    assert main([*argv, "-o", str(out)]) == 0
+    assert png_bit_depth(out) == 16
+    got = np.round(load_image(out).pixels * 65535).astype(np.uint16)
+    sample_values = {tuple(v) for v in q.reshape(-1, 3)}
+    assert all(tuple(v) in sample_values for v in got.reshape(-1, 3))
+    assert len({tuple(v) for v in got.reshape(-1, 3)}) > 1000
+    assert metrics.grid_border_ratio(np.tile(got / 65535, (2, 2, 1)), got.shape[:2]) < 1.4
+    out8 = tmp_path / "o8.png"
+    assert main([*argv, "--bit-depth", "8", "-o", str(out8)]) == 0
+    assert png_bit_depth(out8) == 8
+    got8 = np.round(load_image(out8).pixels * 255)
+    rounded = np.round(got / 65535 * 255)
+    assert np.abs(got8 - rounded).max() <= 1 and (got8 != rounded).mean() > 0.2  # dithered
+    assert main([*argv, "--bit-depth", "8", "-o", str(tmp_path / "o8.jpg")]) == 0
+
+
+def test_synth_checks_outputs_before_the_run_and_writes_seams_atomically(tmp_path, capsys):
     rng = np.random.default_rng(1)
     src = tmp_path / "s16.png"
     save_image(src, rng.random((40, 40, 3)), bit_depth=16)
-    out = tmp_path / "o16.png"
-    assert (
-        main(
-            [
-                "synth",
-                str(src),
-                "--size",
-                "60x60",
-                "--block",
-                "16",
-                "--tileable",
-                "--mode",
-                "fast",
-                "-o",
-                str(out),
-            ]
-        )
-        == 0
-    )
-    assert png_bit_depth(out) == 16
+    big = ["synth", str(src), "--size", "4000x4000", "--block", "16"]
+    t0 = time.perf_counter()
+    for out, message in (("x.xyz", "unsupported output format .xyz"), ("x.jpg", "16-bit")):
+        assert main([*big, "-o", str(tmp_path / out)]) == 1
+        assert message in capsys.readouterr().err
+    assert time.perf_counter() - t0 < 5  # refused before synthesizing 4000 x 4000 px
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    seams = blocker / "seams.json"  # a folder that cannot exist: under a regular file
+    small = ["synth", str(src), "--size", "40x40", "--block", "16", "-o", str(tmp_path / "o.png")]
+    assert main([*small, "--save-seams", str(seams)]) == 1
+    err = capsys.readouterr().err
+    assert f"{seams}: cannot write" in err and "Traceback" not in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["file", "o.png", "s16.png"]
 
 
 def test_transfer_cli(sample_png, tmp_path, capsys):
