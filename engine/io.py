@@ -51,6 +51,7 @@ __all__ = [
     "LoadedImage",
     "READ_SUFFIXES",
     "WRITE_SUFFIXES",
+    "check_output",
     "load_image",
     "save_image",
     "to_rgb",
@@ -292,6 +293,26 @@ def _write_problem(folder: Path, exc: OSError) -> str:
     return exc.strerror or str(exc)
 
 
+def check_output(path, *, bit_depth: int = 8, channels: int = 3) -> Path:
+    """Refuse, before any work, an output that :func:`save_image` could not write in that
+    format: an unknown suffix, 16 bits in anything but PNG / TIFF, alpha (``channels`` 2 or
+    4) in JPEG / BMP. Raises :class:`ImageError` naming the file; writes nothing."""
+    p = Path(os.fspath(path))
+    if isinstance(bit_depth, bool) or bit_depth not in (8, 16):
+        raise ValueError(f"bit_depth must be 8 or 16, got {bit_depth!r}")
+    suffix = p.suffix.lower()
+    if suffix not in WRITE_SUFFIXES:
+        raise ImageError(
+            f"{p}: unsupported output format {suffix or '(no suffix)'} "
+            f"(use one of {', '.join(WRITE_SUFFIXES)})"
+        )
+    if bit_depth == 16 and suffix not in (".png", ".tif", ".tiff"):
+        raise ImageError(f"{p}: 16-bit output needs .png or .tif, not {suffix}")
+    if channels in (2, 4) and suffix in (".jpg", ".jpeg", ".bmp"):
+        raise ImageError(f"{p}: {suffix} cannot store an alpha channel; use .png or .tif")
+    return p
+
+
 def save_image(path, pixels, *, bit_depth: int = 8) -> Path:
     """Write float (H, W[, C]) pixels in [0, 1] (or uint8/uint16) to an image file, atomically.
 
@@ -302,24 +323,13 @@ def save_image(path, pixels, *, bit_depth: int = 8) -> Path:
     from engine.export import _umask, quantize
 
     p = Path(os.fspath(path))
-    if isinstance(bit_depth, bool) or bit_depth not in (8, 16):
-        raise ValueError(f"bit_depth must be 8 or 16, got {bit_depth!r}")
     a = np.asarray(pixels)
     if a.ndim == 3 and a.shape[2] == 1:
         a = a[:, :, 0]
     if a.ndim not in (2, 3) or (a.ndim == 3 and a.shape[2] not in (2, 3, 4)) or 0 in a.shape:
         raise ValueError(f"pixels must be shaped (H, W) or (H, W, 1-4), got {np.shape(pixels)}")
-    suffix = p.suffix.lower()
-    if suffix not in WRITE_SUFFIXES:
-        raise ImageError(
-            f"{p}: unsupported output format {suffix or '(no suffix)'} "
-            f"(use one of {', '.join(WRITE_SUFFIXES)})"
-        )
-    if bit_depth == 16 and suffix not in (".png", ".tif", ".tiff"):
-        raise ImageError(f"{p}: 16-bit output needs .png or .tif, not {suffix}")
     channels = 1 if a.ndim == 2 else a.shape[2]
-    if channels in (2, 4) and suffix in (".jpg", ".jpeg", ".bmp"):
-        raise ImageError(f"{p}: {suffix} cannot store an alpha channel; use .png or .tif")
+    suffix = check_output(p, bit_depth=bit_depth, channels=channels).suffix.lower()
     q = quantize(a, bit_depth, dither=False)
     try:
         p.parent.mkdir(parents=True, exist_ok=True)

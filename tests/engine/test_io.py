@@ -204,6 +204,23 @@ def test_unsupported_mode(tmp_path, kind):
         load_image(path)
 
 
+def test_check_output_refuses_before_any_work(tmp_path):
+    from engine.io import check_output
+
+    assert check_output(tmp_path / "a.TIF", bit_depth=16, channels=4) == tmp_path / "a.TIF"
+    for name, kw, reason in (
+        ("x.gif", {}, r"unsupported output format \.gif"),
+        ("x", {}, r"unsupported output format \(no suffix\)"),
+        ("x.webp", {"bit_depth": 16}, r"16-bit output needs \.png or \.tif, not \.webp"),
+        ("x.bmp", {"channels": 2}, r"\.bmp cannot store an alpha channel"),
+    ):
+        with pytest.raises(ImageError, match=f"{name}: {reason}"):
+            check_output(tmp_path / name, **kw)
+    with pytest.raises(ValueError, match="bit_depth must be 8 or 16"):
+        check_output(tmp_path / "x.png", bit_depth=12)
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_save_errors(tmp_path):
     px = np.zeros((4, 4, 3))
     with pytest.raises(ImageError, match=r"x\.gif: unsupported output format \.gif"):
