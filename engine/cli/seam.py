@@ -83,7 +83,7 @@ def run(args) -> int:
 
     from engine.blend import blend_weights, composite
     from engine.errormap import error_map
-    from engine.io import load_image, save_image, to_rgb
+    from engine.io import check_output, load_image, save_image, to_rgb
     from engine.seams import find_seam
 
     if args.o_max is not None and args.method != "oscillating":
@@ -98,6 +98,14 @@ def run(args) -> int:
     r1, r2 = a.pixels, b.pixels
     if r1.shape[2] != r2.shape[2]:
         r1, r2 = to_rgb(r1), to_rgb(r2)
+    depth = max(a.bit_depth, b.bit_depth)
+    for path, bits, channels in (
+        (args.save_mask, 8, 1),
+        (args.save_composite, depth, r1.shape[2]),
+        (args.save_error, 16, 1),
+    ):
+        if path:
+            check_output(path, bit_depth=bits, channels=channels)  # before the search
     err = error_map(r1, r2, metric=args.metric)
     options = dict(args.seam_option)
     if args.o_max is not None:
@@ -115,7 +123,6 @@ def run(args) -> int:
         **options,
     )
     elapsed = time.perf_counter() - t0
-    depth = max(a.bit_depth, b.bit_depth)
     if args.save_mask:
         save_image(args.save_mask, seam.mask.astype(np.float32))
     if args.save_composite:

@@ -101,6 +101,11 @@ def test_errors_are_one_clear_line(capsys, overlap):
     assert code == 1 and err.count("\n") == 1 and "bad.png: not an image file" in err
     code, _, err = run(capsys, tmp / "missing.png", r2)
     assert code == 1 and "missing.png: no such file" in err
+    code, out, err = run(
+        capsys, r1, r2, "--save-mask", tmp / "m.png", "--save-error", tmp / "e.jpg"
+    )
+    assert code == 1 and out == "" and "e.jpg: 16-bit output needs .png or .tif" in err
+    assert not (tmp / "m.png").exists()  # refused before the search, nothing written
     code, _, err = run(capsys, r1, r2, "--method", "dp", "--o-max", 3)
     assert code == 1 and "--o-max applies to --method oscillating only" in err
     with pytest.raises(SystemExit):
