@@ -66,7 +66,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         default="png",
         help="format of the per-tile and preview files (atlases are always PNG)",
     )
-    p.add_argument("--seed", type=int, default=0, help="seed of the dither noise")
+    p.add_argument(
+        "--seed", type=int_at_least(0), default=0, help="seed of the dither noise (default 0)"
+    )
     p.add_argument("--overwrite", action="store_true", help="replace a non-empty --out folder")
     p.set_defaults(func=run)
     return p

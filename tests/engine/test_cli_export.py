@@ -87,8 +87,10 @@ def test_cli_export_errors_are_one_line(tmp_path, capsys):
         and "Traceback" not in err
     )
     assert not (tmp_path / "o").exists()
-    with pytest.raises(SystemExit):
-        main(["export", str(bad), "--out", str(tmp_path / "o"), "--spacing", "-1"])
+    for option in ("--spacing", "--seed"):
+        with pytest.raises(SystemExit):
+            main(["export", str(bad), "--out", str(tmp_path / "o"), option, "-1"])
+        assert f"argument {option}: must be >= 0" in capsys.readouterr().err
 
 
 def test_cli_export_subprocess(tmp_path, project_file):
