@@ -281,9 +281,10 @@ def iter_transfer(
     plans = []
     for i, (b, ov, _) in enumerate(sched, start=1):
         if b < 4 or ov >= b:
+            also = f" and overlap {overlap} to {ov} px" if ov >= b else ""
             raise ValueError(
-                f"iterations={n_iter} shrinks block {b1} to {b} px at iteration {i}: "
-                "use fewer iterations or a larger block"
+                f"iterations={n_iter} shrinks block {b1} to {b} px{also} at iteration {i}: "
+                "use fewer iterations, a larger block" + (" or a smaller overlap" if also else "")
             )
         plans.append(
             _check_options(

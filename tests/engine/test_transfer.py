@@ -159,6 +159,8 @@ def test_transfer_cancel_and_errors(cobbles):
         iter_transfer(cobbles, disc(), block=24, alpha=1.5)
     with pytest.raises(ValueError, match="iterations"):
         iter_transfer(cobbles, disc(), block=12, iterations=6)
+    with pytest.raises(ValueError, match="overlap 11 to 5 px at iteration 3.*smaller overlap"):
+        iter_transfer(cobbles, disc(), block=12, overlap=11, iterations=3)
     with pytest.raises(ValueError, match="correspondence"):
         iter_transfer(cobbles, disc(), block=24, correspondence="edges")
     with pytest.raises(ValueError, match="larger than the output"):
