@@ -150,6 +150,7 @@ def speed(args) -> None:
                 f"{base_t:.3f}",
                 "1.00",
                 "",
+                "",
                 f"{grid_border_ratio(_Grid(base_img, **kw)):.3f}",
             ]
         )
@@ -173,6 +174,7 @@ def speed(args) -> None:
                         f"{t:.3f}",
                         f"{base_t / t:.2f}",
                         "" if target is None else f"<= {target}",
+                        "" if target is None else ("yes" if t <= target else "NO"),
                         f"{grid_border_ratio(res):.3f}",
                     ]
                 )
@@ -188,6 +190,7 @@ def speed(args) -> None:
                 "median s",
                 "× baseline",
                 "target",
+                "met",
                 "grid border ratio",
             ],
             rows,
@@ -227,10 +230,18 @@ def streaming(args) -> None:
             ],
             max(args.repeats, 7),
         )
+        over = 100 * (t_stream / t_plain - 1)
         rows.append(
-            [job, f"{t_plain:.3f}", f"{t_stream:.3f}", f"{100 * (t_stream / t_plain - 1):+.1f} %"]
+            [
+                job,
+                f"{t_plain:.3f}",
+                f"{t_stream:.3f}",
+                f"{over:+.1f} %",
+                "<= 10 %",
+                "yes" if over <= 10 else "NO",
+            ]
         )
-    print(format_table(["job", "no events s", "streamed s", "overhead"], rows))
+    print(format_table(["job", "no events s", "streamed s", "overhead", "target", "met"], rows))
     print()
 
 

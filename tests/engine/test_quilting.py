@@ -61,6 +61,17 @@ def test_events_replay_to_the_result_and_records_are_consistent(cobbles):
     np.testing.assert_array_equal(canvas, res.image)
 
 
+def test_unstreamed_reference_is_the_same_run(cobbles):
+    """The benchmark's streaming-overhead reference creates no event but computes exactly what
+    quilt() returns (so "streaming adds <= 10 %" compares like with like)."""
+    kw = dict(block=24, overlap=4, rng=3, threads=1)
+    a = quilt(cobbles, (70, 90), **kw)
+    b = quilting._quilt_unstreamed(cobbles, (70, 90), **kw)
+    np.testing.assert_array_equal(a.image, b.image)
+    assert [r.source for r in a.blocks] == [r.source for r in b.blocks]
+    assert list(iter_quilt(cobbles, (70, 90), **kw))  # quilt() did drain events
+
+
 def test_best_choice_is_within_tolerance_of_brute_force(cobbles):
     """Replaying the events gives the content each block was matched against: the chosen
     window's recorded error is its brute-force SSD, and it is within 1 + tolerance of the
