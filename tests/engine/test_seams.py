@@ -125,6 +125,25 @@ def test_dp_constraints_equal_brute_force(shape):
                 assert abs(s.path[0, 1] - s.path[-1, 1]) <= 1
 
 
+def test_dp_cyclic_pruned_starts_give_the_path_of_trying_every_start():
+    """The cyclic DP tries start columns cheapest open bound first and stops early: the same
+    path (ties included: the smallest start) as one constrained DP per start in turn."""
+    from engine.seams.dp import _dp_pass
+
+    rng = np.random.default_rng(4)
+    for t in range(120):
+        h, w = int(rng.integers(2, 25)), int(rng.integers(1, 10))
+        e = [rng.random((h, w)), rng.integers(0, 3, (h, w)).astype(float), np.ones((h, w))][t % 3]
+        lo, hi = np.zeros(h, np.int64), np.full(h, w - 1, np.int64)
+        if t % 4 == 0:
+            lo[0] = hi[0] = rng.integers(w)
+        back, cols = np.zeros((h, w), np.int8), np.zeros(h, np.int64)
+        costs = [_dp_pass(e, lo, hi, s, back, cols) for s in range(lo[0], hi[0] + 1)]
+        _dp_pass(e, lo, hi, lo[0] + int(np.argmin(costs)), back, cols)
+        kw = {"start": int(lo[0])} if t % 4 == 0 else {}
+        np.testing.assert_array_equal(find_seam(e, cyclic=True, **kw).path[:, 1], cols)
+
+
 def test_dp_start_end_waypoint_unreachable():
     e = np.ones((3, 6))
     with pytest.raises(ValueError, match="no one-pixel-per-row"):
