@@ -124,3 +124,33 @@ def test_project_option_helpers(tmp_path):
     assert np.array_equal(
         p.candidates[1].maps["albedo"], np.round(src[8:, 8:] * 255) / np.float32(255)
     )
+
+
+def test_sixteen_bit_source_to_bundle_end_to_end(tmp_path):
+    """``tileset`` on a 16-bit PNG with a normal map, ``--project``, then ``export``: 16-bit
+    tiles whose every value is a copy of a source pixel (hard cuts: no blend anywhere), in
+    every map."""
+    from scipy import ndimage
+
+    from engine.io import save_image
+
+    g = np.random.default_rng(3)
+    smooth = ndimage.uniform_filter(g.random((96, 96, 3)), (7, 7, 1))
+    src = (smooth * 65535).astype(np.uint16)
+    normal = (np.clip(0.5 + (smooth - 0.5) * 0.4, 0, 1) * 65535).astype(np.uint16)
+    normal[..., 2] = 65535
+    save_image(tmp_path / "s.png", src, bit_depth=16)
+    save_image(tmp_path / "n.png", normal, bit_depth=16)
+    proj = tmp_path / "p.quiltproj"
+    argv = ["tileset", str(tmp_path / "s.png"), "--out", str(tmp_path / "ts"), "--blend", "none"]
+    argv += ["--candidates", "3", "--tile-min", "32", "--map", f"normal={tmp_path / 'n.png'}"]
+    assert main([*argv, "--project", str(proj)]) == 0
+    assert main(["export", str(proj), "--out", str(tmp_path / "b")]) == 0
+    man = json.loads((tmp_path / "b" / "tileset.json").read_text())
+    assert man["bit_depth"] == 16 and [m["name"] for m in man["maps"]] == ["albedo", "normal"]
+    for m, source in (("albedo", src), ("normal", normal)):
+        values = {tuple(v) for v in source.reshape(-1, 3)}
+        for t in man["tiles"]:
+            tile = decode_png((tmp_path / "b" / t["files"][m]).read_bytes())
+            assert tile.dtype == np.uint16
+            assert all(tuple(v) in values for v in tile.reshape(-1, 3)), (m, t["id"])
