@@ -74,6 +74,17 @@ def add_seam_options(p: argparse.ArgumentParser) -> None:
     )
 
 
+def add_bit_depth(p: argparse.ArgumentParser, source: str) -> None:
+    """``--bit-depth 8|16``: output bits per channel, by default those of ``source``."""
+    p.add_argument(
+        "--bit-depth",
+        type=int,
+        choices=(8, 16),
+        default=None,
+        help=f"output bits per channel (default: the {source}'s; 16 -> 8 is dithered)",
+    )
+
+
 def add_exclusion(p: argparse.ArgumentParser, image: str) -> None:
     """``--exclude-color LO:HI`` and ``--exclude-mask FILE`` for the pixels of ``image``."""
     p.add_argument(

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from engine.cli._args import int_at_least
+from engine.cli._args import add_bit_depth, int_at_least
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -47,13 +47,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         default="edge",
         help="bleed by repeating the edge pixel (default) or the opposite edge",
     )
-    p.add_argument(
-        "--bit-depth",
-        type=int,
-        choices=(8, 16),
-        default=None,
-        help="output bits per channel (default: the project's; 16 -> 8 is dithered)",
-    )
+    add_bit_depth(p, "project")
     p.add_argument(
         "--dither",
         action=argparse.BooleanOptionalAction,

@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from engine.cli._args import (
+    add_bit_depth,
     add_exclusion,
     add_seam_options,
     excluded_pixels,
@@ -75,13 +76,7 @@ def add_cut_arguments(p: argparse.ArgumentParser, *, seam_default: str = "dp") -
     p.add_argument(
         "--threads", type=int_at_least(1), default=None, help="worker threads (default: every core)"
     )
-    p.add_argument(
-        "--bit-depth",
-        type=int,
-        choices=(8, 16),
-        default=None,
-        help="output bits per channel (default: the sample's; 16 -> 8 is dithered)",
-    )
+    add_bit_depth(p, "sample")
     p.add_argument("-o", "--output", required=True, metavar="OUT.png", help="output image")
 
 
@@ -200,18 +195,14 @@ def load_sample_and_exclusion(args):
 
 def check_output(path: str, depth: int, channels: int) -> None:
     """Refuse an output :func:`engine.io.save_image` could not write, before any work."""
-    from engine.io import WRITE_SUFFIXES
+    from engine.io import ImageError
+    from engine.io import check_output as check
 
-    suffix = Path(path).suffix.lower()
-    if suffix not in WRITE_SUFFIXES:
-        raise ValueError(
-            f"{path}: unsupported output format {suffix or '(no suffix)'} "
-            f"(use one of {', '.join(WRITE_SUFFIXES)})"
-        )
-    if depth == 16 and suffix not in (".png", ".tif", ".tiff"):
-        raise ValueError(f"{path}: 16-bit output needs .png or .tif (or --bit-depth 8)")
-    if channels in (2, 4) and suffix in (".jpg", ".jpeg", ".bmp"):
-        raise ValueError(f"{path}: {suffix} cannot store the sample's alpha; use .png or .tif")
+    try:
+        check(path, bit_depth=depth, channels=channels)
+    except ImageError as exc:
+        hint = " (or pass --bit-depth 8)" if "16-bit" in str(exc) else ""
+        raise ImageError(f"{exc}{hint}") from None
 
 
 def save_output(args, image, depth: int) -> None:
