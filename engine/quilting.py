@@ -309,14 +309,30 @@ def grid_rects(out_shape, block, overlap: int, tileable: bool) -> list[tuple[int
     return rects
 
 
+def _torus_fits(n_out: int, block: int, overlap: int) -> bool:
+    """Evenly spaced blocks on a torus: each overlaps its two neighbours and no further one."""
+    spacing = np.diff([*axis_positions(n_out, block, overlap, True), n_out])
+    return block < n_out and spacing.max() < block and 2 * spacing.min() > block
+
+
+def _torus_overlap(n_out: int, block: int, overlap: int) -> int:
+    """The largest overlap <= ``overlap`` that fits a tileable axis (``overlap`` if none does)."""
+    return next((o for o in range(overlap, -1, -1) if _torus_fits(n_out, block, o)), overlap)
+
+
 def _check_torus_axis(n_out: int, block: int, overlap: int, axis: str) -> None:
-    pos = axis_positions(n_out, block, overlap, True)
-    spacing = np.diff([*pos, n_out])
-    if block >= n_out or spacing.max() >= block or 2 * spacing.min() <= block:
+    if _torus_fits(n_out, block, overlap):
+        return
+    if block < n_out and (fitting := _torus_overlap(n_out, block, overlap)) != overlap:
         raise ValueError(
-            f"a tileable output {axis} of {n_out} px does not fit blocks of {block} px with "
-            f"overlap {overlap}: choose an output {axis} of at least {2 * block} px"
+            f"a tileable output {axis} of {n_out} px with blocks of {block} px and overlap "
+            f"{overlap} puts blocks half a block or less apart (each would overlap more than its "
+            f"two neighbours): use an overlap of at most {fitting}"
         )
+    raise ValueError(
+        f"a tileable output {axis} of {n_out} px does not fit blocks of {block} px with "
+        f"overlap {overlap}: choose an output {axis} of at least {2 * block} px"
+    )
 
 
 def _dependencies(rects, shape, torus: bool):
@@ -1056,6 +1072,8 @@ def _check_options(
         overlap = max(1, min(bh, bw) // (2 if seam == "minimax" else 6))
         if select == "bhatia":
             overlap = max(1, min(bh, bw) // 4)
+        elif tileable:  # the torus spaces blocks evenly: keep them more than half a block apart
+            overlap = min(_torus_overlap(Ho, bh, overlap), _torus_overlap(Wo, bw, overlap))
     overlap = positive_int(overlap, "overlap", minimum=0)
     if overlap >= min(bh, bw):
         raise ValueError(f"overlap must be smaller than the block ({min(bh, bw)}), got {overlap}")

@@ -228,6 +228,16 @@ def test_tileable_output_wraps_seamlessly(cobbles, kw):
         assert grid_border_ratio(straight) > 1.5 * grid_border_ratio(tiled)
 
 
+def test_tileable_minimax_default_overlap_fits_the_torus(cobbles):
+    """Long & Mould's half-block overlap puts evenly spaced torus blocks half a block apart:
+    the default shrinks to the largest overlap that fits, and an explicit one is refused with
+    the overlap that would fit named."""
+    res = quilt(cobbles, (96, 96), block=24, seam="minimax", tileable=True, rng=0)
+    assert res.overlap < 12 and wrap_border_ratio(res.image) < 1.5
+    with pytest.raises(ValueError, match="overlap of at most 10"):
+        quilt(cobbles, (96, 96), block=24, overlap=12, seam="minimax", tileable=True, rng=0)
+
+
 def test_adaptive_block_size_splits_only_bad_blocks(cobbles):
     base = quilt(cobbles, (80, 80), block=24, overlap=4, rng=0)
     errs = np.array([r.best_error / (r.overlap.sum() * 3) for r in base.blocks[1:]])
