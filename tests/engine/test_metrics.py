@@ -10,6 +10,7 @@ from engine.metrics import (
     detail_ratio,
     grid_border_ratio,
     grid_score,
+    laplacian_variance,
     seam_stats,
     wrap_border_ratio,
 )
@@ -91,6 +92,74 @@ def test_grid_border_ratio_sees_block_grid_lines():
     assert grid_border_ratio(blocks, (20, 20), direction="horizontal") > 2.0
     with pytest.raises(ValueError, match="no grid line"):
         grid_border_ratio(blocks, (200, 200))
+
+
+def _reference_laplacian_variance(image) -> float:
+    """The definition: float64 4-neighbour Laplacian over the interior, variance per colour
+    channel (alpha dropped), averaged over channels."""
+    from engine._validate import as_image
+    from engine.errormap import colour_channels
+
+    x = colour_channels(as_image(image)).astype(np.float64)
+    lap = x[:-2, 1:-1] + x[2:, 1:-1] + x[1:-1, :-2] + x[1:-1, 2:] - 4.0 * x[1:-1, 1:-1]
+    return float(lap.reshape(-1, x.shape[2]).var(axis=0).mean())
+
+
+@pytest.mark.parametrize("strip", [1, 7, 1 << 20])  # values per strip: 1 row ... one strip
+@pytest.mark.parametrize(
+    "make",
+    [
+        lambda r: r.random((37, 29, 3)).astype(np.float32),
+        lambda r: r.random((37, 29)),  # gray float64
+        lambda r: r.integers(0, 256, (37, 29, 4), dtype=np.uint8),  # RGBA: alpha dropped
+        lambda r: r.integers(0, 65536, (40, 3, 2), dtype=np.uint16),  # gray + alpha, 3 wide
+        lambda r: (r.random((3, 50, 3)) + 1000.0).astype(np.float32) / 1000.5,  # offset
+    ],
+)
+def test_laplacian_variance_matches_the_definition_strip_by_strip(monkeypatch, make, strip):
+    import engine.metrics as metrics
+
+    monkeypatch.setattr(metrics, "_STRIP_VALUES", strip)
+    image = make(np.random.default_rng(strip))
+    before = image.copy()
+    got = laplacian_variance(image)
+    assert got == pytest.approx(_reference_laplacian_variance(image), rel=1e-5, abs=1e-12)
+    np.testing.assert_array_equal(image, before)  # input untouched
+
+
+def test_laplacian_variance_bad_input_and_flat():
+    assert laplacian_variance(np.full((5, 6, 3), 0.25, np.float32)) == 0.0
+    with pytest.raises(ValueError, match="at least 3x3"):
+        laplacian_variance(np.zeros((2, 8)))
+    with pytest.raises(ValueError, match="tile must be at least 3x3"):
+        detail_ratio(np.zeros((8, 2)), np.ones((8, 8)))
+    with pytest.raises(TypeError, match="image must be a numeric array"):
+        laplacian_variance(np.array([["a"] * 4] * 4))
+    with pytest.raises(ValueError, match="NaN"):
+        laplacian_variance(np.full((4, 4), np.nan))
+
+
+def test_laplacian_variance_of_a_large_source_uses_strips_not_copies():
+    """A 2048x2048 RGB float32 source (48 MiB): the float64 whole-image Laplacian peaked at
+    several times the source; strips keep the extra memory near 24 MiB whatever the size."""
+    import tracemalloc
+
+    source = np.random.default_rng(0).random((2048, 2048, 3), dtype=np.float32)
+    tracemalloc.start()
+    try:
+        value = laplacian_variance(source)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 0.6 * source.nbytes, peak / 2**20
+    assert value == pytest.approx(_reference_laplacian_variance(source[:600]), rel=0.02)
+
+
+def test_detail_ratio_is_the_ratio_of_laplacian_variances(brick):
+    tile = brick[:100, :120]
+    assert detail_ratio(tile, brick) == pytest.approx(
+        laplacian_variance(tile) / laplacian_variance(brick), rel=1e-12
+    )
 
 
 def test_detail_ratio_blur_lowers_it():
