@@ -33,7 +33,9 @@ def as_image(image, name: str = "image", *, min_size: int = 1) -> np.ndarray:
     if a.ndim != 3:
         raise ValueError(f"{name} must be shaped (H, W) or (H, W, C), got shape {a.shape}")
     if a.shape[0] < min_size or a.shape[1] < min_size or a.shape[2] < 1:
-        raise ValueError(f"{name} must be at least {min_size}x{min_size} pixels, got {a.shape[1]}x{a.shape[0]}")
+        raise ValueError(
+            f"{name} must be at least {min_size}x{min_size} pixels, got {a.shape[1]}x{a.shape[0]}"
+        )
     out = img_as_float32(a)
     if out is a:
         out = out.copy()

@@ -20,12 +20,13 @@ import io
 import numbers
 import os
 import struct
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 from PIL import Image, ImageOps, UnidentifiedImageError
+
+from engine._fs import atomic_path
 
 DEFAULT_MAX_PIXELS = 100_000_000  # 10k x 10k; larger files are refused as decompression bombs
 READ_SUFFIXES = (".png", ".jpg", ".jpeg", ".tif", ".tiff", ".bmp", ".webp")
@@ -320,7 +321,7 @@ def save_image(path, pixels, *, bit_depth: int = 8) -> Path:
     alpha). C is 1 (gray), 2 (gray + alpha), 3 (RGB) or 4 (RGBA). Values are rounded (no
     dither; see :func:`engine.export.quantize`). Returns the path written.
     """
-    from engine.export import _umask, quantize
+    from engine.export import quantize
 
     p = Path(os.fspath(path))
     a = np.asarray(pixels)
@@ -333,33 +334,23 @@ def save_image(path, pixels, *, bit_depth: int = 8) -> Path:
     q = quantize(a, bit_depth, dither=False)
     try:
         p.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=p.parent, prefix=f".{p.name}.", suffix=suffix)
+        with atomic_path(p, suffix=suffix) as tmp:
+            if suffix in (".tif", ".tiff"):
+                import tifffile
+
+                tifffile.imwrite(
+                    tmp,
+                    q,
+                    photometric="minisblack" if channels < 3 else "rgb",
+                    extrasamples=("unassalpha",) if channels in (2, 4) else None,
+                    compression="zlib",
+                )
+            elif suffix == ".png":
+                from engine.export._png import encode_png
+
+                tmp.write_bytes(encode_png(q))
+            else:
+                Image.fromarray(q).save(tmp, format=Image.registered_extensions()[suffix])
     except OSError as exc:
         raise ImageError(f"{p}: cannot write ({_write_problem(p.parent, exc)})") from None
-    os.close(fd)
-    try:
-        if suffix in (".tif", ".tiff"):
-            import tifffile
-
-            tifffile.imwrite(
-                tmp,
-                q,
-                photometric="minisblack" if channels < 3 else "rgb",
-                extrasamples=("unassalpha",) if channels in (2, 4) else None,
-                compression="zlib",
-            )
-        elif suffix == ".png":
-            from engine.export._png import encode_png
-
-            Path(tmp).write_bytes(encode_png(q))
-        else:
-            Image.fromarray(q).save(tmp, format=Image.registered_extensions()[suffix])
-        os.chmod(tmp, 0o666 & ~_umask())
-        os.replace(tmp, p)
-    except OSError as exc:
-        Path(tmp).unlink(missing_ok=True)
-        raise ImageError(f"{p}: cannot write ({exc.strerror or exc})") from None
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
     return p

@@ -25,7 +25,6 @@ import math
 import numbers
 import os
 import re
-import tempfile
 import zipfile
 import zlib
 from collections.abc import Mapping, Sequence
@@ -34,8 +33,9 @@ from pathlib import Path
 
 import numpy as np
 
+from engine._fs import atomic_path
 from engine._validate import as_image
-from engine.export import _umask, export_bundle, quantize
+from engine.export import export_bundle, quantize
 from engine.export._png import PNGError, decode_png, encode_png
 from engine.materials import MAP_KINDS, NORMAL_CONVENTIONS, resolve_kinds
 
@@ -520,30 +520,19 @@ def save_project(path, project: Project) -> Path:
         raise ProjectError(
             f"{p}: parameters, seeds, params or extra are not JSON-serialisable ({exc})"
         ) from None
-    parent = p.parent if str(p.parent) else Path(".")
-    tmp = None
     try:
-        fd, tmp = tempfile.mkstemp(dir=parent, prefix=f".{p.name}.", suffix=".tmp")
-        with os.fdopen(fd, "wb") as f:
+        with atomic_path(p) as tmp, open(tmp, "wb") as f:
             with zipfile.ZipFile(f, "w", compression=zipfile.ZIP_DEFLATED) as zf:
                 zf.writestr(_zinfo("project.json"), text.encode("utf-8"))
                 for entry, data in images.items():
                     zf.writestr(_zinfo(entry, stored=True), data)  # PNG is already compressed
             f.flush()
             os.fsync(f.fileno())
-        os.chmod(tmp, 0o666 & ~_umask())
-        os.replace(tmp, p)
     except OSError as exc:
-        if tmp is not None:
-            Path(tmp).unlink(missing_ok=True)
         raise ProjectError(
             f"{p}: cannot save the project ({exc.strerror or exc}); the previous file, "
             "if any, is unchanged"
         ) from exc
-    except BaseException:
-        if tmp is not None:
-            Path(tmp).unlink(missing_ok=True)
-        raise
     return p
 
 

@@ -298,11 +298,11 @@ def save_seams(path: str, res) -> None:
             "seam": res.seam,
             "blocks": blocks,
         }
-        from engine.cli.tileset import _write_bytes
+        from engine._fs import write_bytes_atomically
 
         try:
             p.parent.mkdir(parents=True, exist_ok=True)
-            _write_bytes(p, json.dumps(doc).encode("utf-8"))  # atomic: all or nothing
+            write_bytes_atomically(p, json.dumps(doc).encode("utf-8"))  # atomic: all or nothing
         except OSError as exc:
             raise OSError(f"{p}: cannot write ({exc.strerror or exc})") from None
         return

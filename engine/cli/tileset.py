@@ -27,6 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
+from engine._fs import write_bytes_atomically
 from engine.cli._args import (
     add_exclusion,
     add_seam_options,
@@ -457,7 +458,7 @@ def _run(args) -> int:
         files = {}
         for m, img in images.items():
             fname = f"{stem}.png" if m == "main" else f"{stem}_{m}.png"
-            _write_bytes(out / fname, encode_png(quantize(img, depth, dither=False)))
+            write_bytes_atomically(out / fname, encode_png(quantize(img, depth, dither=False)))
             files[m] = fname
         return files
 
@@ -578,21 +579,4 @@ def _csv(cells: np.ndarray) -> str:
 
 
 def _write_text(path: Path, text: str) -> None:
-    _write_bytes(path, text.encode("utf-8"))
-
-
-def _write_bytes(path: Path, data: bytes) -> None:
-    """Write atomically (temporary sibling, then rename) with the usual umask permissions."""
-    import os
-
-    from engine.export import _umask
-
-    tmp = path.with_name(f".{path.name}.tmp")
-    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o666 & ~_umask())
-    try:
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
+    write_bytes_atomically(path, text.encode("utf-8"))

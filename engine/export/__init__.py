@@ -44,6 +44,7 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
+from engine._fs import umask
 from engine._validate import as_rng, choice
 from engine.export._png import encode_png
 from engine.materials import NORMAL_CONVENTIONS
@@ -706,7 +707,7 @@ def _write_atomically(
     try:
         for rel, content in files.items():
             _write_file(tmp / rel, content, bit_depth)
-        os.chmod(tmp, 0o777 & ~_umask())
+        os.chmod(tmp, 0o777 & ~umask())
         if out.is_dir():
             if replace:
                 old = Path(tempfile.mkdtemp(dir=parent, prefix=f".{out.name}.old-"))
@@ -727,15 +728,3 @@ def _write_atomically(
         ) from exc
     if old is not None:
         shutil.rmtree(old, ignore_errors=True)
-
-
-def _umask() -> int:
-    """The process umask, read without changing it (os.umask would race other threads)."""
-    try:
-        with open("/proc/self/status", encoding="ascii") as f:
-            for line in f:
-                if line.startswith("Umask:"):
-                    return int(line.split()[1], 8)
-    except (OSError, ValueError):
-        pass
-    return 0o022
