@@ -26,39 +26,34 @@ from quilt_gui.widgets.canvas import ImageCanvas, cosmetic_pen
 REPEATS = (1, 3, 5)
 
 
-#: A fixed small image with detail: detail ratios against it are proportional to the
-#: Laplacian variance, so the source's figure is computed once per source (see below).
-_REFERENCE = np.random.default_rng(0).random((16, 16, 3)).astype(np.float32)
 _source_detail: dict[int, tuple[weakref.ref, float]] = {}
 _source_lock = threading.Lock()
 
 
 def source_detail(source: np.ndarray) -> float:
-    """``detail_ratio(source, reference)``, remembered while ``source`` lives (worker threads).
+    """``laplacian_variance(source)``, remembered while ``source`` lives (worker threads).
 
-    The source's Laplacian variance costs seconds on a large source; the tile's figure
-    changes on every rectangle move, the source's never.
+    The tile's figure changes on every rectangle move, the source's never.
     """
-    from engine.metrics import detail_ratio
+    from engine.metrics import laplacian_variance
 
     with _source_lock:  # concurrent jobs on one source compute it once
         hit = _source_detail.get(id(source))
         if hit is not None and hit[0]() is source:
             return hit[1]
-        value = float(detail_ratio(source, _REFERENCE))
+        value = float(laplacian_variance(source))
         _source_detail[id(source)] = (weakref.ref(source), value)
         return value
 
 
 def tile_metrics(tile: np.ndarray, source: np.ndarray, *, cancel=None) -> dict:
-    """Wrap border ratio and detail ratio of a tile (engine.metrics), for the label.
-
-    detail ratio = var(Lap(tile)) / var(Lap(source))
-                 = detail_ratio(tile, reference) / detail_ratio(source, reference).
+    """Wrap border ratio and detail ratio of a tile (engine.metrics), for the label:
+    detail ratio = laplacian_variance(tile) / laplacian_variance(source), the latter cached.
     """
-    from engine.metrics import detail_ratio, wrap_border_ratio
+    from engine.metrics import laplacian_variance, wrap_border_ratio
 
-    detail = float(detail_ratio(tile, _REFERENCE)) / source_detail(source)
+    vs = source_detail(source)
+    detail = float(laplacian_variance(tile)) / vs if vs > 0 else float("nan")
     return {"wrap": float(wrap_border_ratio(tile)), "detail": detail}
 
 
