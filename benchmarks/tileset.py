@@ -23,6 +23,9 @@ options. Three tables:
    fine noise added; one run each).
 4. With ``--joint-weights 0,0.5,...``: the template search's λ sweep on every sample (how
    the default ``joint_weight`` was chosen).
+5. With ``--patch-rings w_T,w_T/2,8,default --ring-tiles 64,128,256``: the candidates' patch
+   ring w_P on every sample (``w_T/2`` is ``max(4, w_T // 2)``; ``default`` the engine's
+   :func:`engine.tiles.default_patch_overlap`, chosen from this table).
 """
 
 from __future__ import annotations
@@ -48,6 +51,7 @@ from engine.tiles import (  # noqa: E402
     CandidateTile,
     assemble,
     candidates,
+    default_patch_overlap,
     find_template,
     iter_candidates,
     make_seamless,
@@ -104,14 +108,21 @@ def pair_text(pair, digits: int = 2) -> str:
     return " / ".join(f"{v:.{digits}f}" for v in pair)
 
 
-def sample_figures(name: str, tile: int, n: int, seed: int, joint_weight=None) -> dict:
-    """Template, seamless tile and ``n`` candidates of one bundled sample, and their figures."""
+def sample_figures(
+    name: str, tile: int, n: int, seed: int, joint_weight=None, patch_overlap=None
+) -> dict:
+    """Template, seamless tile and ``n`` candidates of one bundled sample, and their figures.
+
+    ``patch_overlap``: w_P of the candidates (None: the engine's default), or a callable
+    of w_T giving it.
+    """
     S = load_image(resources.sample_path(name)).pixels
     opts = {} if joint_weight is None else {"joint_weight": joint_weight}
     tmpl = find_template(S, tile_min=tile, tile_max=tile, **opts)
     st = make_seamless(S, tmpl)
     a, b = tmpl.rect[2:]
-    cands = candidates(S, st, n, rng=seed, workers=2)
+    ring = patch_overlap(tmpl.overlap) if callable(patch_overlap) else patch_overlap
+    cands = candidates(S, st, n, rng=seed, workers=2, patch_overlap=ring)
     ratios = pair_ratios([c.tile for c in cands])
     picked = sorted(cands, key=lambda c: c.scores["criterion"])[:8]
     layout = random_layout(len(picked), 8, 8, rng=seed, no_equal_neighbours=True)
@@ -133,6 +144,8 @@ def sample_figures(name: str, tile: int, n: int, seed: int, joint_weight=None) -
         "pairs": (float(np.median(ratios)), float(ratios.max())),
         "changed": float(np.mean([c.scores["changed"] for c in cands])),
         "grid": (g, g0),
+        "cands": cands,
+        "ring": ring,
     }
 
 
@@ -220,6 +233,91 @@ def joint_weight_sweep(weights, tile: int, n: int, seed: int) -> str:
             "detail",
             "pairs median / max",
             "grid ratio",
+        ],
+        rows,
+    )
+
+
+#: The patch rings compared by ``--patch-rings`` (w_P as a function of w_T).
+RINGS = {
+    "w_T": lambda w: w,
+    "w_T/2": lambda w: max(4, w // 2),
+    "8": lambda w: 8,
+    "default": default_patch_overlap,  # the engine's choice, made from this table
+}
+
+
+def patch_ring_sweep(rings, tiles, n: int, seed: int) -> str:
+    """Per sample, tile size and patch ring w_P: the candidates' grid score (8x8 of 8
+    picked over the template repeated, and of all ``n`` as the editor's QA measured it: mean
+    of 3 random 8x8 layouts), pair median / max, mean detail ratio of the candidates, mean
+    seam error per loop pixel and the share of pixels changed: how the default w_P was
+    chosen."""
+    rows = []
+    for tile in tiles:
+        summary = {}
+        for label in rings:
+            ring_fn = RINGS[label]
+            for name in resources.SAMPLE_NAMES:
+                f = sample_figures(name, tile, n, seed, patch_overlap=ring_fn)
+                S, cands = f["S"], f["cands"]
+                period = cands[0].tile.shape[:2]
+                g, g0 = f["grid"]
+                g_all = np.mean(
+                    [
+                        grid_score(
+                            assemble(cands, random_layout(len(cands), 8, 8, rng=s)),
+                            period,
+                            source=S,
+                        )
+                        for s in range(3)
+                    ]
+                )
+                detail = np.mean([detail_ratio(c.tile, S) for c in cands])
+                err = np.mean([c.scores["criterion"] / max(1, len(c.loop)) for c in cands])
+                figs = (g / g0, g_all, *f["pairs"], detail, err, f["changed"])
+                summary.setdefault(label, []).append(figs)
+                rows.append(
+                    [
+                        f"{tile}",
+                        label,
+                        f"{f['ring']}",
+                        name,
+                        f"{g / g0:.2f}",
+                        f"{g_all:.3f}",
+                        pair_text(f["pairs"], 3),
+                        f"{detail:.3f}",
+                        f"{err:.4f}",
+                        f"{f['changed']:.0%}",
+                    ]
+                )
+            m = np.asarray(summary[label])
+            rows.append(
+                [
+                    f"{tile}",
+                    label,
+                    "",
+                    "mean (max pairs: worst)",
+                    f"{m[:, 0].mean():.2f}",
+                    f"{m[:, 1].mean():.3f}",
+                    f"{m[:, 2].mean():.3f} / {m[:, 3].max():.3f}",
+                    f"{m[:, 4].mean():.3f}",
+                    f"{m[:, 5].mean():.4f}",
+                    f"{m[:, 6].mean():.0%}",
+                ]
+            )
+    return format_table(
+        [
+            "tile",
+            "w_P",
+            "px",
+            "sample",
+            "grid ratio (8 picked)",
+            "grid (all, 3 layouts)",
+            "pairs median / max",
+            "detail",
+            "seam error / px",
+            "changed",
         ],
         rows,
     )
@@ -401,7 +499,23 @@ def main(argv=None) -> int:
         metavar="L1,L2,...",
         help="also sweep the template search's joint_weight λ over these values (quality only)",
     )
+    ap.add_argument(
+        "--patch-rings",
+        type=lambda v: v.split(","),
+        metavar="R1,R2,...",
+        help=f"also compare the candidates' patch ring w_P ({', '.join(RINGS)}) per sample",
+    )
+    ap.add_argument(
+        "--ring-tiles",
+        type=lambda v: [int(x) for x in v.split(",")],
+        default=[256],
+        metavar="T1,T2,...",
+        help="tile sizes of the --patch-rings comparison (default 256)",
+    )
     args = ap.parse_args(argv)
+    unknown = set(args.patch_rings or ()) - set(RINGS)
+    if unknown:
+        ap.error(f"--patch-rings: unknown ring(s) {sorted(unknown)}; choose from {list(RINGS)}")
     print(f"python -m benchmarks.tileset (candidates={args.candidates}, seed={args.seed})")
     headers = ["source -> tile", "step", "seconds / MiB", "target"]
     if not args.skip_speed:
@@ -431,6 +545,12 @@ def main(argv=None) -> int:
     if args.joint_weights:
         print("\n## Template search: joint weight λ (512x512 samples, 256x256 tiles)\n")
         print(joint_weight_sweep(args.joint_weights, 256, args.candidates, args.seed), flush=True)
+    if args.patch_rings:
+        print("\n## Candidates: patch ring w_P (512x512 samples)\n")
+        print(
+            patch_ring_sweep(args.patch_rings, args.ring_tiles, args.candidates, args.seed),
+            flush=True,
+        )
     return 0
 
 

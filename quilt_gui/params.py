@@ -154,12 +154,13 @@ PARAMS: tuple[Param, ...] = (
     ),
     _P(
         "patch_overlap",
-        8,
+        0,
         "Patch ring w_P",
-        "Width of the ring along the tile border in which the closed patch seam runs (px); "
-        "0 = the template overlap w_T.\nEverything outside the seam is the template, the same "
-        "in every tile, so a narrow ring shows less of a grid: 8 px instead of w_T = 16 halves "
-        "the preview's grid score on the samples, for a seam error about 25 % higher.",
+        "Width of the ring along the tile border in which the closed patch seam runs (px).\n"
+        "auto (0): half the template overlap w_T, at least 8 px and at most w_T, as the "
+        "tileset command does (w_T 16 -> 8 px, w_T 26 -> 13 px).\nEverything outside the "
+        "seam is the template, the same in every tile: a narrower ring shows less of a grid "
+        "in the preview but leaves the seam less room (higher seam error).",
         "Candidates",
         0,
         256,

@@ -148,7 +148,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         type=int_at_least(2),
         default=None,
         metavar="N",
-        help="w_P, the ring the patch cut runs in (default: --overlap)",
+        help="w_P, the ring the patch cut runs in (default: min(w_T, max(8, w_T // 2)) of the "
+        "template overlap w_T, see engine.tiles.default_patch_overlap)",
     )
     p.add_argument(
         "--patch-size",
@@ -301,6 +302,7 @@ def _run(args) -> int:
     from engine.tiles import (
         CandidateTile,
         TemplateUpdate,
+        default_patch_overlap,
         iter_candidates,
         iter_find_template,
         iter_make_seamless,
@@ -392,7 +394,7 @@ def _run(args) -> int:
 
     # 3. candidates
     n = args.candidates
-    ring = args.patch_overlap or overlap
+    ring = args.patch_overlap or default_patch_overlap(overlap)
     margin = args.margin if args.margin is not None else min(2, ring - 1)
 
     def on_candidate(ev):
@@ -412,7 +414,7 @@ def _run(args) -> int:
             st,
             n,
             patch_size=args.patch_size,
-            patch_overlap=args.patch_overlap,
+            patch_overlap=ring,
             margin=margin,
             neighbourhood=args.neighbourhood,
             method=args.seam,
@@ -495,7 +497,7 @@ def _run(args) -> int:
         "tile_max": tile_max,
         "joint_weight": joint,
         "overlap": overlap,
-        "patch_overlap": args.patch_overlap or overlap,
+        "patch_overlap": ring,
         "patch_size": args.patch_size or [int(rect[3]), int(rect[2])],
         "margin": margin,
         "neighbourhood": args.neighbourhood,

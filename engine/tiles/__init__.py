@@ -14,6 +14,7 @@ from engine.tiles.candidates import (
     CandidateTile,
     candidate_seed,
     candidates,
+    default_patch_overlap,
     iter_candidates,
     make_candidate,
 )
@@ -45,6 +46,7 @@ __all__ = [
     "candidate_seed",
     "candidates",
     "default_overlap",
+    "default_patch_overlap",
     "find_template",
     "iter_candidates",
     "iter_find_template",

@@ -318,3 +318,22 @@ def test_joint_weight_is_passed_to_the_search_and_recorded(src, tmp_path):
         assert man["parameters"]["joint_weight"] == float(weight)
         t = find_template(S, tile_min=48, tile_max=56, joint_weight=float(weight))
         assert man["template"]["rect"] == list(t.rect)
+
+
+def test_default_patch_ring_is_the_engines(src, tmp_path):
+    """Without --patch-overlap the CLI uses engine.tiles.default_patch_overlap(w_T) (w_T 20 ->
+    w_P 10, not 20): the manifest says so and the tiles are the engine's defaults' tiles."""
+    from engine.export import quantize
+    from engine.tiles import default_patch_overlap
+
+    out = tmp_path / "ring"
+    argv = ["tileset", str(src["rgb8"]), "--out", str(out), "--candidates", "2", "--seed", "3"]
+    assert main([*argv, "--rect", "10,12,50,48", "--overlap", "20"]) == 0
+    man = json.loads((out / "manifest.json").read_text())
+    assert man["parameters"]["patch_overlap"] == default_patch_overlap(20) == 10
+    S = S_exact(src)
+    st = make_seamless(S, (10, 12, 50, 48), overlap=20)
+    cands = candidates(S, st, 2, rng=3)
+    for c in cands:
+        tile = png(out / f"tile_{c.index:03d}.png")
+        np.testing.assert_array_equal(tile, quantize(c.tile, 8, dither=False))

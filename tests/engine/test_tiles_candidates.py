@@ -14,6 +14,7 @@ from engine.tiles import (
     assemble,
     candidate_seed,
     candidates,
+    default_patch_overlap,
     find_template,
     iter_candidates,
     make_candidate,
@@ -246,6 +247,33 @@ def pair_ratios(tiles, direction):
     for i, j in ((0, 1), (3, 2), (5, 5)):
         assert ratio[i, j] == pytest.approx(border_ratio(tiles[i], tiles[j], direction=direction))
     return ratio.ravel()
+
+
+def test_default_patch_ring_is_scale_aware():
+    """[REC] w_P = min(w_T, max(8, w_T // 2)): half the template overlap, never below 8 px
+    and never wider than w_T (benchmarks/tileset.py --patch-rings)."""
+    got = {w: default_patch_overlap(w) for w in (2, 6, 8, 13, 16, 17, 26, 103)}
+    assert got == {2: 2, 6: 6, 8: 8, 13: 8, 16: 8, 17: 8, 26: 13, 103: 51}
+    with pytest.raises(ValueError, match="overlap"):
+        default_patch_overlap(0)
+
+
+def test_candidates_default_to_that_ring():
+    """The closed cut runs in the default ring (offsets margin .. w_P - 1 from the patch
+    window's border), not in a ring of w_T; make_candidate uses the same default."""
+    S = texture((200, 210), seed=4)
+    st = make_seamless(S, (20, 16, 120, 110), overlap=24)  # w_T 24 -> w_P 12
+    ring_px = default_patch_overlap(24)
+    assert ring_px == 12
+    for c in candidates(S, st, 4, rng=1, workers=1):
+        h, w = c.mask.shape
+        r, col = c.loop[:, 0], c.loop[:, 1]
+        depth = np.minimum.reduce([r, col, h - 1 - r, w - 1 - col])
+        assert depth.min() >= 2 and depth.max() <= ring_px - 1, (depth.min(), depth.max())
+    kw = dict(patch_origin=(30, 40))
+    default = make_candidate(S, st, **kw)
+    np.testing.assert_array_equal(default.tile, make_candidate(S, st, patch_overlap=12, **kw).tile)
+    assert not np.array_equal(default.tile, make_candidate(S, st, patch_overlap=24, **kw).tile)
 
 
 def test_connectability_and_variety_on_samples():
