@@ -5,8 +5,9 @@ A :class:`Job` runs a function on the global thread pool. The function gets a
 returns an engine event generator (``iter_*``), which the job drains in the worker
 thread. Events are not sent to the GUI one by one: the worker puts them in a
 buffer and wakes the GUI thread once; the GUI drains the buffer at most ~30 times a
-second, keeping only the newest :class:`~engine.events.Snapshot` of each type and the
-newest :class:`~engine.events.Progress`, and every :class:`~engine.events.Item`.
+second, keeping only the newest :class:`~engine.events.Snapshot` of each type (and of each
+``which``, as the two overlaps of a seamless tile) and the newest
+:class:`~engine.events.Progress`, and every :class:`~engine.events.Item`.
 
 Jobs are registered by a *key* ("template", "candidates", "quilt" ...). Starting a
 job whose key is running *supersedes* the old one: it is aborted and none of its
@@ -230,16 +231,25 @@ def _pump(job: Job):
         raise JobError(f"{type(exc).__name__}: {exc}") from exc
 
 
+def _snapshot_key(event) -> tuple:
+    """Snapshots of one type supersede each other per ``which`` (e.g. the two overlaps of a
+    seamless tile each keep their newest seam)."""
+    return type(event), getattr(event, "which", None)
+
+
 def coalesce(events: list) -> list:
-    """Keep every Item, the newest Snapshot of each type and the newest Progress, in order."""
-    last: dict[type, int] = {}
+    """Keep every Item, the newest Snapshot of each type (and ``which``, if it has one) and
+    the newest Progress, in order."""
+    last: dict[tuple, int] = {}
     for i, ev in enumerate(events):
         if isinstance(ev, (Snapshot, Progress)) and not isinstance(ev, Item):
-            last[type(ev)] = i
+            last[_snapshot_key(ev)] = i
     return [
         ev
         for i, ev in enumerate(events)
-        if not isinstance(ev, (Snapshot, Progress)) or isinstance(ev, Item) or last[type(ev)] == i
+        if not isinstance(ev, (Snapshot, Progress))
+        or isinstance(ev, Item)
+        or last[_snapshot_key(ev)] == i
     ]
 
 

@@ -47,6 +47,14 @@ class SeamlessUpdate(Snapshot):
     ``seam`` is canonical (rows run along the seam); ``path`` is (row, col) in the overlap
     region as drawn (R_L frame: (h + w_T) x w_T; R_T frame: w_T x w); ``path_source`` in
     source pixels. ``final`` marks the last update of that overlap.
+
+    ``regions`` (``R_R`` and ``R_L``, or ``R_B`` and ``R_T``: the main map's pixels) and
+    ``error`` (the error map as drawn, float32) let a viewer draw the overlap before the
+    result exists; the vertical overlap's regions are cut from the horizontal stitch, so
+    nothing else could show them live. They are read-only arrays made once per overlap:
+    every update of that overlap carries the same objects (no copy per update, and a
+    consumer that keeps only the newest snapshot still has them), and the final
+    :class:`SeamlessTile` holds them too.
     """
 
     which: str
@@ -54,6 +62,8 @@ class SeamlessUpdate(Snapshot):
     path: np.ndarray
     path_source: np.ndarray
     final: bool = False
+    regions: dict | None = None
+    error: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -334,6 +344,7 @@ def _iter_make_seamless(
 
     # ---- horizontal: R1 = R_R kept on the left (the tile's left edge), R2 = R_L; canonical
     E_h = seam_error(R_R, R_L, wts, metric)
+    drawn_h = _drawn({"R_R": R_R[MAIN], "R_L": R_L[MAIN]}, E_h)
     lo, hi = _allowed(wT, blend, width)
     seam_h = yield from _stream(
         iter_seam(
@@ -345,6 +356,7 @@ def _iter_make_seamless(
         ),
         "horizontal",
         (y, x),
+        drawn_h,
     )
     check(cancel)
     alpha_h = _alpha(seam_h, E_h, blend, width, rho)
@@ -352,13 +364,14 @@ def _iter_make_seamless(
     inner = {k: v[:, :a].copy() for k, v in F.items()}  # I of §1.7
     for k in inner:
         inner[k][:, :wT] = strip[k]
-    yield _update("horizontal", seam_h, True, (y, x))
+    yield _update("horizontal", seam_h, True, (y, x), drawn_h)
     yield Progress(1, 2, "seamless: vertical stitch")
 
     # ---- vertical: R1 = R_B kept on top; canonical = transpose (rows = tile columns), cyclic
     R_T = {k: v[:wT] for k, v in inner.items()}
     R_B = {k: v[b : b + wT] for k, v in inner.items()}
     E_v = seam_error(R_B, R_T, wts, metric)
+    drawn_v = _drawn({"R_B": R_B[MAIN], "R_T": R_T[MAIN]}, E_v)
     Ec = np.ascontiguousarray(E_v.T)
     wv = tuple((c, r) for r, c in wps.get("vertical", ()))
     seam_v = yield from _stream(
@@ -372,6 +385,7 @@ def _iter_make_seamless(
         ),
         "vertical",
         (y, x),
+        drawn_v,
         transpose=True,
     )
     check(cancel)
@@ -380,14 +394,14 @@ def _iter_make_seamless(
     tiles = {k: v[:b].copy() for k, v in inner.items()}
     for k in tiles:
         tiles[k][:wT] = band[k]
-    up_v = _update("vertical", seam_v, True, (y, x), transpose=True)
+    up_v = _update("vertical", seam_v, True, (y, x), drawn_v, transpose=True)
     yield up_v
     yield Progress(2, 2, "seamless: done")
 
     path_h = np.asarray(seam_h.path, dtype=np.intp)
     path_v = np.asarray(up_v.path, dtype=np.intp)
-    errors = {"horizontal": E_h.astype(np.float32), "vertical": E_v.astype(np.float32)}
-    regions = {"R_L": R_L[MAIN], "R_R": R_R[MAIN], "R_T": R_T[MAIN], "R_B": R_B[MAIN]}
+    errors = {"horizontal": drawn_h["error"], "vertical": drawn_v["error"]}
+    regions = {**drawn_h["regions"], **drawn_v["regions"]}
     region_rects = {
         "R_L": (x, y, wT, b + wT),
         "R_R": (x + a, y, wT, b + wT),
@@ -400,9 +414,9 @@ def _iter_make_seamless(
         tile=fr(tiles[MAIN]),
         rect=(x, y, a, b),
         overlap=wT,
-        regions={k: fr(v) for k, v in regions.items()},
+        regions={k: regions[k] for k in ("R_L", "R_R", "R_T", "R_B")},
         region_rects=region_rects,
-        errors={k: fr(v) for k, v in errors.items()},
+        errors=errors,
         seams={"horizontal": seam_h, "vertical": seam_v},
         paths={"horizontal": fr(path_h), "vertical": fr(path_v)},
         paths_tile={"horizontal": fr(path_h[path_h[:, 0] < b]), "vertical": fr(path_v)},
@@ -429,7 +443,16 @@ def _alpha(
     return alpha
 
 
-def _stream(gen, which: str, origin, *, transpose: bool = False):
+def _drawn(regions: dict, error: np.ndarray) -> dict:
+    """The read-only region and error arrays of one overlap (made once, shared by its
+    updates and the result)."""
+    return {
+        "regions": {k: frozen_array(v) for k, v in regions.items()},
+        "error": frozen_array(error.astype(np.float32)),
+    }
+
+
+def _stream(gen, which: str, origin, drawn: dict, *, transpose: bool = False):
     """Re-yield a seam search's improvements as :class:`SeamlessUpdate`; return its seam.
 
     The final update is sent by the caller once the cut is applied.
@@ -441,12 +464,12 @@ def _stream(gen, which: str, origin, *, transpose: bool = False):
             return stop.value
         if isinstance(ev, SeamUpdate):
             if not ev.final:
-                yield _update(which, ev.seam, False, origin, transpose=transpose)
+                yield _update(which, ev.seam, False, origin, drawn, transpose=transpose)
         else:
             yield ev
 
 
-def _update(which: str, seam: Seam, final: bool, origin, *, transpose: bool = False):
+def _update(which: str, seam: Seam, final: bool, origin, drawn: dict, *, transpose=False):
     path = np.asarray(seam.path, dtype=np.intp)
     if transpose:
         path = path[:, ::-1]
@@ -456,6 +479,7 @@ def _update(which: str, seam: Seam, final: bool, origin, *, transpose: bool = Fa
         path=frozen_array(path),
         path_source=frozen_array(path + np.asarray(origin)),
         final=final,
+        **drawn,
     )
 
 

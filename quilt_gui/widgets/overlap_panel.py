@@ -26,10 +26,11 @@ from quilt_gui.widgets.source_view import (
     SEAM_COLORS,
     WaypointItem,
     nearest_waypoint,
-    region_rects,
 )
 
 GAP = 3  # pixels between the three panels
+#: The two regions of each overlap, in panel order (R1 kept on the outside, then R2).
+LIVE_REGIONS = {"horizontal": ("R_R", "R_L"), "vertical": ("R_B", "R_T")}
 
 
 def _rgba(a: np.ndarray) -> np.ndarray:
@@ -177,6 +178,7 @@ class OverlapPanel(QWidget):
         row.addWidget(self.clear_button)
         lay.addLayout(row)
         self.frames: dict[str, tuple | None] = {k: None for k in self.views}  # (rect, w_T) shown
+        self._shown: dict[str, object] = {k: None for k in self.views}  # error map shown
         doc.seamless_changed.connect(self._on_seamless_changed)
         doc.waypoints_changed.connect(self._on_waypoints_changed)
         pipeline.seam_updated.connect(self._on_seam_updated)
@@ -205,17 +207,14 @@ class OverlapPanel(QWidget):
             for which, v in self.views.items():
                 v.clear()
                 self.frames[which] = None
+                self._shown[which] = None
                 self.labels[which].setText("No tile yet: draw a rectangle or Find best tile.")
             return
         self.frames = {k: (tuple(s.rect), int(s.overlap)) for k in self.views}
-        reg = s.regions
-        self.views["horizontal"].show_overlap(
-            reg["R_R"], reg["R_L"], s.errors["horizontal"], stacked=False
-        )
-        self.views["vertical"].show_overlap(
-            reg["R_B"], reg["R_T"], s.errors["vertical"], stacked=True
-        )
         for which, v in self.views.items():
+            r1, r2 = (s.regions[k] for k in LIVE_REGIONS[which])
+            v.show_overlap(r1, r2, s.errors[which], stacked=which == "vertical")
+            self._shown[which] = s.errors[which]
             v.set_path(s.paths[which])
             self.labels[which].setText(
                 f"seam criterion {s.criterion[which]:.3f}   peak {s.peak[which]:.3f}   "
@@ -228,29 +227,23 @@ class OverlapPanel(QWidget):
         rect = self.doc.template_rect
         return None if rect is None else (tuple(rect), int(self.doc.params["overlap"]))
 
-    def _show_live_frame(self, which: str, frame) -> bool:
-        """Show the overlap of ``frame`` before its result exists; False if it cannot be.
-
-        The left/right overlap comes straight from the source (its error map is quick to
-        compute); the top/bottom one is cut from the left/right stitch, so it waits.
-        """
-        from engine.errormap import error_map
-
-        view, label = self.views[which], self.labels[which]
-        self.frames[which] = frame
-        if which == "vertical" or self.doc.source is None:
-            view.clear()
-            label.setText("searching... (this overlap is taken after the left/right stitch)")
-            return False
-        (rect, overlap), src = frame, self.doc.source.main
-        crops = {}
-        for key in ("R_L", "R_R"):
-            x, y, w, h = region_rects(rect, overlap)[key]
-            crops[key] = src[y : y + h, x : x + w]
-        error = error_map(crops["R_R"], crops["R_L"], metric=self.doc.params["metric"])
-        view.show_overlap(crops["R_R"], crops["R_L"], error, stacked=False)
+    def _show_live_frame(self, update, frame) -> None:
+        """Show the overlap a running job's update belongs to, from the regions and error
+        map the update carries (a new rectangle's overlaps are drawn before its result)."""
+        which = update.which
+        view = self.views[which]
+        r1, r2 = (update.regions[k] for k in LIVE_REGIONS[which])
+        view.show_overlap(r1, r2, update.error, stacked=which == "vertical")
         view.set_waypoints(self.doc.waypoints[which])
-        return True
+        self.frames[which] = frame
+        self._shown[which] = update.error
+        other = "vertical"
+        if which == "horizontal" and self.frames[other] != frame:
+            self.views[other].clear()  # the old rectangle's overlap must not stay up
+            self.frames[other] = None
+            self.labels[other].setText(
+                "waiting for the left/right stitch (this overlap is cut from it)..."
+            )
 
     @Slot(object)
     def _on_seam_updated(self, update) -> None:
@@ -259,9 +252,11 @@ class OverlapPanel(QWidget):
         frame = self.current_frame()
         if v is None or frame is None:
             return
-        stale = self.frames[update.which] != frame or v.frame_shape is None
-        if stale and not self._show_live_frame(update.which, frame):
-            return
+        new = self.frames[update.which] != frame or self._shown[update.which] is not update.error
+        if update.regions is not None and update.error is not None and new:
+            self._show_live_frame(update, frame)
+        elif self.frames[update.which] != frame or v.frame_shape is None:
+            return  # an update without its overlap's pixels, for a frame not shown
         v.set_path(np.asarray(update.path))
         self.labels[update.which].setText(
             f"searching... criterion {update.seam.criterion:.3f}   peak {update.seam.peak:.3f}"

@@ -127,6 +127,50 @@ def test_stream_order_and_oscillating_improvements():
     np.testing.assert_array_equal(ups[-1].path, st.paths["vertical"])
 
 
+@pytest.mark.parametrize("method", ["dp", "oscillating"])
+def test_updates_carry_each_overlaps_regions_and_error_map(method):
+    """Live drawing of a new rectangle: the first update of each overlap (the vertical one's
+    regions exist only after the horizontal stitch) has its two regions and its error map,
+    read-only; later updates share the same arrays (no copy), and so does the result."""
+    S = texture(seed=4, sigma=1.0)
+    opts = {"o_max": 2} if method == "oscillating" else {}
+    gen = iter_make_seamless(S, RECT, overlap=W_T, method=method, **opts)
+    ups = []
+    while True:
+        try:
+            ev = next(gen)
+        except StopIteration as stop:
+            st = stop.value
+            break
+        if isinstance(ev, SeamlessUpdate):
+            ups.append(ev)
+    names = {"horizontal": ("R_R", "R_L"), "vertical": ("R_B", "R_T")}
+    for which, keys in names.items():
+        mine = [u for u in ups if u.which == which]
+        first = mine[0]
+        assert set(first.regions) == set(keys)
+        assert first.error.dtype == np.float32
+        assert first.error.shape == first.regions[keys[0]].shape[:2]
+        for k in keys:
+            assert not first.regions[k].flags.writeable
+            assert first.regions[k] is st.regions[k]
+            np.testing.assert_array_equal(first.regions[k], st.regions[k])
+        assert not first.error.flags.writeable and first.error is st.errors[which]
+        for u in mine[1:]:
+            assert u.error is first.error
+            assert all(u.regions[k] is first.regions[k] for k in keys)
+        # the path is drawn in the same frame as the regions
+        assert (first.path[:, 0] < first.error.shape[0]).all()
+        assert (first.path[:, 1] < first.error.shape[1]).all()
+    a, b = RECT[2], RECT[3]
+    v = next(u for u in ups if u.which == "vertical")
+    assert v.regions["R_T"].shape[:2] == (W_T, a) and v.error.shape == (W_T, a)
+    h = next(u for u in ups if u.which == "horizontal")
+    assert h.error.shape == (b + W_T, W_T)
+    if method == "oscillating":  # the vertical overlap is drawable before its seam is final
+        assert not v.final
+
+
 def test_waypoints_in_drawn_coordinates():
     S = texture(seed=5)
     wps = {"horizontal": [(30, 2)], "vertical": [(5, 40)]}

@@ -181,32 +181,56 @@ def test_waypoint_click_in_overlap_panel_steers_the_seam(qtbot, win):
     assert win.doc.waypoints["horizontal"] == []
 
 
-def test_live_seam_of_a_new_rectangle_is_drawn_on_its_own_overlap(qtbot, win):
-    from types import SimpleNamespace
+def test_live_seams_of_a_new_rectangle_are_drawn_on_both_its_overlaps(qtbot, win):
+    """Before a new rectangle's result exists, each live update draws that rectangle's own
+    overlap: the left/right one and the top/bottom one (cut from the left/right stitch),
+    from the regions and error map the engine sends with the updates."""
+    from quilt_gui.imaging import heat_rgba
 
     template(qtbot, win, (150, 120, 128, 112))
     panel, ov = win.overlap_panel, win.doc.params["overlap"]
-    new = (60, 40, 100, 90)  # smaller: the old frame would hold its path
-    win.doc.apply_template_rect(new)  # the seamless job starts; its updates are faked here
+    old = win.doc.seamless
+    new = (60, 40, 100, 90)
+    seen = []
 
-    def update(which, path):
-        seam = SimpleNamespace(criterion=1.0, peak=0.5)
-        return SimpleNamespace(which=which, path=np.asarray(path), seam=seam)
+    def record(update):  # runs after the panel's own slot (connected later)
+        view = panel.views[update.which]
+        seen.append(
+            (
+                update.which,
+                win.doc.seamless is old,
+                view.frame_shape,
+                panel.frames[update.which],
+                view.array.copy(),
+                update,
+            )
+        )
 
-    panel._on_seam_updated(update("horizontal", [(r, 3) for r in range(90 + ov)]))
-    view = panel.views["horizontal"]
-    assert view.frame_shape == (90 + ov, ov) and panel.frames["horizontal"] == (new, ov)
-    x, y = new[:2]
-    np.testing.assert_array_equal(
-        view.array[:, :ov, :3],
-        to_uint8(win.doc.source.main[y : y + 90 + ov, x + 100 : x + 100 + ov])[..., :3],
-    )
-    assert view.paths[0].isVisible()
-    panel._on_seam_updated(update("vertical", [(3, c) for c in range(100)]))
-    assert panel.views["vertical"].frame_shape is None  # waits for the left/right stitch
-    assert "searching" in panel.labels["vertical"].text()
+    win.pipeline.seam_updated.connect(record)
+    win.doc.set_param("method", "oscillating")  # streams improvements on both overlaps
     wait_idle(qtbot, win)
-    assert panel.views["vertical"].frame_shape == (ov, 100)
+    old = win.doc.seamless
+    seen.clear()
+    win.doc.apply_template_rect(new)
+    wait_idle(qtbot, win)
+    assert win.doc.seamless is not old and tuple(win.doc.seamless.rect) == new
+    live = [s for s in seen if s[1]]  # delivered while the old result was still shown
+    assert {s[0] for s in live} == {"horizontal", "vertical"}, [s[0] for s in seen]
+    shapes = {"horizontal": (90 + ov, ov), "vertical": (ov, 100)}
+    for which, _, shape, frame, image, update in live:
+        assert shape == shapes[which] and frame == (new, ov)
+        keys = ("R_R", "R_L") if which == "horizontal" else ("R_B", "R_T")
+        h, w = shape
+        panels = [to_uint8(update.regions[k])[..., :3] for k in keys]
+        panels.append(heat_rgba(update.error)[..., :3])
+        for (ox, oy), expected in zip(panel.views[which].offsets, panels, strict=True):
+            np.testing.assert_array_equal(image[oy : oy + h, ox : ox + w, :3], expected)
+    x, y = new[:2]
+    h_update = next(s[5] for s in live if s[0] == "horizontal")
+    np.testing.assert_array_equal(  # R_R is the source strip right of the new rectangle
+        h_update.regions["R_R"], win.doc.source.main[y : y + 90 + ov, x + 100 : x + 100 + ov]
+    )
+    assert panel.views["vertical"].paths[0].isVisible()
 
 
 def test_changing_a_parameter_supersedes_and_no_stale_result_is_drawn(qtbot, win):

@@ -50,6 +50,18 @@ def test_coalesce_keeps_items_and_newest_snapshot():
     assert out == [Thing(1), Snap(2), Thing(2), Progress(2, 3)]
 
 
+@dataclass(frozen=True)
+class Side(Snapshot):
+    which: str
+    value: int
+
+
+def test_coalesce_keeps_the_newest_snapshot_of_each_which():
+    """Two overlaps stream seams: a vertical update must not drop the horizontal one."""
+    evs = [Side("h", 1), Side("h", 2), Side("v", 1), Snap(1), Side("v", 2)]
+    assert jobs.coalesce(evs) == [Side("h", 2), Snap(1), Side("v", 2)]
+
+
 def test_items_all_arrive_and_snapshots_are_coalesced(qtbot):
     seen = []
     done = []
