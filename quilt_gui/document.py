@@ -12,7 +12,9 @@ The document holds no widgets and builds no QImages. Its serialization is
 
 from __future__ import annotations
 
+import base64
 import re
+import zlib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -131,7 +133,9 @@ class Document(QObject):
         self.quilt_result = None  # engine QuiltResult / TransferResult when finished
         self.transfer_target: np.ndarray | None = None  # the image a transfer imitates
         self.transfer_target_path = ""
-        self.exclude_painted: np.ndarray | None = None  # (H, W) bool, sample pixels never used
+        # (H, W) bool: source pixels the template search, the candidates and quilting never
+        # use (with the exclude_color range); saved in the project's extra["exclude_painted"]
+        self.exclude_painted: np.ndarray | None = None
         self._dirty = False  # changes that are not undo steps (streamed results)
         self._was_modified = False
         self.undo_stack.cleanChanged.connect(self._on_clean_changed)
@@ -539,7 +543,7 @@ class Document(QObject):
             layout=layout,
             waypoints={k: [tuple(p) for p in v] for k, v in self.waypoints.items()},
             preview=preview,
-            extra={"editor": "quilt-studio"},
+            extra={"editor": "quilt-studio", **_painted_extra(self.exclude_painted)},
         )
 
     def from_project(self, project: Project, path: str | None) -> None:
@@ -581,6 +585,7 @@ class Document(QObject):
         if project.preview is not None:
             self.preview = next(iter(project.preview.values()))
         self.project_path = path
+        self.apply_painted(_painted_from_extra(project.extra, source.shape))
         self.params_changed.emit(frozenset(self.params))
         self.template_changed.emit()
         self.waypoints_changed.emit()
@@ -591,6 +596,41 @@ class Document(QObject):
         self.preview_changed.emit()
         self.path_changed.emit()
         self.mark_saved()
+
+
+PAINTED_KEY = "exclude_painted"
+
+
+def _painted_extra(mask: np.ndarray | None) -> dict:
+    """The painted exclusion as JSON for ``Project.extra`` (the project format has no field
+    for it): shape and the bit-packed, zlib-compressed mask in base64."""
+    if mask is None or not mask.any():
+        return {}
+    packed = zlib.compress(np.packbits(np.asarray(mask, bool)).tobytes(), 9)
+    return {
+        PAINTED_KEY: {
+            "shape": list(mask.shape),
+            "packbits_zlib_base64": base64.b64encode(packed).decode("ascii"),
+        }
+    }
+
+
+def _painted_from_extra(extra: dict, shape: tuple[int, int]) -> np.ndarray | None:
+    """The painted exclusion saved by :func:`_painted_extra`; None if absent or not a mask of
+    the source's ``shape`` (a damaged entry is dropped, the rest of the project opens)."""
+    entry = extra.get(PAINTED_KEY) if isinstance(extra, dict) else None
+    if not isinstance(entry, dict) or entry.get("shape") != list(shape):
+        return None
+    n = int(shape[0]) * int(shape[1])
+    try:
+        raw = base64.b64decode(entry["packbits_zlib_base64"], validate=True)
+        bits = zlib.decompressobj().decompress(raw, (n + 7) // 8 + 1)
+    except (KeyError, TypeError, ValueError, zlib.error):
+        return None
+    if len(bits) != (n + 7) // 8:
+        return None
+    mask = np.unpackbits(np.frombuffer(bits, np.uint8), count=n).astype(bool).reshape(shape)
+    return mask if mask.any() else None
 
 
 def _rect(value) -> tuple[int, int, int, int] | None:

@@ -50,7 +50,7 @@ from quilt_gui.widgets.preview import PreviewView
 from quilt_gui.widgets.quilt_view import QuiltView
 from quilt_gui.widgets.source_view import SourceView
 from quilt_gui.widgets.status import JobStatus, MessageBar
-from quilt_gui.widgets.tile_view import TileView
+from quilt_gui.widgets.tile_view import REPEATS, TileView
 from resources import SAMPLE_NAMES, sample_path
 
 log = logging.getLogger(__name__)
@@ -94,6 +94,31 @@ def read_project(path: str):
     return project
 
 
+_warmup_started = False
+
+
+def _warmup() -> None:
+    import engine.seams
+
+    engine.seams.warmup()
+
+
+def start_warmup(manager: jobs.JobManager) -> jobs.Job | None:
+    """Load (or compile) the numba seam kernels in a worker, once per process, so the first
+    seam a person asks for is not held up by it and the GUI thread never is."""
+    global _warmup_started
+    if _warmup_started:
+        return None
+    _warmup_started = True
+    return manager.start(
+        "warmup",
+        _warmup,
+        label="Loading the seam kernels",
+        pass_cancel=False,
+        on_error=lambda exc: log.warning("seam kernel warm-up failed: %s", exc),
+    )
+
+
 def recovery_dir() -> Path:
     """Folder of the untitled-project recovery file (next to the settings file)."""
     return Path(QSettings().fileName()).parent / "recovery"
@@ -123,6 +148,7 @@ class MainWindow(QMainWindow):
         self.autosave_timer.setInterval(max(5, settings.get("autosave_seconds")) * 1000)
         self.autosave_timer.timeout.connect(self.autosave_now)
         self.autosave_timer.start()
+        start_warmup(self.jobs)
         self.resize(1500, 950)
         geo, state = settings.get("window_geometry"), settings.get("window_state")
         if not geo.isEmpty():
@@ -244,8 +270,21 @@ class MainWindow(QMainWindow):
             "Clear painted e&xclusion",
             self._clear_painted,
             None,
-            "Forget the pixels painted as never to copy",
+            "Forget the source pixels painted as never to use",
         )
+        self.act_repeats = {
+            n: A(
+                f"Seamless tile {n}×{n}",
+                partial(self._set_repeats, n),
+                str(n),
+                f"Show the seamless tile repeated {n}×{n}",
+                checkable=True,
+            )
+            for n in REPEATS
+        }
+        group = QActionGroup(self)
+        for a in self.act_repeats.values():
+            group.addAction(a)
         self.act_cancel = A(
             "&Cancel running job", self.jobs.stop_all, "Esc", "Stop the running computation"
         )
@@ -282,11 +321,15 @@ class MainWindow(QMainWindow):
                 "Preview": [self.act_reroll_layout],
                 "Quilting": [self.act_quilt],
                 "Transfer": [self.act_load_target, self.act_transfer],
+                "Exclusion": [self.act_clear_painted],
             },
         )
         self.params_panel.show_groups(TILESET_GROUPS)
         self.overlap_panel = OverlapPanel(doc, self.pipeline)
         self.tile_view = TileView(doc)
+        for n, a in self.act_repeats.items():
+            a.setChecked(n == self.tile_view.repeats)
+            self.tile_view.repeat_buttons.button(n).setToolTip(a.toolTip())
         self.gallery = CandidateView(doc)
         self.docks = {}
         for key, title, widget, area in (
@@ -331,10 +374,14 @@ class MainWindow(QMainWindow):
         m.addActions([self.act_undo, self.act_redo])
         m.addSeparator()
         m.addAction(self.act_clear_wp)
+        m.addAction(self.act_clear_painted)
         m = mb.addMenu("&View")
         m.addActions([self.act_fit, self.act_100, self.act_zoom_in, self.act_zoom_out])
         m.addSeparator()
         m.addActions([self.act_heat, self.act_preview_grid])
+        m.addSeparator()
+        m.addActions(list(self.act_repeats.values()))
+        m.addSeparator()
         for dock in self.docks.values():
             m.addAction(dock.toggleViewAction())
         theme = m.addMenu("&Theme")
@@ -351,8 +398,6 @@ class MainWindow(QMainWindow):
         m.addAction(self.act_cancel)
         m = mb.addMenu("&Quilting")
         m.addActions([self.act_quilt, self.act_load_target, self.act_transfer])
-        m.addSeparator()
-        m.addAction(self.act_clear_painted)
         m = mb.addMenu("&Help")
         m.addAction("&Keyboard and mouse", self.show_help)
 
@@ -389,6 +434,7 @@ class MainWindow(QMainWindow):
         self.source_view.patch_moved.connect(self._on_patch_moved)
         self.tabs.currentChanged.connect(self._on_tab_changed)
         self.quilt_view.selection_changed.connect(self._show_criteria)
+        self.tile_view.repeats_changed.connect(self._on_repeats_changed)
         for canvas in self.canvases():
             canvas.hovered.connect(partial(self._on_hover, canvas))
         self.source_view.set_heat_visible(self.act_heat.isChecked())
@@ -775,7 +821,7 @@ class MainWindow(QMainWindow):
         self.pipeline.run_quilt()
 
     def _clear_painted(self, *_args) -> None:
-        self.quilt_view.clear_painted()
+        self.source_view.painter.clear_painted()
 
     def run_transfer(self, *_args) -> None:
         self.tabs.setCurrentWidget(self.quilt_view)
@@ -829,6 +875,13 @@ class MainWindow(QMainWindow):
     def _zoom_out(self) -> None:
         self.current_canvas().zoom_out()
 
+    def _set_repeats(self, n: int, *_checked) -> None:
+        self.tile_view.set_repeats(n)
+
+    @Slot(int)
+    def _on_repeats_changed(self, n: int) -> None:
+        self.act_repeats[n].setChecked(True)
+
     def _set_heat(self, on: bool) -> None:
         settings.set("heat_overlay", bool(on))
         self.source_view.set_heat_visible(on)
@@ -844,7 +897,10 @@ class MainWindow(QMainWindow):
                 "Wheel: zoom about the cursor · drag: pan · Ctrl+0 fit · Ctrl+1 100 % · "
                 "drag the yellow rectangle or its handles, arrow keys nudge (Shift: 10 px) · "
                 "Ctrl+click an overlap (or click in the overlaps panel): waypoint, right-click "
-                "removes · H heat overlay · gallery: click picks, Shift+click picks a range, "
+                "removes · Shift+drag on the source paints pixels never to use, "
+                "Shift+right-drag erases, Ctrl+Shift+click excludes a colour · "
+                "H heat overlay · 1 / 3 / 5: seamless tile 1×1 / 3×3 / 5×5 · "
+                "gallery: click picks, Shift+click picks a range, "
                 "Space, Ctrl+A all, Enter or double-click opens, L locks, R re-rolls, "
                 "right-click: preview weight · drag the orange patch rectangle to rebuild a "
                 "candidate · Ctrl+R re-rolls the layout, G its grid · Esc cancels the running "

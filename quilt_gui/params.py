@@ -348,36 +348,37 @@ PARAMS: tuple[Param, ...] = (
         "Wrap-around overlaps on the last column and row: the output tiles seamlessly.",
         "Quilting",
     ),
+    _P("q_seed", 1, "Seed", "Random seed of the synthesis.", "Quilting", 0, 2**31 - 1),
+    # -- excluded source pixels: template search, candidates and quilting
     _P(
         "exclude_color",
         "",
         "Excluded colour",
-        "#rrggbb of the sample colour never to copy "
-        "(Ctrl+click the sample in the Quilting tab to pick it); empty = none.",
-        "Quilting",
-    ),
-    _P(
-        "brush",
-        8,
-        "Brush radius",
-        "Radius of the exclusion brush (Shift+drag on the sample in the Quilting tab; "
-        "Shift+right-drag erases).",
-        "Quilting",
-        1,
-        256,
+        "#rrggbb of a source colour never to use: no tile rectangle, patch or quilting block "
+        "contains it (Ctrl+Shift+click the source to pick it; Ctrl+click in the Quilting "
+        "tab); empty = none.",
+        "Exclusion",
     ),
     _P(
         "exclude_tolerance",
         0.0,
         "Exclude colour ±",
-        "Never copy sample pixels within this "
-        "distance of the picked colour (Ctrl+click the sample to pick it); 0 = off.",
-        "Quilting",
+        "Never use source pixels within this distance of the picked colour (per channel); 0 = off.",
+        "Exclusion",
         0.0,
         0.5,
         step=0.01,
     ),
-    _P("q_seed", 1, "Seed", "Random seed of the synthesis.", "Quilting", 0, 2**31 - 1),
+    _P(
+        "brush",
+        8,
+        "Brush radius",
+        "Radius of the exclusion brush: Shift+drag on the source (or the Quilting tab's "
+        "sample) paints pixels never to use, Shift+right-drag erases.",
+        "Exclusion",
+        1,
+        256,
+    ),
     # -- options of the seam methods (shared by the tile set and quilting)
     _P(
         "o_max",
@@ -508,7 +509,7 @@ CANDIDATE_KEYS = frozenset(
 PREVIEW_KEYS = frozenset({"preview_rows", "preview_cols", "no_equal_neighbours", "layout_seed"})
 #: Parameters whose change re-runs a shown quilting / transfer result (the brush only paints).
 QUILT_KEYS = frozenset(
-    p.key for p in PARAMS if p.group in ("Quilting", "Transfer", "Seam options")
+    p.key for p in PARAMS if p.group in ("Quilting", "Transfer", "Seam options", "Exclusion")
 ) - {"brush"}
 
 

@@ -143,9 +143,10 @@ class Pipeline(QObject):
         self.template_searching.emit(True)
         return self.jobs.start(
             "template",
-            iter_find_template,
+            excluding(iter_find_template),
             doc.source.main,
             label="Finding the best tile",
+            exclusion=self.exclusion(),
             tile_min=p["tile_min"],
             tile_max=max(p["tile_min"], p["tile_max"]),
             overlap=p["overlap"],
@@ -266,10 +267,12 @@ class Pipeline(QObject):
 
     # ------------------------------------------------------------------ candidates
     def _tile_options(self) -> dict:
-        """Seam and patch options of the candidate calls (from the parameters)."""
+        """Seam and patch options of the candidate calls (from the parameters), with the
+        ``exclusion`` that :func:`excluding` turns into their ``excluded`` mask."""
         p = self.doc.params
         extra = {k: v for k, v in self.doc.source.maps.items() if k != self.doc.source.main_name}
         return dict(
+            exclusion=self.exclusion(),
             patch_size=p["patch_size"] or None,
             patch_overlap=p["patch_overlap"] or None,
             margin=p["margin"],
@@ -346,7 +349,7 @@ class Pipeline(QObject):
             return None
         return self.jobs.start(
             "candidates",
-            iter_candidates,
+            excluding(iter_candidates),
             doc.source.main,
             doc.seamless,
             n,
@@ -413,7 +416,7 @@ class Pipeline(QObject):
             text = f"Move patch of candidate #{index + 1}"
         return self.jobs.start(
             f"candidate:{index}",
-            make_candidate,
+            excluding(make_candidate),
             doc.source.main,
             doc.seamless,
             index=index,
@@ -498,7 +501,8 @@ class Pipeline(QObject):
         )
 
     def exclusion(self) -> tuple:
-        """(colour, tolerance, painted mask): the arguments of :func:`excluded_mask`."""
+        """(colour, tolerance, painted mask): the arguments of :func:`excluded_mask` (the
+        source pixels the template search, the candidates and quilting never use)."""
         p = self.doc.params
         return p["exclude_color"], p["exclude_tolerance"], self.doc.exclude_painted
 
@@ -654,8 +658,19 @@ def excluded_mask(sample: np.ndarray, color: str, tolerance: float, painted=None
 def _job_mask(sample, exclusion):
     mask = excluded_mask(sample, *exclusion)
     if mask is not None and mask.all():
-        raise ValueError("the excluded colour range and painted mask cover the whole sample")
+        raise ValueError("the excluded colour range and painted mask cover the whole source")
     return mask
+
+
+def excluding(fn):
+    """``fn(source, *args, excluded=mask, **options)`` as a job body taking ``exclusion``
+    (:meth:`Pipeline.exclusion`): the mask is built in the worker, not the GUI thread."""
+
+    def job(source, *args, exclusion, **options):
+        return fn(source, *args, excluded=_job_mask(source, exclusion), **options)
+
+    job.__name__ = job.__qualname__ = f"excluding_{fn.__name__}"
+    return job
 
 
 def quilt_job(sample, out_shape, *, exclusion, cancel=None, **options):

@@ -49,8 +49,16 @@ SLIDERS = frozenset(
     }
 )
 MATERIALS = "Material maps"
-TILESET_GROUPS = ("Template", "Seam", MATERIALS, "Seam options", "Candidates", "Preview")
-QUILT_GROUPS = ("Quilting", "Seam options", "Transfer")
+TILESET_GROUPS = (
+    "Template",
+    "Seam",
+    MATERIALS,
+    "Seam options",
+    "Candidates",
+    "Preview",
+    "Exclusion",
+)
+QUILT_GROUPS = ("Quilting", "Exclusion", "Seam options", "Transfer")
 
 
 class ParamsPanel(QScrollArea):

@@ -1,6 +1,7 @@
 """Quilting mode: the output grows block by block; click a block to inspect its cut.
 
-Left: the sample, with the source window of the selected block and the excluded pixels.
+Left: the sample, with the source window of the selected block and the excluded pixels
+(:mod:`quilt_gui.widgets.exclusion`: the same exclusion as the tile set's).
 Right: the output, painted block by block as the engine places them (only the new block's
 pixels are converted, so the GUI stays responsive on large outputs). Below: the selected
 block's sample window, its placed pixels and its overlap error map, with the seam on each.
@@ -9,7 +10,7 @@ block's sample window, its placed pixels and its overlap error map, with the sea
 from __future__ import annotations
 
 import numpy as np
-from PySide6.QtCore import QEvent, QRectF, Qt, QTimer, Signal, Slot
+from PySide6.QtCore import QRectF, Qt, QTimer, Signal, Slot
 from PySide6.QtGui import QColor, QImage, QPainter
 from PySide6.QtWidgets import (
     QGraphicsItem,
@@ -24,8 +25,8 @@ from PySide6.QtWidgets import (
 
 from quilt_gui.document import Document
 from quilt_gui.imaging import to_qimage
-from quilt_gui.pipeline import excluded_mask
-from quilt_gui.widgets.canvas import ImageCanvas, ImageItem, ShadeItem
+from quilt_gui.widgets.canvas import ImageCanvas, ShadeItem
+from quilt_gui.widgets.exclusion import HINT, ExclusionPainter
 from quilt_gui.widgets.overlap_panel import OverlapView
 
 
@@ -85,10 +86,8 @@ class QuiltView(QWidget):
         self.block_rect.setZValue(40)
         self.block_rect.hide()
         self.output.add_item(self.block_rect)
-        self.excluded = ImageItem()
-        self.excluded.setZValue(15)
-        self.excluded.hide()
-        self.sample.add_item(self.excluded)
+        self.painter = ExclusionPainter(doc, self.sample)
+        self.excluded = self.painter.overlay
         self.inspector = OverlapView("#7dff5f")
         self.inspector.setToolTip(
             "The selected block: its sample window, the pixels placed, and "
@@ -99,14 +98,7 @@ class QuiltView(QWidget):
         )
         self.info.setWordWrap(True)
         self.selected: int | None = None
-        self._stroke: np.ndarray | None = None  # the mask being painted (Shift+drag)
-        self._stroke_value = True
-        self._last_px: tuple[int, int] | None = None
-        self.sample.viewport().installEventFilter(self)
-        self.sample.setToolTip(
-            "Ctrl+click: exclude this colour · Shift+drag: paint pixels "
-            "never to copy · Shift+right-drag: erase"
-        )
+        self.sample.setToolTip(f"Ctrl+click: exclude this colour · {HINT}")
         self._inspect_timer = QTimer(self)
         self._inspect_timer.setSingleShot(True)
         self._inspect_timer.setInterval(0)
@@ -159,8 +151,6 @@ class QuiltView(QWidget):
         doc.quilt_finished.connect(self._on_finished)
         doc.quilt_iteration.connect(self._on_iteration)
         doc.target_changed.connect(self._on_target_changed)
-        doc.params_changed.connect(self._on_params_changed)
-        doc.exclusion_changed.connect(self._update_exclusion)
         self._on_source_changed()
 
     # ------------------------------------------------------------------ document -> view
@@ -168,29 +158,7 @@ class QuiltView(QWidget):
     def _on_source_changed(self) -> None:
         src = self.doc.source
         self.sample.set_image(None if src is None else src.main, fit=True)
-        self._update_exclusion()
         self._on_reset()
-
-    @Slot(object)
-    def _on_params_changed(self, keys) -> None:
-        if keys & {"exclude_color", "exclude_tolerance"}:
-            self._update_exclusion()
-
-    def _update_exclusion(self) -> None:
-        src = self.doc.source
-        p = self.doc.params
-        painted = self._stroke if self._stroke is not None else self.doc.exclude_painted
-        mask = (
-            None
-            if src is None
-            else excluded_mask(src.main, p["exclude_color"], p["exclude_tolerance"], painted)
-        )
-        if mask is None or not mask.any():
-            self.excluded.hide()
-            return
-        rgba = np.zeros(mask.shape + (4,), np.uint8)
-        rgba[mask] = (255, 40, 40, 150)
-        self.excluded.set_array(rgba)
 
     @Slot()
     def _on_reset(self) -> None:
@@ -253,59 +221,6 @@ class QuiltView(QWidget):
         if self.doc.transfer_target is not None:
             self.inputs.setCurrentWidget(self.target)
 
-    # ------------------------------------------------------------------ painted exclusion
-    def eventFilter(self, obj, event) -> bool:  # noqa: N802 - Qt API
-        """Shift+drag on the sample paints the exclusion mask (right button erases)."""
-        if obj is not self.sample.viewport() or self.doc.source is None:
-            return False
-        kind = event.type()
-        if (
-            kind == QEvent.Type.MouseButtonPress
-            and event.modifiers() & Qt.KeyboardModifier.ShiftModifier
-        ):
-            px = self.sample.pixel_at(event.position())
-            if px is None:
-                return False
-            current = self.doc.exclude_painted
-            self._stroke = (
-                np.zeros(self.doc.source.shape, bool) if current is None else current.copy()
-            )
-            self._stroke_value = event.button() != Qt.MouseButton.RightButton
-            self._last_px = px
-            self._paint(px, px)
-            return True
-        if kind == QEvent.Type.MouseMove and self._stroke is not None:
-            px = self.sample.pixel_at(event.position())
-            if px is not None:
-                self._paint(self._last_px or px, px)
-                self._last_px = px
-            return True
-        if kind == QEvent.Type.MouseButtonRelease and self._stroke is not None:
-            stroke, self._stroke, self._last_px = self._stroke, None, None
-            text = "Paint exclusion" if self._stroke_value else "Erase exclusion"
-            self.doc.set_painted(stroke if stroke.any() else None, text=text)
-            return True
-        return False
-
-    def _paint(self, a: tuple[int, int], b: tuple[int, int]) -> None:
-        """Stamp the brush along the segment a -> b (pixels (row, col))."""
-        r = int(self.doc.params["brush"])
-        H, W = self._stroke.shape
-        steps = max(abs(b[0] - a[0]), abs(b[1] - a[1]), 1)
-        for t in np.linspace(0.0, 1.0, steps + 1):
-            cy, cx = a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t
-            r0, r1 = max(0, int(cy) - r), min(H, int(cy) + r + 1)
-            c0, c1 = max(0, int(cx) - r), min(W, int(cx) + r + 1)
-            yy, xx = np.mgrid[r0:r1, c0:c1]
-            disk = (yy - cy) ** 2 + (xx - cx) ** 2 <= r * r
-            self._stroke[r0:r1, c0:c1][disk] = self._stroke_value
-        self._update_exclusion()
-
-    @Slot()
-    def clear_painted(self) -> None:
-        if self.doc.exclude_painted is not None:
-            self.doc.set_painted(None, text="Clear painted exclusion")
-
     # ------------------------------------------------------------------ inspection
     @Slot()
     def _inspect_newest(self) -> None:
@@ -318,15 +233,14 @@ class QuiltView(QWidget):
 
     @Slot(object, object)
     def _on_sample_clicked(self, px, modifiers) -> None:
-        if not modifiers & Qt.KeyboardModifier.ControlModifier or self.doc.source is None:
-            return
-        rgb = self.doc.source.main[px[0], px[1]]
-        rgb = np.repeat(rgb[:1], 3) if rgb.shape[0] < 3 else rgb[:3]
-        color = "#" + "".join(f"{int(round(float(v) * 255)):02x}" for v in rgb)
-        values = {"exclude_color": color}
-        if self.doc.params["exclude_tolerance"] <= 0:
-            values["exclude_tolerance"] = 0.08
-        self.doc.set_params(values, text="Exclude a colour")
+        """Ctrl+click on the sample excludes its colour (Ctrl+Shift+click, as on the Source
+        tab, is the painter's)."""
+        if modifiers & Qt.KeyboardModifier.ControlModifier and self.doc.source is not None:
+            self.painter.pick_colour(px)
+
+    @Slot()
+    def clear_painted(self) -> None:
+        self.painter.clear_painted()
 
     def select(self, index: int | None) -> None:
         """Show block ``index`` in the inspector (None clears it)."""

@@ -2,8 +2,10 @@
 
 Overlays (all on pixel edges): the tile rectangle with handles (drag, resize, arrow-key
 nudge), the four overlap regions R_L/R_R/R_T/R_B shaded, each overlap's error map as a
-heat overlay, the seams (live while they are searched), waypoints, and the patch source
-rectangle of the current candidate (drag it to regenerate that candidate).
+heat overlay, the seams (live while they are searched), waypoints, the patch source
+rectangle of the current candidate (drag it to regenerate that candidate), and the excluded
+pixels no tile or patch may use (:mod:`quilt_gui.widgets.exclusion`: Shift+drag paints,
+Shift+right-drag erases, Ctrl+Shift+click excludes a colour).
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ from quilt_gui.widgets.canvas import (
     PixelSetItem,
     ShadeItem,
 )
+from quilt_gui.widgets.exclusion import ExclusionPainter
 from quilt_gui.widgets.rect_item import EditableRect
 
 REGION_COLORS = {"R_L": "#3fc1ff", "R_R": "#3fc1ff", "R_T": "#ff5fd2", "R_B": "#ff5fd2"}
@@ -85,6 +88,7 @@ class SourceView(ImageCanvas):
         self.patch_item.hide()
         self.add_item(self.patch_item)
         self.patch_index: int | None = None
+        self.painter = ExclusionPainter(doc, self)  # excluded pixels: Shift+drag, Ctrl+Shift+click
         self._waypoint_items: list[WaypointItem] = []
         self.heat_visible = True
         self._nudge_merge: int | None = None
