@@ -23,7 +23,9 @@ options. Three tables:
    fine noise added; one run each).
 4. With ``--joint-weights 0,0.5,...``: the template search's λ sweep on every sample (how
    the default ``joint_weight`` was chosen).
-5. With ``--patch-rings w_T,w_T/2,8,default --ring-tiles 64,128,256``: the candidates' patch
+5. With ``--detail 6144``: seconds and peak memory of the source's Laplacian variance
+   (the detail ratio's denominator), strip-wise vs the float64 whole-image reference.
+6. With ``--patch-rings w_T,w_T/2,8,default --ring-tiles 64,128,256``: the candidates' patch
    ring w_P on every sample (``w_T/2`` is ``max(4, w_T // 2)``; ``default`` the engine's
    :func:`engine.tiles.default_patch_overlap`, chosen from this table).
 """
@@ -323,6 +325,43 @@ def patch_ring_sweep(rings, tiles, n: int, seed: int) -> str:
     )
 
 
+def _float64_laplacian_variance(x: np.ndarray) -> float:
+    """The definition as first written: whole-image float64 shifted copies (the reference
+    the strip-wise :func:`engine.metrics.laplacian_variance` replaced)."""
+    lap = (
+        x[:-2, 1:-1].astype(np.float64)
+        + x[2:, 1:-1]
+        + x[1:-1, :-2]
+        + x[1:-1, 2:]
+        - 4.0 * x[1:-1, 1:-1]
+    )
+    return float(lap.reshape(-1, x.shape[2]).var(axis=0).mean())
+
+
+def detail_cost(size: int, seed: int) -> list:
+    """Seconds and peak traced memory of the source's Laplacian variance on a ``size``²
+    RGB float32 source: the strip-wise engine function and the float64 reference."""
+    from engine.metrics import laplacian_variance
+
+    S = np.random.default_rng(seed).random((size, size, 3), dtype=np.float32)
+    rows = []
+    for name, fn in (
+        ("engine.metrics.laplacian_variance (float32 strips)", laplacian_variance),
+        ("float64 whole-image reference", _float64_laplacian_variance),
+    ):
+        t0 = time.perf_counter()
+        value = fn(S)
+        dt = time.perf_counter() - t0
+        tracemalloc.start()
+        fn(S)
+        peak = tracemalloc.get_traced_memory()[1]
+        tracemalloc.stop()
+        rows.append(
+            [f"{size}x{size} RGB", name, f"{dt:.2f}", f"{peak / 2**20:.0f}", f"{value:.6g}"]
+        )
+    return rows
+
+
 def big_source(size: int, seed: int) -> np.ndarray:
     from skimage.transform import resize
 
@@ -500,6 +539,13 @@ def main(argv=None) -> int:
         help="also sweep the template search's joint_weight λ over these values (quality only)",
     )
     ap.add_argument(
+        "--detail",
+        type=int,
+        metavar="SIZE",
+        help="also time the source's Laplacian variance (detail ratio) on a SIZE² RGB source, "
+        "strip-wise vs the float64 reference (6144 needs ~1.5 GB for the reference)",
+    )
+    ap.add_argument(
         "--patch-rings",
         type=lambda v: v.split(","),
         metavar="R1,R2,...",
@@ -545,6 +591,10 @@ def main(argv=None) -> int:
     if args.joint_weights:
         print("\n## Template search: joint weight λ (512x512 samples, 256x256 tiles)\n")
         print(joint_weight_sweep(args.joint_weights, 256, args.candidates, args.seed), flush=True)
+    if args.detail:
+        print("\n## Detail ratio: the source's Laplacian variance\n")
+        heads = ["source", "implementation", "seconds", "peak traced MiB", "value"]
+        print(format_table(heads, detail_cost(args.detail, args.seed)), flush=True)
     if args.patch_rings:
         print("\n## Candidates: patch ring w_P (512x512 samples)\n")
         print(
