@@ -4,8 +4,9 @@ Run under Xvfb so real window-system rendering is used:
 
     xvfb-run -s "-screen 0 1600x1000x24" python tools/screenshots.py
 
-Writes docs/template.png, docs/template_400.png, docs/candidates.png, docs/preview.png,
-docs/quilting.png and docs/export.png.
+Writes docs/template.png, docs/template_400.png, docs/candidates.png, docs/candidate.png,
+docs/preview.png, docs/quilting.png, docs/quilting_inspect.png, docs/export.png and
+docs/exclusion.png.
 """
 
 from __future__ import annotations
@@ -106,6 +107,22 @@ def main() -> int:
     dlg.folder.setText(os.path.join(tempfile.gettempdir(), "cobblestones_export"))
     shot(dlg, "export.png")
     dlg.close()
+
+    # -- excluded source pixels (painted + a colour range) and the tile found around them
+    import numpy as np
+
+    H, W = doc.source.shape
+    yy, xx = np.mgrid[0:H, 0:W]
+    doc.set_painted((yy - H * 0.45) ** 2 + (xx - W * 0.5) ** 2 < (min(H, W) * 0.22) ** 2)
+    src = doc.source.main
+    w.source_view.painter.pick_colour(np.unravel_index(np.argmin(src.sum(axis=2)), (H, W)))
+    w.act_find.trigger()
+    wait_until(idle)
+    w.message_bar.dismiss()
+    w.source_view.show_patch(None)
+    w.source_view.fit()
+    w.params_panel.ensureWidgetVisible(w.params_panel.groups["Exclusion"])
+    shot(w, "exclusion.png")
     w.close()
     return 0
 
