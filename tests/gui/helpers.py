@@ -55,3 +55,12 @@ def make_window(qtbot) -> MainWindow:
     w.show()
     qtbot.waitExposed(w)
     return w
+
+
+def drag(qtbot, canvas, a, b, *, button=Qt.MouseButton.LeftButton, modifier=None, steps=6):
+    """Press at view point ``a``, move to ``b`` in ``steps``, release (a painted stroke)."""
+    mod = Qt.KeyboardModifier.ShiftModifier if modifier is None else modifier
+    qtbot.mousePress(canvas.viewport(), button, mod, a)
+    for k in range(1, steps + 1):
+        qtbot.mouseMove(canvas.viewport(), a + (b - a) * (k / steps))
+    qtbot.mouseRelease(canvas.viewport(), button, mod, b)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from PySide6.QtCore import QPointF, Qt
 
-from tests.gui.helpers import make_window, open_sample, wait_idle
+from tests.gui.helpers import drag, make_window, open_sample, wait_idle
 
 
 def small(w, **extra):
@@ -135,11 +135,7 @@ def test_painted_exclusion_is_one_undo_step_and_never_copied(qtbot):
     n0 = w.doc.undo_stack.count()
     a = s.view_pos_of_pixel(200, 150).toPoint()
     b = s.view_pos_of_pixel(260, 330).toPoint()
-    shift = Qt.KeyboardModifier.ShiftModifier
-    qtbot.mousePress(s.viewport(), Qt.MouseButton.LeftButton, shift, a)
-    for t in np.linspace(0, 1, 8)[1:]:
-        qtbot.mouseMove(s.viewport(), a + (b - a) * t)
-    qtbot.mouseRelease(s.viewport(), Qt.MouseButton.LeftButton, shift, b)
+    drag(qtbot, s, a, b, steps=7)  # Shift+drag paints
     mask = w.doc.exclude_painted
     assert w.doc.undo_stack.count() == n0 + 1
     assert mask[200, 150] and mask[260, 330] and mask[230, 240] and not mask[100, 100]

@@ -11,7 +11,7 @@ from PySide6.QtCore import QPointF, Qt
 
 from quilt_gui import main_window
 from quilt_gui.pipeline import excluded_mask
-from tests.gui.helpers import make_window, open_sample, template, wait_idle
+from tests.gui.helpers import drag, make_window, open_sample, template, wait_idle
 
 
 @pytest.fixture
@@ -36,10 +36,7 @@ def test_shift_drag_on_the_source_paints_one_undoable_exclusion(qtbot, win):
     a = v.view_pos_of_pixel(220, 200).toPoint()
     b = v.view_pos_of_pixel(240, 300).toPoint()
     shift = Qt.KeyboardModifier.ShiftModifier
-    qtbot.mousePress(v.viewport(), Qt.MouseButton.LeftButton, shift, a)
-    for t in np.linspace(0, 1, 6)[1:]:
-        qtbot.mouseMove(v.viewport(), a + (b - a) * t)
-    qtbot.mouseRelease(v.viewport(), Qt.MouseButton.LeftButton, shift, b)
+    drag(qtbot, v, a, b, modifier=shift)
     mask = win.doc.exclude_painted
     assert win.doc.undo_stack.count() == n0 + 1
     assert mask[220, 200] and mask[240, 300] and mask[230, 250] and not mask[100, 100]
