@@ -198,7 +198,7 @@ class SetLayout(QUndoCommand):
 
 
 class SetPainted(QUndoCommand):
-    """The painted exclusion mask of the quilting sample (one brush stroke = one step)."""
+    """The painted exclusion mask of the source (one brush stroke = one step)."""
 
     def __init__(self, doc: Document, mask, text: str) -> None:
         super().__init__(text)
