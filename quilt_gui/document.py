@@ -417,7 +417,8 @@ class Document(QObject):
 
     def finish_quilt(self, result) -> None:
         self.quilt_result = result
-        self.quilt_output = np.array(result.image, dtype=np.float32)
+        self.quilt_output = np.asarray(result.image, dtype=np.float32)  # the worker's display
+        # copy of this very array is cached (imaging.prepare_display): no copy here
         self.quilt_blocks = list(result.blocks)
         self.quilt_finished.emit()
 

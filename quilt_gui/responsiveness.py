@@ -133,13 +133,23 @@ def recompute_latency(window, method: str, repeats: int = 3) -> float:
     return float(np.median(times))
 
 
-def measure_all(window, *, repeats: int = 3) -> dict[str, dict]:
-    """The figures of the benchmark table (the window must have the sample open)."""
+def measure_all(window, *, repeats: int = 3, heavy: bool = False) -> dict[str, dict]:
+    """The figures of the benchmark table (the window must have the sample open).
+
+    ``heavy`` adds runs of several seconds (300 candidates; a 1536x1536 quilt), so the
+    percentiles rest on thousands of ticks rather than a few dozen."""
     doc = window.doc
     window.pipeline.find_template()
     wait_until(lambda: not window.pipeline.busy())
     rows = {f"{doc.params['n_candidates']} candidates": measure_candidates(window, repeats)}
     rows["quilting (best match)"] = measure_quilting(window)
+    if heavy:
+        n, size = doc.params["n_candidates"], (doc.params["out_width"], doc.params["out_height"])
+        doc.set_param("n_candidates", 300)
+        rows["300 candidates"] = measure_candidates(window, 1)
+        doc.set_params({"n_candidates": n, "out_width": 1536, "out_height": 1536})
+        rows["quilting 1536x1536 (best match)"] = measure_quilting(window)
+        doc.set_params({"out_width": size[0], "out_height": size[1]})
     n = doc.params["n_candidates"]
     doc.set_param("n_candidates", 400)
     rows["cancel candidates"] = {
