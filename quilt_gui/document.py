@@ -174,6 +174,30 @@ class Document(QObject):
     def picked_entries(self) -> list[CandidateEntry]:
         return [self.candidates[i] for i in self.picks]
 
+    def connects_to_template(self, entry: CandidateEntry) -> bool:
+        """True when ``entry`` was made from the current seamless template (same size and
+        outer margin), i.e. it connects to tiles made from it."""
+        if self.seamless is None:
+            return False
+        template = np.asarray(self.seamless.tile)
+        tile, m = np.asarray(entry.tile), max(1, int(self.params["margin"]))
+        return tile.shape == template.shape and bool(
+            np.array_equal(tile[:m], template[:m])
+            and np.array_equal(tile[-m:], template[-m:])
+            and np.array_equal(tile[:, :m], template[:, :m])
+            and np.array_equal(tile[:, -m:], template[:, -m:])
+        )
+
+    @property
+    def candidates_outdated(self) -> bool:
+        """The candidates were made from an earlier template (they still connect to each
+        other, not to tiles of the current one)."""
+        return (
+            bool(self.candidates)
+            and self.seamless is not None
+            and not (self.connects_to_template(self.candidates[0]))
+        )
+
     # ------------------------------------------------------------------ user edits (undoable)
     def set_param(
         self, key: str, value: Any, *, merge_id: int | None = None, text: str | None = None

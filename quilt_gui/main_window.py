@@ -966,9 +966,10 @@ class MainWindow(QMainWindow):
         self.act_export.setEnabled(bool(self.doc.candidates))
         self.act_reroll_layout.setEnabled(bool(self.doc.picks))
         n = len(self.doc.candidates)
-        self.docks["gallery"].setWindowTitle(
-            f"Candidates — {len(self.doc.picks)} of {n} picked" if n else "Candidates"
-        )
+        title = f"Candidates — {len(self.doc.picks)} of {n} picked" if n else "Candidates"
+        if self.doc.candidates_outdated:
+            title += " — made from an earlier template (Generate to update)"
+        self.docks["gallery"].setWindowTitle(title)
 
     # ------------------------------------------------------------------ closing
     def closeEvent(self, event) -> None:  # noqa: N802 - Qt API

@@ -322,13 +322,11 @@ class Pipeline(QObject):
         if not self._template_ready():
             return None
         doc = self.doc
-        template = np.asarray(doc.seamless.tile)
-        m = max(1, int(doc.params["margin"]))
         keep, keep_picks, dropped = [], [], 0
         for i, e in enumerate(doc.candidates):
             if not e.locked:
                 continue
-            if e.tile.shape != template.shape or not _same_border(e.tile, template, m):
+            if not doc.connects_to_template(e):
                 dropped += 1
                 continue
             if i in doc.picks:
@@ -599,16 +597,6 @@ def make_preview(tiles, source, *, rows, cols, seed, no_equal_neighbours, weight
     if rows * cols > 1:
         score = float(grid_score(image, (th, tw), source=source))
     return layout, image, score
-
-
-def _same_border(a: np.ndarray, b: np.ndarray, m: int) -> bool:
-    """True when the outer ``m`` pixels of two tiles are equal (they connect)."""
-    return bool(
-        np.array_equal(a[:m], b[:m])
-        and np.array_equal(a[-m:], b[-m:])
-        and np.array_equal(a[:, :m], b[:, :m])
-        and np.array_equal(a[:, -m:], b[:, -m:])
-    )
 
 
 def parse_color(text: str) -> tuple[float, float, float] | None:

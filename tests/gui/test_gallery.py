@@ -103,3 +103,18 @@ def test_candidate_dialog_shows_seam_on_tile_and_patch_source_and_keeps_it_in_pr
     np.testing.assert_array_equal(back.loop, e.loop)
     assert back.target_rect == e.target_rect
     assert w.open_candidate(1).loop_item.isVisible()
+
+
+def test_candidates_from_an_earlier_template_are_marked_until_regenerated(qtbot):
+    w = make_window(qtbot)
+    open_sample(qtbot, w)
+    generate(qtbot, w, 4)
+    title = w.docks["gallery"].windowTitle
+    assert not w.doc.candidates_outdated and "earlier template" not in title()
+    x, y, tw, th = w.doc.template_rect
+    w.doc.set_template_rect((x + 4, y + 2, tw - 6, th))
+    wait_idle(qtbot, w)
+    assert w.doc.candidates_outdated and "earlier template" in title()
+    assert len(w.doc.candidates) == 4  # kept (they still connect to each other), not dropped
+    generate(qtbot, w, 4)
+    assert not w.doc.candidates_outdated and "earlier template" not in title()
