@@ -18,7 +18,6 @@ same cut can be applied to other co-registered maps (normal, height, ...) with `
 from __future__ import annotations
 
 import math
-import numbers
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -38,12 +37,11 @@ from engine.blend import (
 )
 from engine.cancel import check
 from engine.errormap import error_map
-from engine.seams import METHODS, Seam, find_seam, graph_path
+from engine.seams import _MINIMAX_METRIC, METHODS, Seam, find_seam, graph_path
 from engine.seams import OPTIONS as SEAM_OPTIONS
 
 ORIENTATIONS = ("right", "left", "bottom", "top")
 GRAPH_METHODS = ("dijkstra", "minimax")
-_MINIMAX_METRIC = {"exact": "minimax", "lm": "lm", "sorted": "sorted"}
 
 __all__ = [
     "GRAPH_METHODS",
@@ -307,14 +305,6 @@ class LCut:
         return composite(self.mask, old, new)
 
 
-def _nonneg(value, name: str) -> int:
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-        raise TypeError(f"{name} must be an integer, got {value!r}")
-    if value < 0:
-        raise ValueError(f"{name} must be >= 0, got {value}")
-    return int(value)
-
-
 @njit(cache=True, nogil=True)
 def _old_side_of_barrier(barrier, seed_left, seed_top):  # pragma: no cover - compiled
     """Old region of a cut given as a barrier (h, w) bool: the barrier, every pixel 4-connected
@@ -464,8 +454,8 @@ def l_cut(
     """
     e = np.ascontiguousarray(as_error_map(error))
     bh, bw = e.shape
-    ovl = _nonneg(overlap_left, "overlap_left")
-    ovt = _nonneg(overlap_top, "overlap_top")
+    ovl = positive_int(overlap_left, "overlap_left", minimum=0)
+    ovt = positive_int(overlap_top, "overlap_top", minimum=0)
     if ovl == 0 and ovt == 0:
         raise ValueError("overlap_left and overlap_top must not both be 0")
     if ovl > bw:
