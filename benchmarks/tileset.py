@@ -47,6 +47,7 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
 
 import resources  # noqa: E402
 from benchmarks._util import format_table  # noqa: E402
+from engine.events import drain  # noqa: E402
 from engine.io import load_image  # noqa: E402
 from engine.metrics import border_ratio, detail_ratio, grid_score, wrap_border_ratio  # noqa: E402
 from engine.tiles import (  # noqa: E402
@@ -386,14 +387,13 @@ def time_candidates(S, st, n: int, seed: int, workers: int) -> tuple[float, floa
     busy0, own0 = _busy_seconds(), time.process_time()
     t0 = time.perf_counter()
     first = None
-    gen = iter_candidates(S, st, n, rng=seed, workers=workers)
-    while True:
-        try:
-            ev = next(gen)
-        except StopIteration:
-            break
+
+    def on_event(ev) -> None:
+        nonlocal first
         if first is None and isinstance(ev, CandidateTile):
             first = time.perf_counter() - t0
+
+    drain(iter_candidates(S, st, n, rng=seed, workers=workers), on_event)
     total = time.perf_counter() - t0
     own = time.process_time() - own0
     others = max(0.0, _busy_seconds() - busy0 - own) / total

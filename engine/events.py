@@ -56,10 +56,13 @@ def frozen_array(a: np.ndarray) -> np.ndarray:
     return out
 
 
-def drain(gen):
-    """Run an event generator to its end and return its return value."""
+def drain(gen, on_event=None):
+    """Run an event generator to its end and return its return value; ``on_event``, if
+    given, is called with every event on the way."""
     while True:
         try:
-            next(gen)
+            event = next(gen)
         except StopIteration as stop:
             return stop.value
+        if on_event is not None:
+            on_event(event)

@@ -166,15 +166,13 @@ class ProgressPrinter:
 
 def drive(gen, printer):
     """Run an engine generator, printing its Progress events; returns its value."""
-    from engine.events import Progress
+    from engine.events import Progress, drain
 
-    while True:
-        try:
-            ev = next(gen)
-        except StopIteration as stop:
-            return stop.value
+    def on_event(ev) -> None:
         if isinstance(ev, Progress):
             printer(ev)
+
+    return drain(gen, on_event)
 
 
 def load_sample_and_exclusion(args):

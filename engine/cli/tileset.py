@@ -237,15 +237,6 @@ class _Reporter:
         print(f"[{time.perf_counter() - self.t0:7.2f}s] {text}", file=sys.stderr, flush=True)
 
 
-def _run_events(gen, on_event):
-    while True:
-        try:
-            ev = next(gen)
-        except StopIteration as stop:
-            return stop.value
-        on_event(ev)
-
-
 def _parse_rect(text: str):
     try:
         v = [int(t) for t in text.split(",")]
@@ -295,7 +286,7 @@ def _check_out(out: Path) -> None:
 
 
 def _run(args) -> int:
-    from engine.events import Progress
+    from engine.events import Progress, drain
     from engine.export import quantize
     from engine.export._png import encode_png
     from engine.io import load_image
@@ -355,7 +346,7 @@ def _run(args) -> int:
             if isinstance(ev, TemplateUpdate):
                 say(f"template: {ev.phase} rect {ev.rect} cost {ev.cost:.4f}")
 
-        tmpl = _run_events(
+        tmpl = drain(
             iter_find_template(
                 S,
                 tile_min=tile_min,
@@ -370,7 +361,7 @@ def _run(args) -> int:
         warn_list += list(tmpl.warnings)
 
     # 2. seamless tile
-    st = _run_events(
+    st = drain(
         iter_make_seamless(
             S,
             rect,
@@ -383,8 +374,7 @@ def _run(args) -> int:
             rho=args.rho,
             maps=maps or None,
             weights=weights,
-        ),
-        lambda ev: None,
+        )
     )
     warn_list += [w for w in st.warnings if w not in warn_list]
     say(
@@ -408,7 +398,7 @@ def _run(args) -> int:
             say(ev.message)
 
     done = [0]
-    cands = _run_events(
+    cands = drain(
         iter_candidates(
             S,
             st,

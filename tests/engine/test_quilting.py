@@ -9,6 +9,7 @@ from engine.matching import ZERO_ERROR_FRACTION, error_floor
 from engine.metrics import wrap_border_ratio
 from engine.quilting import BlockPlaced, grid_border_ratio, iter_quilt, quilt
 from resources import SAMPLE_NAMES
+from tests.engine.helpers import events_and_result
 
 
 @pytest.fixture(scope="module")
@@ -19,15 +20,6 @@ def cobbles():
     return load_image(sample_path("cobblestones")).pixels[:96, :96].copy()
 
 
-def events_of(gen):
-    events = []
-    while True:
-        try:
-            events.append(next(gen))
-        except StopIteration as stop:
-            return events, stop.value
-
-
 def wrap_write(canvas, pos, pixels):
     h, w = pixels.shape[:2]
     rows = np.arange(pos[0], pos[0] + h) % canvas.shape[0]
@@ -36,7 +28,7 @@ def wrap_write(canvas, pos, pixels):
 
 
 def test_events_replay_to_the_result_and_records_are_consistent(cobbles):
-    events, res = events_of(
+    events, res = events_and_result(
         iter_quilt(cobbles, (70, 90), block=24, overlap=4, rng=3, threads=1, blend="none")
     )
     placed = [e for e in events if isinstance(e, BlockPlaced)]
@@ -77,7 +69,9 @@ def test_best_choice_is_within_tolerance_of_brute_force(cobbles):
     window's recorded error is its brute-force SSD, and it is within 1 + tolerance of the
     brute-force best over all windows (exact mode)."""
     sample = cobbles[:48, :48]
-    events, res = events_of(iter_quilt(sample, (40, 40), block=16, overlap=4, rng=1, threads=1))
+    events, res = events_and_result(
+        iter_quilt(sample, (40, 40), block=16, overlap=4, rng=1, threads=1)
+    )
     canvas = np.zeros_like(res.image)
     filled = np.zeros(canvas.shape[:2], bool)
     checked = 0

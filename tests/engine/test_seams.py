@@ -19,6 +19,7 @@ from engine.seams import (
 )
 from engine.seams.oscillating import INITS, SMOOTH_SIGMA
 from engine.seams.oscillating import criterion as osc_criterion
+from tests.engine.helpers import events_and_result
 from tests.engine.test_seams_oracles import (
     brute_dp,
     brute_graph,
@@ -48,16 +49,6 @@ def controls_of(seam: Seam) -> np.ndarray:
     c = np.full(h, -1)
     np.maximum.at(c, seam.path[:, 0], seam.path[:, 1])
     return c
-
-
-def run_stream(gen):
-    """All events left in an event generator, and its return value."""
-    events = []
-    while True:
-        try:
-            events.append(next(gen))
-        except StopIteration as stop:
-            return events, stop.value
 
 
 def assert_valid(seam: Seam, error, *, one_per_row=False):
@@ -442,7 +433,7 @@ def test_oscillating_cancel_returns_valid_path_no_worse_than_initial(init):
     for _ in range(5):
         next(gen)
     token.cancel()
-    rest, result = run_stream(gen)
+    rest, result = events_and_result(gen)
     assert rest and rest[-1].final and rest[-1].seam is result
     assert_valid(result, e)
     assert result.criterion <= first.seam.criterion
@@ -707,7 +698,7 @@ def test_validation_messages():
 def test_input_untouched_float32_accepted(method):
     e = smooth_map((16, 6), 0).astype(np.float32)
     before = e.copy()
-    updates, seam = run_stream(iter_find_seam(e, method=method))
+    updates, seam = events_and_result(iter_find_seam(e, method=method))
     assert np.array_equal(e, before)
     assert isinstance(updates[-1], SeamUpdate) and updates[-1].final
     assert updates[-1].seam is seam and seam.method == method

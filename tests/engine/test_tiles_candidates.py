@@ -6,7 +6,7 @@ from scipy import ndimage
 
 import resources
 from engine.cancel import CancelToken
-from engine.events import Progress
+from engine.events import Progress, drain
 from engine.io import load_image
 from engine.metrics import border_ratio, grid_score
 from engine.tiles import (
@@ -22,6 +22,7 @@ from engine.tiles import (
     random_layout,
 )
 from engine.tiles.candidates import _Setup
+from tests.engine.helpers import events_and_result
 
 
 def texture(shape=(140, 150), channels=3, seed=0, sigma=1.5):
@@ -39,22 +40,13 @@ def small():
     return S, make_seamless(S, RECT, overlap=W_T)
 
 
-def drain_events(gen):
-    events = []
-    while True:
-        try:
-            events.append(next(gen))
-        except StopIteration as stop:
-            return events, stop.value
-
-
 def ring(a, m):
     return np.concatenate([a[:m].ravel(), a[-m:].ravel(), a[:, :m].ravel(), a[:, -m:].ravel()])
 
 
 def test_candidates_keep_the_template_border_and_stream(small):
     S, st = small
-    events, cands = drain_events(iter_candidates(S, st, 6, rng=3, workers=2, margin=2))
+    events, cands = events_and_result(iter_candidates(S, st, 6, rng=3, workers=2, margin=2))
     items = [e for e in events if isinstance(e, CandidateTile)]
     assert all(isinstance(e, (CandidateTile, Progress)) for e in events)
     assert sorted(c.index for c in items) == list(range(6))
@@ -100,16 +92,14 @@ def test_cancel_keeps_the_candidates_already_made(small, workers):
     token = CancelToken()
     gen = iter_candidates(S, st, 12, rng=5, workers=workers, cancel=token)
     got = []
-    while True:
-        try:
-            ev = next(gen)
-        except StopIteration as stop:
-            kept = stop.value
-            break
+
+    def on_event(ev):
         if isinstance(ev, CandidateTile):
             got.append(ev)
             if len(got) == 3:
                 token.cancel()
+
+    kept = drain(gen, on_event)
     assert 3 <= len(kept) < 12
     assert {c.index for c in got} == {c.index for c in kept}
     for c in kept:

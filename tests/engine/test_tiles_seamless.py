@@ -18,6 +18,7 @@ from engine.tiles import (
     iter_make_seamless,
     make_seamless,
 )
+from tests.engine.helpers import events_and_result
 
 
 def texture(shape=(120, 130), channels=3, seed=0, sigma=2.0):
@@ -109,13 +110,7 @@ def test_regions_errors_and_paths_are_consistent():
 def test_stream_order_and_oscillating_improvements():
     S = texture(seed=4, sigma=1.0)
     gen = iter_make_seamless(S, RECT, overlap=W_T, method="oscillating", o_max=2)
-    events = []
-    while True:
-        try:
-            events.append(next(gen))
-        except StopIteration as stop:
-            st = stop.value
-            break
+    events, st = events_and_result(gen)
     ups = [e for e in events if isinstance(e, SeamlessUpdate)]
     assert all(isinstance(e, (SeamlessUpdate, Progress)) for e in events)
     whichs = [u.which for u in ups]
@@ -135,15 +130,8 @@ def test_updates_carry_each_overlaps_regions_and_error_map(method):
     S = texture(seed=4, sigma=1.0)
     opts = {"o_max": 2} if method == "oscillating" else {}
     gen = iter_make_seamless(S, RECT, overlap=W_T, method=method, **opts)
-    ups = []
-    while True:
-        try:
-            ev = next(gen)
-        except StopIteration as stop:
-            st = stop.value
-            break
-        if isinstance(ev, SeamlessUpdate):
-            ups.append(ev)
+    events, st = events_and_result(gen)
+    ups = [ev for ev in events if isinstance(ev, SeamlessUpdate)]
     names = {"horizontal": ("R_R", "R_L"), "vertical": ("R_B", "R_T")}
     for which, keys in names.items():
         mine = [u for u in ups if u.which == which]

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from engine.cancel import Cancelled, CancelToken
-from engine.events import Progress
+from engine.events import Progress, drain
 from engine.tiles import (
     Template,
     TemplateUpdate,
@@ -16,6 +16,7 @@ from engine.tiles import (
     template_cost,
 )
 from engine.tiles.template import _argmin, _pair_cost, _Scan
+from tests.engine.helpers import events_and_result
 
 
 def periodic(period=(23, 29), shape=(90, 100), channels=3, seed=0):
@@ -125,13 +126,7 @@ def test_refine_never_worse_and_two_phase_near_brute_force():
 def test_stream_improves_and_ends_with_result():
     S = periodic(shape=(80, 90))
     gen = iter_find_template(S, tile_min=18, tile_max=30, overlap=3)
-    events = []
-    while True:
-        try:
-            events.append(next(gen))
-        except StopIteration as stop:
-            result = stop.value
-            break
+    events, result = events_and_result(gen)
     ups = [e for e in events if isinstance(e, TemplateUpdate)]
     assert ups and all(isinstance(e, (TemplateUpdate, Progress)) for e in events)
     costs = [u.cost for u in ups]
@@ -162,15 +157,14 @@ def test_cancel_before_and_after_first_rectangle():
     token = CancelToken()
     gen = iter_find_template(S, tile_min=18, tile_max=30, overlap=3, cancel=token)
     first = None
-    while True:
-        try:
-            ev = next(gen)
-        except StopIteration as stop:
-            result = stop.value
-            break
+
+    def on_event(ev):
+        nonlocal first
         if isinstance(ev, TemplateUpdate) and first is None:
             first = ev
             token.cancel()
+
+    result = drain(gen, on_event)
     assert result.rect == first.rect
 
 
