@@ -1,5 +1,8 @@
 """Shared helpers of the engine tests."""
 
+import numpy as np
+from scipy import ndimage
+
 from engine.events import drain
 
 
@@ -8,3 +11,10 @@ def events_and_result(gen):
     events = []
     result = drain(gen, events.append)
     return events, result
+
+
+def smooth_texture(shape, channels=3, seed=0, sigma=2.0):
+    """Gaussian-smoothed noise of ``shape`` + (channels,), stretched to [0, 1], float32."""
+    rng = np.random.default_rng(seed)
+    x = ndimage.gaussian_filter(rng.random(shape + (channels,)), (sigma, sigma, 0))
+    return ((x - x.min()) / (x.max() - x.min())).astype(np.float32)

@@ -22,13 +22,11 @@ from engine.tiles import (
     random_layout,
 )
 from engine.tiles.candidates import _Setup
-from tests.engine.helpers import events_and_result
+from tests.engine.helpers import events_and_result, smooth_texture
 
 
 def texture(shape=(140, 150), channels=3, seed=0, sigma=1.5):
-    rng = np.random.default_rng(seed)
-    x = ndimage.gaussian_filter(rng.random(shape + (channels,)), (sigma, sigma, 0))
-    return ((x - x.min()) / (x.max() - x.min())).astype(np.float32)
+    return smooth_texture(shape, channels, seed, sigma)
 
 
 RECT, W_T = (10, 12, 64, 60), 8

@@ -2,7 +2,6 @@
 
 import numpy as np
 import pytest
-from scipy import ndimage
 
 import resources
 from engine.cancel import Cancelled, CancelToken
@@ -18,14 +17,11 @@ from engine.tiles import (
     iter_make_seamless,
     make_seamless,
 )
-from tests.engine.helpers import events_and_result
+from tests.engine.helpers import events_and_result, smooth_texture
 
 
 def texture(shape=(120, 130), channels=3, seed=0, sigma=2.0):
-    rng = np.random.default_rng(seed)
-    x = ndimage.gaussian_filter(rng.random(shape + (channels,)), (sigma, sigma, 0))
-    x = (x - x.min()) / (x.max() - x.min())
-    return x.astype(np.float32)
+    return smooth_texture(shape, channels, seed, sigma)
 
 
 RECT, W_T = (7, 11, 60, 50), 8
