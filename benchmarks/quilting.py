@@ -95,10 +95,7 @@ class _Grid:
 
 
 def load_sample(name: str, crop: int) -> np.ndarray:
-    px = load_image(sample_path(name)).pixels
-    if px.shape[2] == 1:
-        px = np.repeat(px, 3, axis=2)
-    return np.ascontiguousarray(px[:crop, :crop, :3])
+    return np.ascontiguousarray(load_image(sample_path(name)).rgb[:crop, :crop])
 
 
 def _threads() -> set[str]:

@@ -270,7 +270,7 @@ def run(args) -> int:
 
 def save_seams(path: str, res) -> None:
     """Every block's cut: JSON records, or the output with the cut pixels in red."""
-    from engine.io import save_image
+    from engine.io import save_image, to_rgb
 
     p = Path(path)
     if p.suffix.lower() == ".json":
@@ -304,8 +304,7 @@ def save_seams(path: str, res) -> None:
         except OSError as exc:
             raise OSError(f"{p}: cannot write ({exc.strerror or exc})") from None
         return
-    img = np.repeat(res.image[..., :1], 3, axis=2) if res.image.shape[2] < 3 else res.image[..., :3]
-    img = img.copy()
+    img = to_rgb(res.image).copy()
     h, w = img.shape[:2]
     for r in res.blocks:
         if len(r.path):
