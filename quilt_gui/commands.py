@@ -105,32 +105,38 @@ class SetTemplateRect(_Mergeable):
         return True
 
 
-class SetWaypoints(QUndoCommand):
+class _Swap(QUndoCommand):
+    """Redo gives the document ``new``, undo gives it back ``old``, both through its method
+    named ``APPLY``."""
+
+    APPLY = ""
+
+    def __init__(self, doc: Document, new, old, text: str) -> None:
+        super().__init__(text)
+        self.doc = doc
+        self.new = new
+        self.old = old
+
+    def redo(self) -> None:
+        getattr(self.doc, self.APPLY)(self.new)
+
+    def undo(self) -> None:
+        getattr(self.doc, self.APPLY)(self.old)
+
+
+class SetWaypoints(_Swap):
+    APPLY = "apply_waypoints"
+
     def __init__(self, doc: Document, waypoints: dict, text: str) -> None:
-        super().__init__(text)
-        self.doc = doc
-        self.new = {k: list(v) for k, v in waypoints.items()}
-        self.old = {k: list(v) for k, v in doc.waypoints.items()}
-
-    def redo(self) -> None:
-        self.doc.apply_waypoints(self.new)
-
-    def undo(self) -> None:
-        self.doc.apply_waypoints(self.old)
+        new = {k: list(v) for k, v in waypoints.items()}
+        super().__init__(doc, new, {k: list(v) for k, v in doc.waypoints.items()}, text)
 
 
-class SetPicks(QUndoCommand):
+class SetPicks(_Swap):
+    APPLY = "apply_picks"
+
     def __init__(self, doc: Document, picks: list[int], text: str) -> None:
-        super().__init__(text)
-        self.doc = doc
-        self.new = list(picks)
-        self.old = list(doc.picks)
-
-    def redo(self) -> None:
-        self.doc.apply_picks(self.new)
-
-    def undo(self) -> None:
-        self.doc.apply_picks(self.old)
+        super().__init__(doc, list(picks), list(doc.picks), text)
 
 
 class SetCandidates(QUndoCommand):
@@ -183,47 +189,19 @@ class ReplaceCandidate(QUndoCommand):
         self.doc.apply_candidate(self.index, self.old)
 
 
-class SetLayout(QUndoCommand):
-    def __init__(self, doc: Document, layout, text: str) -> None:
-        super().__init__(text)
-        self.doc = doc
-        self.new = layout
-        self.old = doc.layout
-
-    def redo(self) -> None:
-        self.doc.apply_layout(self.new)
-
-    def undo(self) -> None:
-        self.doc.apply_layout(self.old)
-
-
-class SetPainted(QUndoCommand):
+class SetPainted(_Swap):
     """The painted exclusion mask of the source (one brush stroke = one step)."""
 
+    APPLY = "apply_painted"
+
     def __init__(self, doc: Document, mask, text: str) -> None:
-        super().__init__(text)
-        self.doc = doc
-        self.new = mask
-        self.old = doc.exclude_painted
-
-    def redo(self) -> None:
-        self.doc.apply_painted(self.new)
-
-    def undo(self) -> None:
-        self.doc.apply_painted(self.old)
+        super().__init__(doc, mask, doc.exclude_painted, text)
 
 
-class SetMapWeights(QUndoCommand):
+class SetMapWeights(_Swap):
     """The seam-error weights of the material maps (one step per change)."""
 
+    APPLY = "apply_map_weights"
+
     def __init__(self, doc: Document, weights: dict, text: str) -> None:
-        super().__init__(text)
-        self.doc = doc
-        self.new = dict(weights)
-        self.old = dict(doc.map_weights)
-
-    def redo(self) -> None:
-        self.doc.apply_map_weights(self.new)
-
-    def undo(self) -> None:
-        self.doc.apply_map_weights(self.old)
+        super().__init__(doc, dict(weights), dict(doc.map_weights), text)

@@ -340,9 +340,6 @@ class Document(QObject):
             return None
         return w
 
-    def set_layout(self, layout: np.ndarray | None, *, text: str = "Re-roll layout") -> None:
-        self.undo_stack.push(commands.SetLayout(self, layout, text))
-
     # ------------------------------------------------------------------ apply (commands, jobs)
     def apply_params(self, values: dict) -> None:
         self.params.update(values)
