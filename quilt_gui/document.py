@@ -73,6 +73,11 @@ class Source:
         return next(iter(self.maps))
 
     @property
+    def extra_maps(self) -> dict[str, np.ndarray]:
+        """The material maps other than the main one."""
+        return {k: v for k, v in self.maps.items() if k != self.main_name}
+
+    @property
     def path(self) -> str:
         return next(iter(self.paths.values()), "")
 

@@ -192,25 +192,12 @@ class Pipeline(QObject):
         doc = self.doc
         if doc.source is None or doc.template_rect is None:
             return None
-        p = doc.params
-        extra = {k: v for k, v in doc.source.maps.items() if k != doc.source.main_name}
         wps = {k: list(v) for k, v in doc.waypoints.items() if v}
-        kwargs = dict(
-            overlap=p["overlap"],
-            method=p["method"],
-            metric=p["metric"],
-            blend=p["blend"],
-            width=p["width"],
-            rho=p["rho"],
-            waypoints=wps or None,
-            maps=extra or None,
-            weights=doc.engine_weights(),
-            **params.seam_options(p, p["method"]),
-        )
+        kwargs = dict(overlap=doc.params["overlap"], waypoints=wps or None, **self._seam_options())
         inputs = (
             doc.template_rect,
             tuple(sorted((k, repr(v)) for k, v in kwargs.items() if k != "maps")),
-            tuple(extra),
+            tuple(doc.source.extra_maps),
         )
         return (doc.source.main, doc.template_rect), kwargs, inputs
 
@@ -266,25 +253,32 @@ class Pipeline(QObject):
         if not isinstance(exc, Cancelled):
             self._error(exc)
 
-    # ------------------------------------------------------------------ candidates
-    def _tile_options(self) -> dict:
-        """Seam and patch options of the candidate calls (from the parameters), with the
-        ``exclusion`` that :func:`excluding` turns into their ``excluded`` mask."""
+    def _seam_options(self) -> dict:
+        """Seam method, error metric, blending and material maps (with their seam-error
+        weights) of the seamless tile and the candidates, from the parameters."""
         p = self.doc.params
-        extra = {k: v for k, v in self.doc.source.maps.items() if k != self.doc.source.main_name}
         return dict(
-            exclusion=self.exclusion(),
-            patch_size=p["patch_size"] or None,
-            patch_overlap=p["patch_overlap"] or None,
-            margin=p["margin"],
             method=p["method"],
             metric=p["metric"],
             blend=p["blend"],
             width=p["width"],
             rho=p["rho"],
-            maps=extra or None,
+            maps=self.doc.source.extra_maps or None,
             weights=self.doc.engine_weights(),
             **params.seam_options(p, p["method"]),
+        )
+
+    # ------------------------------------------------------------------ candidates
+    def _tile_options(self) -> dict:
+        """Seam and patch options of the candidate calls (from the parameters), with the
+        ``exclusion`` that :func:`excluding` turns into their ``excluded`` mask."""
+        p = self.doc.params
+        return dict(
+            exclusion=self.exclusion(),
+            patch_size=p["patch_size"] or None,
+            patch_overlap=p["patch_overlap"] or None,
+            margin=p["margin"],
+            **self._seam_options(),
         )
 
     def _template_ready(self) -> bool:
