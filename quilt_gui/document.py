@@ -137,7 +137,6 @@ class Document(QObject):
         self.quilt_blocks: list = []  # engine BlockRecord per placed block
         self.quilt_result = None  # engine QuiltResult / TransferResult when finished
         self.transfer_target: np.ndarray | None = None  # the image a transfer imitates
-        self.transfer_target_path = ""
         # (H, W) bool: source pixels the template search, the candidates and quilting never
         # use (with the exclude_color range); saved in the project's extra["exclude_painted"]
         self.exclude_painted: np.ndarray | None = None
@@ -436,9 +435,8 @@ class Document(QObject):
         self.exclude_painted = mask
         self.exclusion_changed.emit()
 
-    def set_transfer_target(self, pixels: np.ndarray | None, path: str = "") -> None:
+    def set_transfer_target(self, pixels: np.ndarray | None) -> None:
         self.transfer_target = pixels
-        self.transfer_target_path = path
         self.target_changed.emit()
 
     def finish_quilt(self, result) -> None:

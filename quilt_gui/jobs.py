@@ -70,7 +70,6 @@ class Job(QObject):
         self.state = "running"  # running | done | cancelled | failed | aborted
         self.progress: Progress | None = None
         self.started_at = time.perf_counter()
-        self.ended_at: float | None = None
         self.result: Any = None
         self.error: BaseException | None = None
         self._fn, self._args, self._kwargs = fn, args, dict(kwargs)
@@ -196,7 +195,6 @@ class Job(QObject):
 
     @Slot()
     def _on_finished(self) -> None:
-        self.ended_at = time.perf_counter()
         if self.state == "running":
             self.state = "aborted" if self._aborted else "cancelled"
         self._alive = False

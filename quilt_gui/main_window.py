@@ -837,7 +837,7 @@ class MainWindow(QMainWindow):
         self._read("open_target", read_image, path, self._on_target_loaded)
 
     def _on_target_loaded(self, path: str, loaded) -> None:
-        self.doc.set_transfer_target(loaded.pixels, path)
+        self.doc.set_transfer_target(loaded.pixels)
         h, w = loaded.pixels.shape[:2]
         self.show_message(
             "info",

@@ -503,9 +503,6 @@ SEAM_OPTION_KEYS = frozenset(p.key for p in PARAMS if p.group == "Seam options")
 SEAMLESS_KEYS = (
     frozenset({"overlap", "method", "metric", "blend", "width", "rho"}) | SEAM_OPTION_KEYS
 )
-CANDIDATE_KEYS = frozenset(
-    {"n_candidates", "patch_size", "patch_overlap", "margin", "neighbourhood", "seed"}
-)
 PREVIEW_KEYS = frozenset({"preview_rows", "preview_cols", "no_equal_neighbours", "layout_seed"})
 #: Parameters whose change re-runs a shown quilting / transfer result (the brush only paints).
 QUILT_KEYS = frozenset(

@@ -79,9 +79,6 @@ class Pipeline(QObject):
     def _error(self, exc: BaseException) -> None:
         self.message.emit("error", error_text(exc))
 
-    def _progress_only(self, _event) -> None:
-        pass
-
     @Slot()
     def _on_source_changed(self) -> None:
         for key in ("template", "seamless", "candidates", "preview", "tile_metrics", "quilt"):
@@ -488,7 +485,7 @@ class Pipeline(QObject):
             exclusion=self.exclusion(),
             on_event=self._on_quilt_event,
             on_done=self._on_quilt_done,
-            on_error=self._on_quilt_error,
+            on_error=self._error,
             on_cancel=self._on_quilt_cancel,
             **quilt_options(p),
         )
@@ -527,7 +524,7 @@ class Pipeline(QObject):
             sigma=p["sigma"],
             on_event=self._on_quilt_event,
             on_done=self._on_quilt_done,
-            on_error=self._on_quilt_error,
+            on_error=self._error,
             on_cancel=self._on_quilt_cancel,
             **opts,
         )
@@ -551,9 +548,6 @@ class Pipeline(QObject):
             "info",
             f"Synthesized {w}×{h} {what}. Click a block to see its overlap, error map and seam.",
         )
-
-    def _on_quilt_error(self, exc) -> None:
-        self._error(exc)
 
     def _on_quilt_cancel(self) -> None:
         what = "Texture transfer" if self._quilt_mode == "transfer" else "Quilting"
