@@ -1129,13 +1129,7 @@ def _check_options(
     if min_block <= overlap:
         raise ValueError(f"min_block must be larger than the overlap ({overlap}), got {min_block}")
     if seam != "straight":
-        allowed = _seams.OPTIONS.get(seam, {})
-        unknown = sorted(set(seam_options) - set(allowed))
-        if unknown:
-            raise TypeError(
-                f"unexpected option(s) for seam {seam!r}: {', '.join(unknown)} "
-                f"(allowed: {', '.join(allowed) or 'none'})"
-            )
+        _seams.check_option_names(seam, seam_options, "seam")
     elif seam_options:
         raise TypeError(f"seam 'straight' takes no options, got {', '.join(seam_options)}")
     return dict(

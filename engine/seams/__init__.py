@@ -150,15 +150,20 @@ def _pins(shape, start, end, waypoints) -> np.ndarray:
     return pins
 
 
-def _options(method: str, options: dict, shape) -> dict:
+def check_option_names(method: str, options, name: str = "method") -> None:
+    """TypeError naming ``options`` that ``method`` (a parameter called ``name``) does not take."""
     allowed = OPTIONS[method]
     unknown = sorted(set(options) - set(allowed))
     if unknown:
         raise TypeError(
-            f"unexpected option(s) for method {method!r}: {', '.join(unknown)}"
+            f"unexpected option(s) for {name} {method!r}: {', '.join(unknown)}"
             f" (allowed: {', '.join(allowed) or 'none'})"
         )
-    opts = {**allowed, **options}
+
+
+def _options(method: str, options: dict, shape) -> dict:
+    check_option_names(method, options)
+    opts = {**OPTIONS[method], **options}
     if "connectivity" in opts:
         opts["connectivity"] = check_connectivity(opts["connectivity"])
     if method == "minimax":
