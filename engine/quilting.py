@@ -55,7 +55,7 @@ import numpy as np
 from scipy import ndimage
 
 from engine import seams as _seams
-from engine._validate import as_image, as_rng, choice, positive_int
+from engine._validate import as_image, as_rng, choice, non_negative_number, positive_int
 from engine.blend import BLEND_MODES, ramp_from_mask
 from engine.cancel import check
 from engine.errormap import METRICS, colour_channels, error_map
@@ -1092,17 +1092,11 @@ def _check_options(
     if tileable and select != "bhatia":
         _check_torus_axis(Ho, bh, overlap, "height")
         _check_torus_axis(Wo, bw, overlap, "width")
-    if isinstance(tolerance, bool) or not isinstance(tolerance, numbers.Real):
-        raise TypeError(f"tolerance must be a number, got {tolerance!r}")
-    if not (math.isfinite(tolerance) and tolerance >= 0):
-        raise ValueError(f"tolerance must be a finite number >= 0, got {tolerance}")
+    tolerance = non_negative_number(tolerance, "tolerance")
     if candidates is None:
         candidates = DEFAULT_SAMPLED if select == "sampled" else DEFAULT_RERANK
     candidates = positive_int(candidates, "candidates")
-    if isinstance(blend_width, bool) or not isinstance(blend_width, numbers.Real):
-        raise TypeError(f"blend_width must be a number, got {blend_width!r}")
-    if not (math.isfinite(blend_width) and blend_width >= 0):
-        raise ValueError(f"blend_width must be a finite number >= 0, got {blend_width}")
+    blend_width = non_negative_number(blend_width, "blend_width")
     rho = positive_int(rho, "rho", minimum=0)
     ex = None
     if excluded is not None:
@@ -1138,11 +1132,11 @@ def _check_options(
         block=(bh, bw),
         overlap=overlap,
         select=select,
-        tolerance=float(tolerance),
+        tolerance=tolerance,
         candidates=candidates,
         seam=seam,
         blend=blend,
-        blend_width=float(blend_width),
+        blend_width=blend_width,
         rho=rho,
         metric=metric,
         excluded=ex,
