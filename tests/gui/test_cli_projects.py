@@ -9,7 +9,7 @@ import numpy as np
 from engine.cli import main as cli_main
 from engine.project import load_project
 from resources import sample_path
-from tests.gui.helpers import make_window, open_sample, wait_idle
+from tests.gui.helpers import generate, make_window, open_sample, wait_idle
 
 
 def test_cli_project_opens_in_the_editor(qtbot, tmp_path):
@@ -51,11 +51,7 @@ def test_cli_project_opens_in_the_editor(qtbot, tmp_path):
 def test_editor_project_exports_with_the_cli(qtbot, tmp_path):
     w = make_window(qtbot)
     open_sample(qtbot, w)
-    w.doc.set_template_rect((150, 120, 128, 112))
-    w.doc.set_param("n_candidates", 3)
-    wait_idle(qtbot, w)
-    w.act_generate.trigger()
-    wait_idle(qtbot, w)
+    generate(qtbot, w, 3)
     w.doc.set_picks([2, 0])
     wait_idle(qtbot, w)
     path = tmp_path / "editor.quiltproj"

@@ -8,7 +8,7 @@ from PySide6.QtCore import Qt
 
 from engine.materials import decode_normals
 from quilt_gui import settings
-from tests.gui.helpers import make_window, open_sample, wait_idle
+from tests.gui.helpers import generate, make_window, open_sample, wait_idle
 
 
 def normal_map_of(gray: np.ndarray) -> np.ndarray:
@@ -60,11 +60,7 @@ def test_attached_normal_map_follows_every_cut_and_exports(qtbot, tmp_path):
 def test_preview_weight_zero_removes_a_tile_from_the_layout(qtbot):
     w = make_window(qtbot)
     open_sample(qtbot, w)
-    w.doc.set_template_rect((150, 120, 128, 112))
-    w.doc.set_param("n_candidates", 4)
-    wait_idle(qtbot, w)
-    w.act_generate.trigger()
-    wait_idle(qtbot, w)
+    generate(qtbot, w, 4)
     w.doc.set_picks([0, 1, 2])
     wait_idle(qtbot, w)
     assert set(np.unique(w.doc.layout)) == {0, 1, 2}
