@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 from PySide6.QtCore import QEvent, QObject, Qt, Slot
 
+from engine.io import to_rgb
 from quilt_gui.document import Document
 from quilt_gui.pipeline import excluded_mask
 from quilt_gui.widgets.canvas import ImageCanvas, ImageItem
@@ -73,8 +74,8 @@ class ExclusionPainter(QObject):
 
     def pick_colour(self, px: tuple[int, int]) -> None:
         """Exclude the colour of source pixel ``px`` (row, col): one undo step."""
-        rgb = self.doc.source.main[px[0], px[1]]
-        rgb = np.repeat(rgb[:1], 3) if rgb.shape[0] < 3 else rgb[:3]
+        r, c = px
+        rgb = to_rgb(self.doc.source.main[r : r + 1, c : c + 1])[0, 0]
         color = "#" + "".join(f"{int(round(float(v) * 255)):02x}" for v in rgb)
         values = {"exclude_color": color}
         if self.doc.params["exclude_tolerance"] <= 0:
