@@ -28,11 +28,16 @@ def cobblestones(size=512, seed=7):
     d, idx = cKDTree(pts).query(q, k=2)
     edge = (d[:, 1] - d[:, 0]).reshape(size, size)
     cell = idx[:, 0].reshape(size, size)
-    base = np.array([[0.62, 0.48, 0.36], [0.55, 0.53, 0.50], [0.70, 0.60, 0.45], [0.45, 0.38, 0.33]])
+    base = np.array(
+        [[0.62, 0.48, 0.36], [0.55, 0.53, 0.50], [0.70, 0.60, 0.45], [0.45, 0.38, 0.33]]
+    )
     colours = base[rng.integers(0, len(base), len(pts))] * rng.uniform(0.8, 1.15, (len(pts), 1))
     img = colours[cell]
     shade = np.clip(edge / 9.0, 0, 1) ** 0.6
-    grain = 0.06 * _noise(rng, (size, size), 1.0)[..., None] + 0.05 * _noise(rng, (size, size), 4)[..., None]
+    grain = (
+        0.06 * _noise(rng, (size, size), 1.0)[..., None]
+        + 0.05 * _noise(rng, (size, size), 4)[..., None]
+    )
     mortar = np.array([0.22, 0.20, 0.18])
     img = img * (0.55 + 0.45 * shade[..., None]) + grain
     img = np.where((edge < 2.5)[..., None], mortar + grain * 0.5, img)
@@ -45,12 +50,16 @@ def lichen(size=512, seed=11):
     a = _noise(rng, (size, size), 3) + 0.6 * _noise(rng, (size, size), 10)
     b = _noise(rng, (size, size), 1.5)
     stone = np.array([0.52, 0.52, 0.50]) + 0.08 * b[..., None]
-    moss = np.array([0.45, 0.58, 0.22]) + 0.10 * _noise(rng, (size, size), 2)[..., None] * np.array([0.6, 1, 0.3])
+    moss = np.array([0.45, 0.58, 0.22]) + 0.10 * _noise(rng, (size, size), 2)[..., None] * np.array(
+        [0.6, 1, 0.3]
+    )
     t = np.clip((a - 0.2) * 1.5, 0, 1)[..., None]
     return np.clip(stone * (1 - t) + moss * t, 0, 1)
 
 
 if __name__ == "__main__":
     for name, fn in (("cobblestones", cobblestones), ("lichen", lichen)):
-        Image.fromarray(np.round(fn() * 255).astype(np.uint8)).save(OUT / f"{name}.png", optimize=True)
+        Image.fromarray(np.round(fn() * 255).astype(np.uint8)).save(
+            OUT / f"{name}.png", optimize=True
+        )
         print("wrote", OUT / f"{name}.png")
