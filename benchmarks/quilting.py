@@ -11,14 +11,14 @@ float64, union L mask, the compiled dp L-cut, single thread), the exact FFT sear
 (principal components + exact re-ranking) search, on 1 and 2 threads. Every time is the median
 of repeats (the load average is printed: on a shared machine rerun when it is near 0).
 Samples under 200×200 (job A) run on one thread whatever ``threads`` says
-(:data:`engine.quilting.POOL_MIN_SAMPLE_AREA`). Each output's border ratio along the block grid
-(max over the offsets the cuts run in, :func:`engine.quilting.grid_border_ratio`) is shown
-beside it, and the CPU time OpenBLAS's helper threads spent during the runs (0 when every
-product stays on the calling thread, as it should on a small shared machine). Then: the
-streaming overhead (``quilt`` draining every event vs the same run creating none, the two run
-in turn), and the quality figures: grid border ratio of best+dp vs best+straight vs random on
-every bundled sample, and the mean seam peak of Long & Mould's minimax at half-block overlap
-vs dp at the same overlap.
+(:data:`engine.quilting.scheduler.POOL_MIN_SAMPLE_AREA`). Each output's border ratio along the
+block grid (max over the offsets the cuts run in,
+:func:`engine.metrics.block_grid_border_ratio`) is shown beside it, and the CPU time OpenBLAS's
+helper threads spent during the runs (0 when every product stays on the calling thread, as it
+should on a small shared machine). Then: the streaming overhead (``quilt`` draining every event
+vs the same run creating none, the two run in turn), and the quality figures: grid border ratio
+of best+dp vs best+straight vs random on every bundled sample, and the mean seam peak of Long &
+Mould's minimax at half-block overlap vs dp at the same overlap.
 """
 
 from __future__ import annotations
@@ -40,7 +40,9 @@ from benchmarks._util import format_table, median_time  # noqa: E402
 from engine.errormap import error_map  # noqa: E402
 from engine.io import load_image  # noqa: E402
 from engine.matching import ZERO_ERROR_FRACTION, error_floor, select_within_tolerance  # noqa: E402
-from engine.quilting import _quilt_unstreamed, grid_border_ratio, quilt  # noqa: E402
+from engine.metrics import block_grid_border_ratio  # noqa: E402
+from engine.quilting import quilt  # noqa: E402
+from engine.quilting.synthesis import quilt_unstreamed  # noqa: E402
 from engine.stitch import l_cut  # noqa: E402
 from resources import SAMPLE_NAMES, sample_path  # noqa: E402
 
@@ -88,7 +90,7 @@ def baseline_quilt(sample, out_shape, *, block, overlap, tolerance=0.1, rng=0):
 
 
 class _Grid:
-    """What :func:`engine.quilting.grid_border_ratio` needs from a result."""
+    """What :func:`engine.metrics.block_grid_border_ratio` needs from a result."""
 
     def __init__(self, image, block, overlap):
         self.image, self.step, self.band = image, (block - overlap,) * 2, overlap
@@ -148,7 +150,7 @@ def speed(args) -> None:
                 "1.00",
                 "",
                 "",
-                f"{grid_border_ratio(_Grid(base_img, **kw)):.3f}",
+                f"{block_grid_border_ratio(_Grid(base_img, **kw)):.3f}",
             ]
         )
         images = {}
@@ -172,7 +174,7 @@ def speed(args) -> None:
                         f"{base_t / t:.2f}",
                         "" if target is None else f"<= {target}",
                         "" if target is None else ("yes" if t <= target else "NO"),
-                        f"{grid_border_ratio(res):.3f}",
+                        f"{block_grid_border_ratio(res):.3f}",
                     ]
                 )
             same = np.array_equal(images[mode, 1], images[mode, 2])
@@ -223,7 +225,7 @@ def streaming(args) -> None:
         t_stream, t_plain = alternating_medians(
             [
                 lambda s=s, j=j, kw=kw: quilt(s, j["out"], **kw),
-                lambda s=s, j=j, kw=kw: _quilt_unstreamed(s, j["out"], **kw),
+                lambda s=s, j=j, kw=kw: quilt_unstreamed(s, j["out"], **kw),
             ],
             max(args.repeats, 7),
         )
@@ -265,8 +267,8 @@ def quality(args) -> None:
         for label, kw in variants:
             kw = {"block": 32, "overlap": 6, **kw}
             res = [quilt(s, (512, 512), rng=seed, **kw) for seed in seeds]
-            mx = float(np.mean([grid_border_ratio(r) for r in res]))
-            mean = float(np.mean([grid_border_ratio(r, reduce="mean") for r in res]))
+            mx = float(np.mean([block_grid_border_ratio(r) for r in res]))
+            mean = float(np.mean([block_grid_border_ratio(r, reduce="mean") for r in res]))
             cell = f"{mx:.3f} ({mean:.3f})"
             if label == "best+dp":
                 base = mx

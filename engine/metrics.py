@@ -8,6 +8,7 @@ channel); absolute differences are averaged over channels.
   rows instead of columns). 1.0: the joint is as smooth as the texture itself.
 * :func:`wrap_border_ratio` — a tile against itself across its wrap.
 * :func:`grid_border_ratio` — the same ratio along the lines of a block grid.
+* :func:`block_grid_border_ratio` — the same along a quilted image's grid, where its cuts run.
 * :func:`detail_ratio` — variance of the Laplacian of a tile over that of the source
   (:func:`laplacian_variance`).
 * :func:`grid_score` — normalised autocorrelation at a lag of one tile period minus the
@@ -31,6 +32,7 @@ DIRECTIONS = ("horizontal", "vertical")
 WRAP_DIRECTIONS = ("both", "horizontal", "vertical")
 
 __all__ = [
+    "block_grid_border_ratio",
     "border_ratio",
     "detail_ratio",
     "grid_border_ratio",
@@ -137,6 +139,51 @@ def grid_border_ratio(image, period, *, offset=(0, 0), direction: str = "both") 
             f"no grid line of period {(ph, pw)} and offset {(oy, ox)} lies inside the "
             f"{x.shape[1]}x{x.shape[0]} image"
         )
+    return float(np.mean(ratios))
+
+
+def block_grid_border_ratio(result, *, reduce: str = "max") -> float:
+    """Border ratio of a quilted image along its block grid, where the cuts run.
+
+    ``result`` is an :class:`engine.quilting.QuiltResult` or anything with its ``image``,
+    ``step`` (the grid's period), ``band`` (the width of the strip after each grid line in which
+    the cuts run) and, for an output that wraps, ``torus_lines`` (row and column positions where
+    its blocks start; None or absent otherwise).
+
+    The joints are not straight lines after a cut, so the ratio is measured on the grid lines
+    shifted by every offset 0..band and the largest (``"max"``) or the mean (``"mean"``) is
+    returned; a straight overlap's joint lies at offset 0. A tileable output is measured as the
+    torus it is (the image tiled 2 × 2): at the real block positions, the wrap line included.
+    """
+    choice(reduce, "reduce", ("max", "mean"))
+    lines = getattr(result, "torus_lines", None)
+    vals = []
+    for k in range(result.band + 1):
+        if lines is not None:
+            vals.append(_torus_grid_ratio(result.image, lines, k))
+            continue
+        try:
+            vals.append(grid_border_ratio(result.image, result.step, offset=(k, k)))
+        except ValueError:  # no grid line inside the image at this offset
+            continue
+    if not vals:
+        raise ValueError("the output has no block grid line inside it")
+    return float(max(vals) if reduce == "max" else np.mean(vals))
+
+
+def _torus_grid_ratio(image: np.ndarray, lines, offset: int) -> float:
+    """Mean |step| across the lines ``lines + offset`` (rows, cols; modulo the size, so the
+    wrap joint counts) over the mean |step| between every other pair of neighbours."""
+    x = colour_channels(image).astype(np.float64)
+    ratios = []
+    for a, starts in ((x, lines[1]), (x.transpose(1, 0, 2), lines[0])):
+        n = a.shape[1]
+        steps = np.abs(np.roll(a, -1, axis=1) - a).mean(axis=2)  # i: column i -> (i + 1) % n
+        on = np.zeros(n, dtype=bool)
+        on[(starts + offset - 1) % n] = True
+        if on.any() and (~on).any():
+            den = steps[:, ~on].mean()
+            ratios.append(steps[:, on].mean() / den if den > 0 else 1.0)
     return float(np.mean(ratios))
 
 

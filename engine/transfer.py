@@ -34,16 +34,11 @@ from engine.cancel import check
 from engine.errormap import colour_channels
 from engine.events import Progress, Snapshot, drain
 from engine.matching import ZERO_ERROR_FRACTION, SampleSpectrum, error_floor
-from engine.quilting import (
-    SEAMS,
-    BlockRecord,
-    _check_options,
-    _Quilter,
-    _resolve_threads,
-    _run_levels,
-    _Work,
-    grid_rects,
-)
+from engine.quilting.core import BlockWork, Quilter
+from engine.quilting.layout import grid_rects
+from engine.quilting.options import SEAMS, check_options, resolve_threads
+from engine.quilting.records import BlockRecord
+from engine.quilting.scheduler import run_levels
 
 CORRESPONDENCES = ("luminance", "blurred")
 
@@ -133,7 +128,7 @@ def _check_alpha(alpha):
             raise ValueError(f"alpha must lie in [0, 1], got {alpha!r}")
 
 
-class _TransferQuilter(_Quilter):
+class _TransferQuilter(Quilter):
     """One transfer pass: the quilting engine with the α-weighted three-term cost."""
 
     def __init__(self, *, corr_sample, corr_target, previous, alpha, corr_floor, **kw):
@@ -149,7 +144,7 @@ class _TransferQuilter(_Quilter):
         stack = np.concatenate([self.match_sample, self.corr_sample[:, :, None]], axis=2)
         return SampleSpectrum(stack, groups=(tuple(range(c)), (c,)), workers=self.threads)
 
-    def load(self, wk: _Work) -> None:
+    def load(self, wk: BlockWork) -> None:
         super().load(wk)
         ix = self.idx(wk.y, wk.x, wk.h, wk.w)
         wk.extra["corr"] = self.corr_target[ix]
@@ -171,11 +166,11 @@ class _TransferQuilter(_Quilter):
             r_prev * self.floor * hw * c + r_corr * self.corr_floor * hw
         )
 
-    def zero_level_for(self, wk: _Work) -> float:
+    def zero_level_for(self, wk: BlockWork) -> float:
         return wk.extra["zero"]
 
-    def search(self, works: list[_Work]) -> None:
-        groups: dict[tuple[int, int], list[_Work]] = {}
+    def search(self, works: list[BlockWork]) -> None:
+        groups: dict[tuple[int, int], list[BlockWork]] = {}
         for wk in works:
             if wk.extra["searched"]:
                 groups.setdefault((wk.h, wk.w), []).append(wk)
@@ -287,31 +282,31 @@ def iter_transfer(
                 "use fewer iterations, a larger block" + (" or a smaller overlap" if also else "")
             )
         plans.append(
-            _check_options(
+            check_options(
                 s,
                 out_shape,
-                b,
-                ov,
-                "best",
-                tolerance,
-                None,
-                seam,
-                blend,
-                blend_width,
-                rho,
-                metric,
-                excluded,
-                False,
-                None,
-                None,
-                "exact",
-                seam_options,
+                block=b,
+                overlap=ov,
+                select="best",
+                tolerance=tolerance,
+                candidates=None,
+                seam=seam,
+                blend=blend,
+                blend_width=blend_width,
+                rho=rho,
+                metric=metric,
+                excluded=excluded,
+                tileable=False,
+                adaptive_threshold=None,
+                min_block=None,
+                mode="exact",
+                seam_options=seam_options,
             )
         )
     gen = as_rng(rng)
     seed = int(gen.integers(2**63))
     return _iter_transfer(
-        s, t, plans, sched, correspondence, float(sigma), seed, cancel, _resolve_threads(threads)
+        s, t, plans, sched, correspondence, float(sigma), seed, cancel, resolve_threads(threads)
     )
 
 
@@ -339,7 +334,7 @@ def _iter_transfer(s, t, plans, sched, kind, sigma, seed, cancel, threads):
             **opts,
         )
         rects = grid_rects(q.out_shape, q.block, q.overlap, False)
-        gen = _run_levels(q, rects, f"blocks (iteration {i})")
+        gen = run_levels(q, rects, f"blocks (iteration {i})")
         while True:
             try:
                 ev = next(gen)

@@ -237,7 +237,8 @@ def cut_options(args) -> dict:
 
 
 def run(args) -> int:
-    from engine.quilting import grid_border_ratio, iter_quilt
+    from engine.metrics import block_grid_border_ratio
+    from engine.quilting import iter_quilt
 
     sample, depth, excluded = load_sample_and_exclusion(args)
     gen = start(
@@ -259,7 +260,8 @@ def run(args) -> int:
     save_output(args, res.image, depth)
     if args.save_seams:
         save_seams(args.save_seams, res)
-    ratio = grid_border_ratio(res) if min(res.image.shape[:2]) > max(res.step) else float("nan")
+    fits = min(res.image.shape[:2]) > max(res.step)
+    ratio = block_grid_border_ratio(res) if fits else float("nan")
     print(
         f"quilt-studio synth: wrote {args.output} ({res.image.shape[1]}x{res.image.shape[0]}, "
         f"{depth}-bit, {len(res.blocks)} blocks, grid border ratio {ratio:.3f})",

@@ -1,13 +1,14 @@
 import numpy as np
 import pytest
 
-from engine import metrics, quilting
+from engine import metrics
 from engine.cancel import Cancelled, CancelToken
 from engine.events import Progress
 from engine.exclusion import exclusion_mask
 from engine.matching import ZERO_ERROR_FRACTION, error_floor
-from engine.metrics import wrap_border_ratio
-from engine.quilting import BlockPlaced, grid_border_ratio, iter_quilt, quilt
+from engine.metrics import block_grid_border_ratio, wrap_border_ratio
+from engine.quilting import BlockPlaced, iter_quilt, quilt, scheduler
+from engine.quilting.synthesis import quilt_unstreamed
 from resources import SAMPLE_NAMES
 from tests.engine.helpers import events_and_result
 
@@ -58,7 +59,7 @@ def test_unstreamed_reference_is_the_same_run(cobbles):
     quilt() returns (so "streaming adds <= 10 %" compares like with like)."""
     kw = dict(block=24, overlap=4, rng=3, threads=1)
     a = quilt(cobbles, (70, 90), **kw)
-    b = quilting._quilt_unstreamed(cobbles, (70, 90), **kw)
+    b = quilt_unstreamed(cobbles, (70, 90), **kw)
     np.testing.assert_array_equal(a.image, b.image)
     assert [r.source for r in a.blocks] == [r.source for r in b.blocks]
     assert list(iter_quilt(cobbles, (70, 90), **kw))  # quilt() did drain events
@@ -116,7 +117,7 @@ def test_best_choice_is_within_tolerance_of_brute_force(cobbles):
     ],
 )
 def test_same_seed_same_output_for_any_thread_count(cobbles, kw, monkeypatch):
-    monkeypatch.setattr(quilting, "POOL_MIN_SAMPLE_AREA", 0)  # use the pool even for this sample
+    monkeypatch.setattr(scheduler, "POOL_MIN_SAMPLE_AREA", 0)  # use the pool even for this sample
     a, b, d = (
         quilt(cobbles, (100, 120), block=24, overlap=6, rng=7, threads=t, **kw) for t in (1, 2, 3)
     )
@@ -147,7 +148,7 @@ def test_quality_order_best_dp_straight_random(name):
     def ratio(**kw):
         return np.mean(
             [
-                grid_border_ratio(quilt(s, (224, 224), block=32, overlap=6, rng=k, **kw))
+                block_grid_border_ratio(quilt(s, (224, 224), block=32, overlap=6, rng=k, **kw))
                 for k in range(2)
             ]
         )
@@ -214,12 +215,12 @@ def test_tileable_output_wraps_seamlessly(cobbles, kw):
         twice = np.tile(res.image, (2, 2, 1))
         assert lo < metrics.grid_border_ratio(twice, res.image.shape[:2]) < hi
         assert lo < wrap_border_ratio(res.image) < hi
-    assert grid_border_ratio(tiled) <= 1.4
+    assert block_grid_border_ratio(tiled) <= 1.4
     if kw.get("select") != "bhatia":
         assert any(r.arms[3] for r in tiled.blocks) and any(r.arms[2] for r in tiled.blocks)
         # the torus grid sees joints that are there: a straight overlap's
         straight = quilt(cobbles, (100, 110), tileable=True, seam="straight", **kw)
-        assert grid_border_ratio(straight) > 1.5 * grid_border_ratio(tiled)
+        assert block_grid_border_ratio(straight) > 1.5 * block_grid_border_ratio(tiled)
 
 
 def test_tileable_minimax_default_overlap_fits_the_torus(cobbles):

@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from engine.io import load_image
-from engine.quilting import grid_border_ratio, quilt
+from engine.metrics import block_grid_border_ratio
+from engine.quilting import quilt
 from resources import SAMPLE_NAMES, sample_path
 
 
@@ -19,7 +20,7 @@ def test_fast_mode_grid_border_ratio_within_5_percent_of_exact(name):
     ratio = {
         mode: np.mean(
             [
-                grid_border_ratio(quilt(s, (256, 256), block=32, overlap=6, rng=k, mode=mode))
+                block_grid_border_ratio(quilt(s, (256, 256), block=32, overlap=6, rng=k, mode=mode))
                 for k in range(3)
             ]
         )

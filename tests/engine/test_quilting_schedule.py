@@ -2,7 +2,8 @@
 
 import numpy as np
 
-from engine.quilting import _check_torus_axis, _dependencies, grid_rects
+from engine.quilting.layout import check_torus_axis, grid_rects
+from engine.quilting.scheduler import dependencies
 
 
 def dependencies_per_pixel(rects, shape, torus):
@@ -39,11 +40,11 @@ def test_dependencies_equal_the_per_pixel_definition():
             torus = bool(rng.integers(2))
             if torus:
                 try:
-                    _check_torus_axis(H, b, ov, "height")
-                    _check_torus_axis(W, b, ov, "width")
+                    check_torus_axis(H, b, ov, "height")
+                    check_torus_axis(W, b, ov, "width")
                 except ValueError:
                     continue
             rects = grid_rects((H, W), (b, b), ov, torus)
-        assert _dependencies(rects, (H, W), torus) == dependencies_per_pixel(rects, (H, W), torus)
+        assert dependencies(rects, (H, W), torus) == dependencies_per_pixel(rects, (H, W), torus)
         checked += 1
     assert checked > 80

@@ -1,10 +1,9 @@
 import numpy as np
 import pytest
 
-from engine import quilting
 from engine.cancel import Cancelled, CancelToken
 from engine.io import load_image
-from engine.quilting import BlockPlaced, quilt
+from engine.quilting import BlockPlaced, quilt, scheduler
 from engine.transfer import (
     IterationDone,
     correspondence_map,
@@ -76,7 +75,7 @@ def test_correspondence_error_falls_on_every_sample_while_alpha_stays_moderate(n
 
 
 def test_same_seed_same_transfer_for_any_thread_count(cobbles, monkeypatch):
-    monkeypatch.setattr(quilting, "POOL_MIN_SAMPLE_AREA", 0)
+    monkeypatch.setattr(scheduler, "POOL_MIN_SAMPLE_AREA", 0)
     kw = dict(block=20, iterations=2, rng=4)
     a = transfer(cobbles, disc(), threads=1, **kw)
     b = transfer(cobbles, disc(), threads=2, **kw)

@@ -1,0 +1,327 @@
+"""The block loop of image quilting: search, choose, cut and paste one block on the canvas.
+
+ALGORITHMS.md §2.2, §3, §5. The selections ``"best"`` (exact FFT search or ``mode="fast"``),
+``"sampled"`` and ``"random"`` and the adaptive split of a block whose best overlap error is too
+high (Long & Mould's hybrid framework) are described in :mod:`engine.quilting`; the cut and blend
+are :mod:`engine.quilting.cut`'s; the order of the blocks and the threads are
+:mod:`engine.quilting.scheduler`'s.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from engine.cancel import check
+from engine.errormap import colour_channels, error_map
+from engine.exclusion import valid_anchors
+from engine.matching import (
+    ZERO_ERROR_FRACTION,
+    PCAMatcher,
+    SampleSpectrum,
+    error_floor,
+    select_within_tolerance,
+    ssd_at,
+)
+from engine.quilting.cut import blend_alpha, cut_overlap, straight_alpha
+from engine.quilting.layout import arms_of, canvas_index
+from engine.quilting.records import EMPTY_PATH, BlockRecord, read_only
+
+__all__ = ["BlockWork", "Quilter"]
+
+
+@dataclass
+class BlockWork:
+    """A block being placed: footprint, content under it, and its generator."""
+
+    index: int
+    y: int
+    x: int
+    h: int
+    w: int
+    rng: np.random.Generator
+    depth: int = 0
+    old: np.ndarray | None = None
+    filled: np.ndarray | None = None
+    arms: tuple[int, int, int, int] = (0, 0, 0, 0)
+    found: tuple | None = None  # search result: ("map", e) | ("list", anchors, errors) | None
+    extra: dict = field(default_factory=dict)  # per-algorithm data (texture transfer)
+
+
+class Quilter:
+    """Shared state of one synthesis: sample, spectra, canvas, valid anchors, options.
+
+    :func:`engine.quilting.scheduler.run_levels` drives it: :meth:`prepare` once, then per
+    block :meth:`load` (read the canvas under it), :meth:`search` (any thread) and :meth:`place`
+    (choose, cut, paste). Texture transfer subclasses it and overrides :meth:`make_spectrum`,
+    :meth:`load`, :meth:`zero_level_for` and :meth:`search` (its α-weighted cost).
+    """
+
+    def __init__(self, *, seed: int, cancel, threads: int, **options):
+        # options: the validated keywords of iter_quilt, as returned by check_options (sample,
+        # out_shape, block, overlap, select, tolerance, candidates, seam, blend, blend_width, rho,
+        # metric, excluded, tileable, adaptive_threshold, min_block, mode, seam_options)
+        self.__dict__.update(options)
+        self.seed, self.cancel, self.threads = seed, cancel, threads
+        sample, out_shape = self.sample, self.out_shape
+        self.match_sample = np.ascontiguousarray(colour_channels(sample))
+        self.canvas = np.zeros((*out_shape, sample.shape[2]), np.float32)
+        self.filled = np.zeros(out_shape, dtype=bool)
+        self.floor = error_floor(self.match_sample)
+        self._valid: dict[tuple[int, int], tuple[np.ndarray | None, np.ndarray]] = {}
+        self._spectrum = None
+        self._pca = None
+        self.fft_workers = 1 if threads > 1 else threads  # the pool already uses every thread
+        self.stream = True  # False: no events (the benchmark's streaming-overhead reference)
+
+    def prepare(self) -> None:
+        """Build the structures every search shares (before any thread reads them)."""
+        if self.select == "best":
+            _ = self.spectrum
+            if self.mode == "fast":
+                self.pca()
+
+    # ---------------------------------------------------------------- sample helpers
+    @property
+    def spectrum(self) -> SampleSpectrum:
+        if self._spectrum is None:
+            self._spectrum = self.make_spectrum()
+        return self._spectrum
+
+    def make_spectrum(self) -> SampleSpectrum:
+        return SampleSpectrum(self.match_sample, workers=self.threads)
+
+    def valid(self, h: int, w: int):
+        """(valid anchor map or None if all valid, flat indices of valid anchors)."""
+        key = (h, w)
+        if key not in self._valid:
+            if self.excluded is None:
+                self._valid[key] = (None, None)
+            else:
+                v = valid_anchors(self.excluded, (h, w))
+                self._valid[key] = (v, np.flatnonzero(v))
+        return self._valid[key]
+
+    def random_anchor(self, h: int, w: int, rng) -> tuple[int, int]:
+        H, W = self.sample.shape[:2]
+        _, flat = self.valid(h, w)
+        nx = W - w + 1
+        k = (
+            int(rng.integers((H - h + 1) * nx))
+            if flat is None
+            else int(flat[rng.integers(flat.size)])
+        )
+        return divmod(k, nx)
+
+    def zero_level_for(self, wk: BlockWork) -> float:
+        """Error below which a candidate counts as an exact copy (see ``tolerance``)."""
+        return self.zero_level(int(wk.filled.sum()))
+
+    def zero_level(self, overlap_pixels: int) -> float:
+        return ZERO_ERROR_FRACTION * self.floor * overlap_pixels * self.match_sample.shape[2]
+
+    def pca(self) -> PCAMatcher:
+        if self._pca is None:
+            ov = self.overlap
+            self._pca = PCAMatcher(
+                self.spectrum,
+                self.block,
+                top=ov,
+                left=ov,
+                rng=np.random.default_rng([self.seed, 1]),
+            )
+        return self._pca
+
+    # ---------------------------------------------------------------- canvas
+    def idx(self, y, x, h, w):
+        return canvas_index(y, x, h, w, self.out_shape, self.tileable)
+
+    def load(self, wk: BlockWork) -> None:
+        ix = self.idx(wk.y, wk.x, wk.h, wk.w)
+        wk.filled = self.filled[ix].copy()
+        wk.old = colour_channels(self.canvas[ix]) if wk.filled.any() else None
+        wk.arms = arms_of(wk.filled) if wk.old is not None else (0, 0, 0, 0)
+
+    # ---------------------------------------------------------------- search
+    def search(self, works: list[BlockWork]) -> None:
+        """Fill ``found`` of every work that needs a search (batched per block shape)."""
+        need = [wk for wk in works if wk.old is not None and self.select in ("best", "sampled")]
+        if self.select == "sampled":
+            for wk in need:
+                wk.found = self._sampled(wk)
+            return
+        exact = need
+        if self.mode == "fast":
+            exact = []
+            fast = []
+            for wk in need:
+                t, left, b, r = wk.arms
+                if (wk.h, wk.w) == self.block and b == r == 0 and wk.depth == 0:
+                    parts = self.pca().parts_for(t, left)
+                    if parts:
+                        fast.append((wk, parts))
+                        continue
+                exact.append(wk)
+            if fast:
+                pca = self.pca()
+                v, _ = self.valid(*self.block)
+                res = pca.query(
+                    [wk.old for wk, _ in fast],
+                    [p for _, p in fast],
+                    v,
+                    rerank=self.candidates,
+                    mask_list=[wk.filled for wk, _ in fast],
+                )
+                for (wk, _), (anchors, errs) in zip(fast, res, strict=True):
+                    wk.found = ("list", anchors, errs)
+        self._exact(exact)
+
+    def _exact(self, works: list[BlockWork]) -> None:
+        groups: dict[tuple[int, int], list[BlockWork]] = {}
+        for wk in works:
+            groups.setdefault((wk.h, wk.w), []).append(wk)
+        for (h, w), group in groups.items():
+            check(self.cancel)
+            maps = self.spectrum.ssd(
+                np.stack([wk.old for wk in group]),
+                np.stack([wk.filled for wk in group]),
+                workers=self.fft_workers,
+            )
+            v, _ = self.valid(h, w)
+            for wk, e in zip(group, maps, strict=True):
+                if v is not None:
+                    e[~v] = np.inf
+                wk.found = ("map", e)
+
+    def _sampled(self, wk: BlockWork):
+        H, W = self.sample.shape[:2]
+        _, flat = self.valid(wk.h, wk.w)
+        nx = W - wk.w + 1
+        total = (H - wk.h + 1) * nx if flat is None else flat.size
+        k = min(self.candidates, total)
+        pick = wk.rng.choice(total, size=k, replace=False)
+        if flat is not None:
+            pick = flat[pick]
+        anchors = np.column_stack(np.divmod(pick, nx))
+        errs = ssd_at(self.match_sample, anchors, wk.old, wk.filled)
+        return ("list", anchors, errs)
+
+    # ---------------------------------------------------------------- placing
+    def choose(self, wk: BlockWork):
+        """(anchor (y, x), match error, best error, number of candidates)."""
+        if wk.found is None:
+            y, x = self.random_anchor(wk.h, wk.w, wk.rng)
+            if wk.old is None or self.select != "random":
+                return (y, x), math.nan, math.nan, 1
+            e = float(ssd_at(self.match_sample, np.array([[y, x]]), wk.old, wk.filled)[0])
+            return (y, x), e, math.nan, 1
+        zero = self.zero_level_for(wk)
+        if wk.found[0] == "map":
+            e = wk.found[1]
+            k, e_min, n = select_within_tolerance(
+                e, tolerance=self.tolerance, zero_level=zero, rng=wk.rng
+            )
+            return divmod(k, e.shape[1]), float(e.flat[k]), e_min, n
+        _, anchors, errs = wk.found
+        if self.select == "sampled":
+            i = int(np.argmin(errs))
+            return tuple(int(v) for v in anchors[i]), float(errs[i]), float(errs[i]), len(errs)
+        i, e_min, n = select_within_tolerance(
+            errs, tolerance=self.tolerance, zero_level=zero, rng=wk.rng
+        )
+        return tuple(int(v) for v in anchors[i]), float(errs[i]), e_min, n
+
+    def should_split(self, wk: BlockWork, e_min: float) -> bool:
+        if self.adaptive_threshold is None or wk.old is None or not np.isfinite(e_min):
+            return False
+        child = self.child_size(wk.h), self.child_size(wk.w)
+        if min(child) < self.min_block:
+            return False
+        per_pixel = e_min / (wk.filled.sum() * self.match_sample.shape[2])
+        return per_pixel > self.adaptive_threshold
+
+    def child_size(self, n: int) -> int:
+        return (n + self.overlap + 1) // 2
+
+    def place(self, wk: BlockWork) -> list[tuple[BlockRecord, np.ndarray]]:
+        """Choose, cut and paste one block (or its four children); returns its records."""
+        check(self.cancel)
+        anchor, e_match, e_min, n = self.choose(wk)
+        if self.should_split(wk, e_min):
+            out = []
+            ch, cw = self.child_size(wk.h), self.child_size(wk.w)
+            for dy in (0, wk.h - ch):
+                for dx in (0, wk.w - cw):
+                    child = BlockWork(wk.index, wk.y + dy, wk.x + dx, ch, cw, wk.rng, wk.depth + 1)
+                    self.load(child)
+                    if child.old is not None and self.select in ("best", "sampled"):
+                        if self.select == "sampled":
+                            child.found = self._sampled(child)
+                        else:
+                            self._exact([child])
+                    out.extend(self.place(child))
+            return out
+        return [self.paste(wk, anchor, e_match, e_min, n)]
+
+    def paste(self, wk: BlockWork, anchor, e_match, e_min, n):
+        ay, ax = anchor
+        h, w = wk.h, wk.w
+        new = self.sample[ay : ay + h, ax : ax + w]
+        err = keep = None
+        path, crit, peak = EMPTY_PATH, math.nan, math.nan
+        if wk.old is None:
+            pixels = new.copy()
+        else:
+            old_full = self.canvas[self.idx(wk.y, wk.x, h, w)]
+            overlap = wk.filled
+            err = error_map(wk.old, colour_channels(new), metric=self.metric)
+            err[~overlap] = 0
+            if self.seam == "straight":
+                keep = np.zeros((h, w), dtype=bool)
+                alpha = straight_alpha(wk.arms, (h, w), self.blend)
+            elif not err.any():
+                # old and new agree exactly over the overlap (a continued copy of the sample):
+                # every cut gives the same pixels, so none is searched
+                keep, crit, peak, alpha = overlap.copy(), 0.0, 0.0, None
+            else:
+                cut = cut_overlap(
+                    err, wk.arms, method=self.seam, cancel=self.cancel, **self.seam_options
+                )
+                keep, path, crit, peak = cut.keep_old, read_only(cut.path), cut.criterion, cut.peak
+                keep &= overlap
+                alpha = None
+                if self.blend != "none":
+                    alpha = blend_alpha(
+                        cut, err, overlap, blend=self.blend, width=self.blend_width, rho=self.rho
+                    )
+            if alpha is None:  # hard cut: exact copies of old and new
+                pixels = new.copy()
+                np.copyto(pixels, old_full, where=keep[:, :, None])
+            else:
+                a = alpha[:, :, None]
+                pixels = a * old_full + (1 - a) * new
+            read_only(err)
+            read_only(keep)
+        ix = self.idx(wk.y, wk.x, h, w)
+        self.canvas[ix] = pixels
+        self.filled[ix] = True
+        H, W = self.out_shape
+        rec = BlockRecord(
+            index=-1,
+            position=(wk.y % H, wk.x % W),
+            size=(h, w),
+            source=(ax, ay, w, h),
+            arms=wk.arms,
+            error=err,
+            keep_old=keep,
+            path=path,
+            criterion=crit,
+            peak=peak,
+            match_error=e_match,
+            best_error=e_min,
+            candidates=n,
+            depth=wk.depth,
+        )
+        return rec, read_only(pixels)

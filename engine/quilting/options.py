@@ -1,0 +1,169 @@
+"""The options of image quilting, checked once: names, defaults and the messages for bad input."""
+
+from __future__ import annotations
+
+import math
+import numbers
+import os
+
+import numpy as np
+
+from engine._validate import as_image, choice, non_negative_number, positive_int
+from engine.blend import BLEND_MODES
+from engine.errormap import METRICS
+from engine.exclusion import valid_anchors
+from engine.matching import check_block
+from engine.quilting.bhatia import bhatia_anchors
+from engine.quilting.layout import check_torus_axis, torus_overlap
+from engine.seams import METHODS as SEAM_METHODS
+from engine.seams import check_option_names
+
+SELECTIONS = ("best", "random", "sampled", "bhatia")
+MODES = ("exact", "fast")
+SEAMS = ("straight", *SEAM_METHODS)
+DEFAULT_SAMPLED = 200
+DEFAULT_RERANK = 32
+
+__all__ = [
+    "DEFAULT_RERANK",
+    "DEFAULT_SAMPLED",
+    "MODES",
+    "SEAMS",
+    "SELECTIONS",
+    "check_options",
+    "check_out_shape",
+    "resolve_threads",
+]
+
+
+def resolve_threads(threads) -> int:
+    """``threads`` as a positive int (None: every core)."""
+    if threads is None:
+        return max(1, os.cpu_count() or 1)
+    return positive_int(threads, "threads")
+
+
+def check_out_shape(out_shape) -> tuple[int, int]:
+    """``out_shape`` as (height, width), two positive ints."""
+    try:
+        h, w = out_shape
+    except (TypeError, ValueError):
+        raise TypeError(f"out_shape must be (height, width), got {out_shape!r}") from None
+    for v in (h, w):
+        if isinstance(v, bool) or not isinstance(v, numbers.Integral):
+            raise TypeError(f"out_shape must hold two integers, got {out_shape!r}")
+    if h < 1 or w < 1:
+        raise ValueError(f"out_shape must be at least 1x1, got {w}x{h} (width x height)")
+    return int(h), int(w)
+
+
+def check_options(
+    sample,
+    out_shape,
+    *,
+    block,
+    overlap,
+    select,
+    tolerance,
+    candidates,
+    seam,
+    blend,
+    blend_width,
+    rho,
+    metric,
+    excluded,
+    tileable,
+    adaptive_threshold,
+    min_block,
+    mode,
+    seam_options,
+) -> dict:
+    """The keywords of :func:`engine.quilting.iter_quilt` validated, defaults filled in: a dict
+    with the same names (``sample`` as float32 (H, W, C), ``excluded`` as bool or None)."""
+    s = as_image(sample, "sample")
+    H, W = s.shape[:2]
+    Ho, Wo = check_out_shape(out_shape)
+    bh, bw = check_block(block)
+    choice(select, "select", SELECTIONS)
+    choice(seam, "seam", SEAMS)
+    choice(mode, "mode", MODES)
+    choice(blend, "blend", BLEND_MODES)
+    choice(metric, "metric", METRICS)
+    if overlap is None:
+        overlap = max(1, min(bh, bw) // (2 if seam == "minimax" else 6))
+        if select == "bhatia":
+            overlap = max(1, min(bh, bw) // 4)
+        elif tileable:  # the torus spaces blocks evenly: keep them more than half a block apart
+            overlap = min(torus_overlap(Ho, bh, overlap), torus_overlap(Wo, bw, overlap))
+    overlap = positive_int(overlap, "overlap", minimum=0)
+    if overlap >= min(bh, bw):
+        raise ValueError(f"overlap must be smaller than the block ({min(bh, bw)}), got {overlap}")
+    if select == "bhatia" and overlap < 1:
+        raise ValueError("overlap (the cut band) must be >= 1 with select='bhatia'")
+    if select == "bhatia" and seam == "straight":
+        raise ValueError("select='bhatia' needs a cut: choose a seam method, e.g. 'resistance'")
+    if bh > H or bw > W:
+        raise ValueError(
+            f"the sample ({W}x{H}) is smaller than the block ({bw}x{bh}); use a smaller block"
+        )
+    if bh > Ho or bw > Wo:
+        raise ValueError(
+            f"the block ({bw}x{bh}) is larger than the output ({Wo}x{Ho}); use a smaller block"
+        )
+    if tileable and select != "bhatia":
+        check_torus_axis(Ho, bh, overlap, "height")
+        check_torus_axis(Wo, bw, overlap, "width")
+    tolerance = non_negative_number(tolerance, "tolerance")
+    if candidates is None:
+        candidates = DEFAULT_SAMPLED if select == "sampled" else DEFAULT_RERANK
+    candidates = positive_int(candidates, "candidates")
+    blend_width = non_negative_number(blend_width, "blend_width")
+    rho = positive_int(rho, "rho", minimum=0)
+    ex = None
+    if excluded is not None:
+        ex = np.asarray(excluded)
+        if ex.shape != (H, W):
+            raise ValueError(f"excluded must be shaped {(H, W)} like the sample, got {ex.shape}")
+        ex = ex.astype(bool)
+        if select == "bhatia":
+            if not bhatia_anchors(ex, (bh, bw), overlap).any():
+                raise ValueError(
+                    "every block position (with its extension) in the sample contains an "
+                    "excluded pixel"
+                )
+        elif not valid_anchors(ex, (bh, bw)).any():
+            raise ValueError("every block position in the sample contains an excluded pixel")
+    if adaptive_threshold is not None:
+        if isinstance(adaptive_threshold, bool) or not isinstance(adaptive_threshold, numbers.Real):
+            raise TypeError(f"adaptive_threshold must be a number, got {adaptive_threshold!r}")
+        if not (math.isfinite(adaptive_threshold) and adaptive_threshold > 0):
+            raise ValueError(f"adaptive_threshold must be > 0, got {adaptive_threshold}")
+    if min_block is None:
+        min_block = max(2 * overlap + 1, min(bh, bw) // 4)
+    min_block = positive_int(min_block, "min_block")
+    if min_block <= overlap:
+        raise ValueError(f"min_block must be larger than the overlap ({overlap}), got {min_block}")
+    if seam != "straight":
+        check_option_names(seam, seam_options, "seam")
+    elif seam_options:
+        raise TypeError(f"seam 'straight' takes no options, got {', '.join(seam_options)}")
+    return dict(
+        sample=s,
+        out_shape=(Ho, Wo),
+        block=(bh, bw),
+        overlap=overlap,
+        select=select,
+        tolerance=tolerance,
+        candidates=candidates,
+        seam=seam,
+        blend=blend,
+        blend_width=blend_width,
+        rho=rho,
+        metric=metric,
+        excluded=ex,
+        tileable=tileable,
+        adaptive_threshold=adaptive_threshold,
+        min_block=min_block,
+        mode=mode,
+        seam_options=seam_options,
+    )

@@ -1,0 +1,179 @@
+"""The entry points of image quilting: :func:`iter_quilt` (streamed) and :func:`quilt`."""
+
+from __future__ import annotations
+
+import inspect
+
+from engine._validate import as_rng
+from engine.events import drain
+from engine.quilting.bhatia import iter_bhatia
+from engine.quilting.core import Quilter
+from engine.quilting.layout import grid_rects
+from engine.quilting.options import check_options, resolve_threads
+from engine.quilting.records import QuiltResult
+from engine.quilting.scheduler import run_levels
+
+__all__ = ["iter_quilt", "quilt", "quilt_unstreamed"]
+
+
+def iter_quilt(
+    sample,
+    out_shape,
+    *,
+    block,
+    overlap=None,
+    select: str = "best",
+    tolerance: float = 0.1,
+    candidates: int | None = None,
+    seam: str = "dp",
+    blend: str = "none",
+    blend_width: float = 4,
+    rho: int = 3,
+    metric: str = "ssd",
+    excluded=None,
+    tileable: bool = False,
+    adaptive_threshold: float | None = None,
+    min_block: int | None = None,
+    mode: str = "exact",
+    rng=None,
+    cancel=None,
+    threads: int | None = None,
+    **seam_options,
+):
+    """Synthesize a texture of ``out_shape`` from ``sample`` by image quilting, streaming events.
+
+    Parameters
+    ----------
+    sample : (H, W[, C]) array_like
+        The texture sample (any dtype; alpha is copied but never compared).
+    out_shape : (int, int)
+        Output (height, width).
+    block : int or (int, int)
+        Block size (must fit in the sample and the output).
+    overlap : int, optional
+        Overlap of neighbouring blocks (< block). Default: block / 6 (Efros & Freeman), block / 2
+        for ``seam="minimax"`` (Long & Mould), block / 4 as Bhatia's cut band.
+    select : {"best", "random", "sampled", "bhatia"}
+        See :mod:`engine.quilting`.
+    tolerance : float
+        ``"best"``: draw among windows within ``(1 + tolerance) × e_min`` (0.1 in §2.2). When
+        ``e_min`` is about 0 (an exact copy exists), ``e_min`` is replaced by a floor δ:
+        half the sample's mean squared adjacent-pixel difference per overlap pixel and channel
+        (:data:`engine.matching.ZERO_ERROR_FRACTION`).
+    candidates : int, optional
+        ``"sampled"``: windows drawn per block (default 200); ``mode="fast"``: windows re-ranked
+        exactly (default 32).
+    seam : str
+        ``"straight"`` or a method of :data:`engine.seams.METHODS`.
+    blend : {"none", "feather", "adaptive"}
+        Softening of the cut; ``blend_width`` (feather, px) and ``rho`` (adaptive) tune it.
+    metric : {"ssd", "euclid", "lab"}
+        Error map the cut runs on (the block search always uses the SSD).
+    excluded : (H, W) bool array_like, optional
+        Sample pixels never to copy (:func:`engine.exclusion.exclusion_mask`).
+    tileable : bool
+        Wrap-around overlaps on the last column and row: the output tiles seamlessly.
+    adaptive_threshold : float, optional
+        Split a block into four when its best overlap error, per overlap pixel and channel
+        (mean squared difference in [0, 1]² units), exceeds this.
+    min_block : int, optional
+        Smallest block adaptive splitting makes (default max(2 overlap + 1, block / 4)); children
+        of a block of n pixels measure (n + overlap + 1) // 2 and overlap like the grid.
+    mode : {"exact", "fast"}
+        Exhaustive FFT search, or principal-component ranking with exact re-ranking.
+    rng : int, Generator or None
+        Seed; the same seed gives the same output for any ``threads``.
+    cancel : CancelToken, optional
+        Checked between and inside blocks; raises :class:`engine.cancel.Cancelled`.
+    threads : int, optional
+        Worker threads (default: every core).
+    **seam_options
+        Passed to the seam method (e.g. ``o_max``, ``variant``, ``max_run``).
+
+    Returns
+    -------
+    generator
+        Yields :class:`BlockPlaced` and :class:`~engine.events.Progress`; returns a
+        :class:`QuiltResult`.
+    """
+    return _iter_quilt(
+        _build_quilter(
+            sample,
+            out_shape,
+            block=block,
+            overlap=overlap,
+            select=select,
+            tolerance=tolerance,
+            candidates=candidates,
+            seam=seam,
+            blend=blend,
+            blend_width=blend_width,
+            rho=rho,
+            metric=metric,
+            excluded=excluded,
+            tileable=tileable,
+            adaptive_threshold=adaptive_threshold,
+            min_block=min_block,
+            mode=mode,
+            rng=rng,
+            cancel=cancel,
+            threads=threads,
+            seam_options=seam_options,
+        )
+    )
+
+
+def _build_quilter(sample, out_shape, *, rng, cancel, threads, seam_options, **options):
+    opts = check_options(sample, out_shape, seam_options=seam_options, **options)
+    seed = int(as_rng(rng).integers(2**63))
+    return Quilter(seed=seed, cancel=cancel, threads=resolve_threads(threads), **opts)
+
+
+def quilt_unstreamed(sample, out_shape, **options) -> QuiltResult:
+    """:func:`quilt` without creating any event: the benchmark's reference for the streaming
+    overhead (same blocks, same records, same image)."""
+    bound = inspect.signature(iter_quilt).bind(sample, out_shape, **options)
+    bound.apply_defaults()
+    q = _build_quilter(**bound.arguments)
+    q.stream = False
+    return drain(_iter_quilt(q))
+
+
+def _iter_quilt(q: Quilter):
+    bh, bw = q.block
+    Ho, Wo = q.out_shape
+    if q.select == "bhatia":
+        records = yield from iter_bhatia(q, q.overlap)
+        step, band = (bh, bw), q.overlap
+    else:
+        rects = grid_rects(q.out_shape, q.block, q.overlap, q.tileable)
+        records = yield from run_levels(q, rects, "blocks")
+        step, band = (bh - q.overlap, bw - q.overlap), q.overlap
+    image = q.canvas
+    image.setflags(write=False)
+    return QuiltResult(
+        image=image,
+        blocks=tuple(records),
+        block=q.block,
+        overlap=q.overlap,
+        step=step,
+        band=band,
+        tileable=q.tileable,
+        select=q.select,
+        seam=q.seam,
+        params=dict(
+            tolerance=q.tolerance,
+            candidates=q.candidates,
+            blend=q.blend,
+            metric=q.metric,
+            mode=q.mode,
+            adaptive_threshold=q.adaptive_threshold,
+            min_block=q.min_block,
+            seam_options=dict(q.seam_options),
+        ),
+    )
+
+
+def quilt(sample, out_shape, **options) -> QuiltResult:
+    """Drain :func:`iter_quilt` and return its :class:`QuiltResult`."""
+    return drain(iter_quilt(sample, out_shape, **options))
