@@ -44,10 +44,10 @@ def main(argv=None) -> int:
     from quilt_gui.main_window import MainWindow
 
     window = MainWindow()
-    window.ask_save_changes = lambda: "discard"
+    window.files.ask_save_changes = lambda: "discard"
     window.resize(1400, 900)
     window.show()
-    window.open_path(str(sample_path(args.sample)), confirm=False, remember=False)
+    window.files.open_path(str(sample_path(args.sample)), confirm=False, remember=False)
     wait_until(lambda: window.doc.has_source and not window.pipeline.busy())
     rows = measure_all(window, repeats=args.repeats, heavy=not args.quick)
     print(

@@ -2,6 +2,10 @@
 
 A drag (slider, rectangle) is one undo step: the view gives every change of one drag the
 same ``merge_id`` and :meth:`QUndoCommand.mergeWith` folds them together.
+
+``doc`` is the part of the document a command changes (:class:`quilt_gui.document.Document`
+for parameters and the painted exclusion, :class:`quilt_gui.tileset_doc.TileSetDocument`
+for the rest); this module does not import them, they import it.
 """
 
 from __future__ import annotations
@@ -12,7 +16,7 @@ from typing import TYPE_CHECKING
 from PySide6.QtGui import QUndoCommand
 
 if TYPE_CHECKING:
-    from quilt_gui.document import CandidateEntry, Document
+    from quilt_gui.model import CandidateEntry
 
 _merge_ids = itertools.count(1)
 
@@ -44,7 +48,7 @@ class SetParams(_Mergeable):
     ID = 1
 
     def __init__(
-        self, doc: Document, values: dict, *, merge_id: int | None = None, text: str | None = None
+        self, doc, values: dict, *, merge_id: int | None = None, text: str | None = None
     ) -> None:
         if text is None:
             text = "Change " + ", ".join(values)
@@ -73,7 +77,7 @@ class SetTemplateRect(_Mergeable):
 
     def __init__(
         self,
-        doc: Document,
+        doc,
         rect,
         *,
         merge_id: int | None = None,
@@ -111,7 +115,7 @@ class _Swap(QUndoCommand):
 
     APPLY = ""
 
-    def __init__(self, doc: Document, new, old, text: str) -> None:
+    def __init__(self, doc, new, old, text: str) -> None:
         super().__init__(text)
         self.doc = doc
         self.new = new
@@ -127,7 +131,7 @@ class _Swap(QUndoCommand):
 class SetWaypoints(_Swap):
     APPLY = "apply_waypoints"
 
-    def __init__(self, doc: Document, waypoints: dict, text: str) -> None:
+    def __init__(self, doc, waypoints: dict, text: str) -> None:
         new = {k: list(v) for k, v in waypoints.items()}
         super().__init__(doc, new, {k: list(v) for k, v in doc.waypoints.items()}, text)
 
@@ -135,7 +139,7 @@ class SetWaypoints(_Swap):
 class SetPicks(_Swap):
     APPLY = "apply_picks"
 
-    def __init__(self, doc: Document, picks: list[int], text: str) -> None:
+    def __init__(self, doc, picks: list[int], text: str) -> None:
         super().__init__(doc, list(picks), list(doc.picks), text)
 
 
@@ -148,7 +152,7 @@ class SetCandidates(QUndoCommand):
 
     def __init__(
         self,
-        doc: Document,
+        doc,
         entries: list[CandidateEntry],
         picks: list[int],
         text: str,
@@ -175,7 +179,7 @@ class SetCandidates(QUndoCommand):
 
 
 class ReplaceCandidate(QUndoCommand):
-    def __init__(self, doc: Document, index: int, entry: CandidateEntry, text: str) -> None:
+    def __init__(self, doc, index: int, entry: CandidateEntry, text: str) -> None:
         super().__init__(text)
         self.doc = doc
         self.index = index
@@ -194,7 +198,7 @@ class SetPainted(_Swap):
 
     APPLY = "apply_painted"
 
-    def __init__(self, doc: Document, mask, text: str) -> None:
+    def __init__(self, doc, mask, text: str) -> None:
         super().__init__(doc, mask, doc.exclude_painted, text)
 
 
@@ -203,5 +207,5 @@ class SetMapWeights(_Swap):
 
     APPLY = "apply_map_weights"
 
-    def __init__(self, doc: Document, weights: dict, text: str) -> None:
+    def __init__(self, doc, weights: dict, text: str) -> None:
         super().__init__(doc, dict(weights), dict(doc.map_weights), text)

@@ -38,7 +38,16 @@ log = logging.getLogger(__name__)
 
 FRAME_MS = 33  # at most ~30 deliveries per second per job
 
-__all__ = ["FRAME_MS", "Job", "JobError", "JobManager", "manager", "shutdown", "start"]
+__all__ = [
+    "FRAME_MS",
+    "Job",
+    "JobError",
+    "JobManager",
+    "error_text",
+    "manager",
+    "shutdown",
+    "start",
+]
 
 
 class Job(QObject):
@@ -203,6 +212,13 @@ class Job(QObject):
 
 class JobError(Exception):
     """A RuntimeError raised by a job's function (superqt would swallow it as "worker deleted")."""
+
+
+def error_text(exc: BaseException) -> str:
+    """A one-line message for the user (no traceback)."""
+    cause = exc.__cause__ if isinstance(exc, JobError) and exc.__cause__ else exc
+    text = str(cause) or type(cause).__name__
+    return text.splitlines()[0] if text else type(cause).__name__
 
 
 def _pump(job: Job):

@@ -1,46 +1,34 @@
 """The main window: wires the document, the pipeline and the views; menus, shortcuts, status.
 
-Nothing here blocks a test: messages go to the message bar and the status bar, and the
-only questions (unsaved changes, file names) are methods tests can replace
-(:meth:`MainWindow.ask_save_changes`, :meth:`MainWindow.ask_open_path` ...).
+Nothing here blocks a test: messages go to the message bar and the status bar. Opening,
+saving, autosave and recovery are :attr:`MainWindow.files` (:mod:`quilt_gui.files`), whose
+questions (unsaved changes, file names) are methods tests can replace.
 """
 
 from __future__ import annotations
 
 import logging
-import os
 from functools import partial
 from pathlib import Path
 
-from PySide6.QtCore import QSettings, Qt, QTimer, Slot
+from PySide6.QtCore import Qt, Slot
 from PySide6.QtGui import QAction, QActionGroup, QKeySequence
 from PySide6.QtWidgets import (
     QApplication,
     QDockWidget,
-    QFileDialog,
     QLabel,
     QMainWindow,
-    QMessageBox,
     QTabWidget,
     QVBoxLayout,
     QWidget,
 )
 
-from engine.io import READ_SUFFIXES, ImageError, load_image
-from engine.materials import infer_kind
-from engine.project import (
-    PROJECT_SUFFIX,
-    ProjectError,
-    load_project,
-    newer_recovery,
-    recovery_path,
-    save_project,
-)
 from quilt_gui import jobs, params, settings
-from quilt_gui.app import APP_NAME, apply_theme
-from quilt_gui.document import Document, Source, safe_name
-from quilt_gui.imaging import pixel_text, prepare_display
-from quilt_gui.pipeline import Pipeline, error_text
+from quilt_gui.document import Document
+from quilt_gui.files import ProjectFiles
+from quilt_gui.imaging import pixel_text
+from quilt_gui.pipeline import Pipeline
+from quilt_gui.theme import apply_theme
 from quilt_gui.widgets.candidate_dialog import CandidateDialog
 from quilt_gui.widgets.canvas import ImageCanvas
 from quilt_gui.widgets.gallery import CandidateView
@@ -51,48 +39,9 @@ from quilt_gui.widgets.quilt_view import QuiltView
 from quilt_gui.widgets.source_view import SourceView
 from quilt_gui.widgets.status import JobStatus, MessageBar
 from quilt_gui.widgets.tile_view import REPEATS, TileView
-from resources import SAMPLE_NAMES, sample_path
+from resources import SAMPLE_NAMES
 
 log = logging.getLogger(__name__)
-
-IMAGE_FILTER = "Images (" + " ".join(f"*{s}" for s in READ_SUFFIXES) + ")"
-PROJECT_FILTER = f"Quilt Studio projects (*{PROJECT_SUFFIX})"
-OPEN_FILTER = (
-    "Images and projects (" + " ".join(f"*{s}" for s in (*READ_SUFFIXES, PROJECT_SUFFIX)) + ")"
-)
-MAIN_MAP = "albedo"
-
-
-#: Pillow's colour-model names (engine.io LoadedImage.mode) as the user reads them.
-MODE_NAMES = {
-    "L": "gray",
-    "LA": "gray + alpha",
-    "1": "black-and-white",
-    "P": "palette",
-    "PA": "palette + alpha",
-    "RGBA": "RGB + alpha",
-    "F": "gray (float)",
-}
-
-
-def mode_text(mode: str) -> str:
-    return MODE_NAMES.get(mode, mode)
-
-
-def read_image(path: str):
-    """Worker: load an image and prepare its display copy (the GUI thread only copies it)."""
-    loaded = load_image(path)
-    prepare_display(loaded.pixels)
-    return loaded
-
-
-def read_project(path: str):
-    """Worker: load a project and prepare the display copy of its main map."""
-    project = load_project(path)
-    if project.sources:
-        prepare_display(next(iter(project.sources.values())))
-    return project
-
 
 _warmup_started = False
 
@@ -119,11 +68,6 @@ def start_warmup(manager: jobs.JobManager) -> jobs.Job | None:
     )
 
 
-def recovery_dir() -> Path:
-    """Folder of the untitled-project recovery file (next to the settings file)."""
-    return Path(QSettings().fileName()).parent / "recovery"
-
-
 class MainWindow(QMainWindow):
     """Quilt Studio's editor window."""
 
@@ -135,19 +79,15 @@ class MainWindow(QMainWindow):
         self.doc.params = params.coerce_all(settings.get("parameters"))  # the last used options
         self.jobs = jobs.manager()
         self.pipeline = Pipeline(self.doc, self.jobs, self)
+        self.files = ProjectFiles(self.doc, self.jobs, self)
         self.messages: list[tuple[str, str]] = []  # (level, text) log, newest last
         self._dialogs: dict[int, CandidateDialog] = {}
-        self._closing = False
         self._criteria: dict[str, float] = {}
         self._make_actions()
         self._make_views()
         self._make_menus()
         self._make_status_bar()
         self._connect()
-        self.autosave_timer = QTimer(self)
-        self.autosave_timer.setInterval(max(5, settings.get("autosave_seconds")) * 1000)
-        self.autosave_timer.timeout.connect(self.autosave_now)
-        self.autosave_timer.start()
         start_warmup(self.jobs)
         self.resize(1500, 950)
         geo, state = settings.get("window_geometry"), settings.get("window_state")
@@ -182,19 +122,19 @@ class MainWindow(QMainWindow):
         K = QKeySequence.StandardKey
         self.act_open = A(
             "&Open image or project…",
-            self.open_dialog,
+            self.files.open_dialog,
             K.Open,
             "Open a texture image or a .quiltproj project",
         )
         self.act_attach = A(
             "Attach &material map…",
-            self.attach_dialog,
+            self.files.attach_dialog,
             None,
             "Add a normal / roughness / height ... map of the same size; it follows every cut",
         )
-        self.act_save = A("&Save project", self.save, K.Save, "Save the project")
+        self.act_save = A("&Save project", self.files.save, K.Save, "Save the project")
         self.act_save_as = A(
-            "Save project &as…", self.save_as, K.SaveAs, "Save the project under a new name"
+            "Save project &as…", self.files.save_as, K.SaveAs, "Save the project under a new name"
         )
         self.act_export = A(
             "&Export tile set…",
@@ -256,7 +196,7 @@ class MainWindow(QMainWindow):
         )
         self.act_load_target = A(
             "Load transfer &target…",
-            self.target_dialog,
+            self.files.target_dialog,
             None,
             "Open the image whose layout texture transfer imitates",
         )
@@ -290,7 +230,7 @@ class MainWindow(QMainWindow):
         )
         self.act_clear_wp = A(
             "Clear &waypoints",
-            self.doc.clear_waypoints,
+            self.doc.tileset.clear_waypoints,
             None,
             "Remove every waypoint of the template seams",
         )
@@ -362,7 +302,7 @@ class MainWindow(QMainWindow):
         self.samples_menu = m.addMenu("Open &sample")
         for name in SAMPLE_NAMES:
             a = self.samples_menu.addAction(name.capitalize())
-            a.triggered.connect(partial(self._open_sample, name))
+            a.triggered.connect(partial(self.files.open_sample, name))
         self.recent_menu = m.addMenu("Open &recent")
         self.recent_menu.aboutToShow.connect(self._fill_recent_menu)
         m.addAction(self.act_attach)
@@ -419,15 +359,17 @@ class MainWindow(QMainWindow):
     def _connect(self) -> None:
         doc = self.doc
         self.pipeline.message.connect(self.show_message)
+        self.files.message.connect(self.show_message)
+        self.files.image_opened.connect(self._on_image_opened)
         self.pipeline.seam_updated.connect(self._on_seam_updated)
         doc.modified_changed.connect(self._update_title)
         doc.path_changed.connect(self._update_title)
         doc.source_changed.connect(self._update_title)
         doc.source_changed.connect(self._update_actions)
-        doc.seamless_changed.connect(self._on_seamless_changed)
-        doc.candidates_reset.connect(self._update_actions)
-        doc.candidate_inserted.connect(self._update_actions)
-        doc.picks_changed.connect(self._update_actions)
+        doc.tileset.seamless_changed.connect(self._on_seamless_changed)
+        doc.tileset.candidates_reset.connect(self._update_actions)
+        doc.tileset.candidate_inserted.connect(self._update_actions)
+        doc.tileset.picks_changed.connect(self._update_actions)
         self.gallery.open_requested.connect(self.open_candidate)
         self.gallery.reroll_requested.connect(self.reroll_candidate)
         self.gallery.current_changed.connect(self._on_gallery_current)
@@ -467,184 +409,17 @@ class MainWindow(QMainWindow):
                 return text
         return ""
 
-    # ------------------------------------------------------------------ questions (patchable)
-    def ask_save_changes(self) -> str:
-        """ "save", "discard" or "cancel" for unsaved changes (tests replace this)."""
-        box = QMessageBox(
-            QMessageBox.Icon.Warning,
-            APP_NAME,
-            f"Save the changes to “{self.doc.name}” before closing?",
-            QMessageBox.StandardButton.Save
-            | QMessageBox.StandardButton.Discard
-            | QMessageBox.StandardButton.Cancel,
-            self,
-        )
-        box.setDefaultButton(QMessageBox.StandardButton.Save)
-        answer = box.exec()
-        return {
-            QMessageBox.StandardButton.Save: "save",
-            QMessageBox.StandardButton.Discard: "discard",
-        }.get(QMessageBox.StandardButton(answer), "cancel")
-
-    def ask_open_path(self, caption: str, filters: str, key: str) -> str:
-        path, _ = QFileDialog.getOpenFileName(self, caption, settings.get(key), filters)
-        return path
-
-    def ask_save_path(self) -> str:
-        start = self.doc.project_path or os.path.join(
-            settings.get("last_project_dir"), self.doc.name + PROJECT_SUFFIX
-        )
-        path, _ = QFileDialog.getSaveFileName(self, "Save project", start, PROJECT_FILTER)
-        if path and not path.endswith(PROJECT_SUFFIX):
-            path += PROJECT_SUFFIX
-        return path
-
-    def _confirm_discard(self) -> bool:
-        """True when the current work may be replaced (saved, discarded or unchanged)."""
-        if not self.doc.modified or not self.doc.has_source:
-            return True
-        answer = self.ask_save_changes()
-        if answer == "save":
-            return self.save(wait=True)
-        return answer == "discard"
-
-    # ------------------------------------------------------------------ opening
-    def open_initial(self, path: str | None) -> None:
-        """Start-up: open ``path`` (image or project) or the bundled sample; offer recovery."""
-        untitled = recovery_dir() / f"untitled.recovery{PROJECT_SUFFIX}"
-        if path:
-            self.open_path(path, confirm=False)
-        else:
-            self.open_path(str(sample_path()), confirm=False, remember=False)
-        if untitled.is_file():
-            self.offer_recovery(untitled)
-
-    def open_dialog(self) -> None:
-        path = self.ask_open_path(
-            "Open image or project",
-            f"{OPEN_FILTER};;{IMAGE_FILTER};;{PROJECT_FILTER};;All files (*)",
-            "last_open_dir",
-        )
-        if path:
-            self.open_path(path)
-
-    def _open_sample(self, name: str, *_checked) -> None:
-        self.open_path(str(sample_path(name)), remember=False)
-
-    def open_path(self, path: str, *, confirm: bool = True, remember: bool = True) -> None:
-        """Open an image or a ``.quiltproj`` in the background (errors become messages)."""
-        path = os.fspath(path)
-        if confirm and not self._confirm_discard():
-            return
-        if path.lower().endswith(PROJECT_SUFFIX):
-            self._read("open", read_project, path, self._on_project_loaded)
-        else:
-            self._read("open", read_image, path, partial(self._on_image_loaded, remember=remember))
-
-    def _read(self, key: str, reader, path: str, on_done) -> None:
-        """Run ``reader(path)`` in the background; ``on_done(path, result)``; errors -> message."""
-        self.jobs.start(
-            key,
-            reader,
-            path,
-            label=f"Opening {Path(path).name}",
-            pass_cancel=False,
-            on_done=partial(on_done, path),
-            on_error=partial(self._on_open_error, path),
-        )
-
-    def _on_image_loaded(self, path: str, loaded, *, remember: bool) -> None:
-        source = Source(
-            maps={MAIN_MAP: loaded.pixels},
-            paths={MAIN_MAP: loaded.path},
-            bit_depth=loaded.bit_depth,
-            kinds={MAIN_MAP: "color"},
-        )
-        self.doc.set_source(source)
-        self._remember(path, "last_open_dir", remember)
-        h, w = loaded.pixels.shape[:2]
-        self.show_message(
-            "info",
-            f"Opened {Path(path).name}: {w}×{h}, {loaded.bit_depth}-bit "
-            f"{mode_text(loaded.mode)}. Next: Find best tile (Ctrl+T) or draw the "
-            "tile rectangle.",
-        )
-        self.tabs.setCurrentWidget(self.source_view)
-
-    def _on_project_loaded(self, path: str, project) -> None:
-        self.doc.from_project(project, path)
-        self._remember(path, "last_project_dir", True)
-        self.show_message("info", f"Opened project {Path(path).name}.")
-        rec = newer_recovery(path)
-        if rec is not None:
-            self.offer_recovery(rec)
-
-    def _on_open_error(self, path: str, exc) -> None:
-        if isinstance(exc, (ImageError, ProjectError)):
-            text = error_text(exc)
-        else:
-            text = f"{path}: cannot be opened ({error_text(exc)})"
-        self.show_message("error", f"Could not open the file. {text}")
-
-    def _remember(self, path: str, dir_key: str, recent: bool) -> None:
-        settings.set(dir_key, str(Path(path).parent))
-        if recent:
-            settings.add_recent_file(str(Path(path).resolve()))
-
     @Slot()
     def _fill_recent_menu(self) -> None:
-        self.recent_menu.clear()
-        files = settings.get("recent_files")
-        if not files:
-            a = self.recent_menu.addAction("(none)")
-            a.setEnabled(False)
-            return
-        for i, f in enumerate(files):
-            a = self.recent_menu.addAction(f"&{(i + 1) % 10} {Path(f).name}")
-            a.setToolTip(f)
-            a.setStatusTip(f)
-            a.triggered.connect(partial(self._open_recent, f))
-        self.recent_menu.addSeparator()
-        self.recent_menu.addAction("Clear list", self._clear_recent)
+        self.files.fill_recent_menu(self.recent_menu)
 
     @Slot()
-    def _clear_recent(self) -> None:
-        settings.set("recent_files", [])
+    def _on_image_opened(self) -> None:
+        self.tabs.setCurrentWidget(self.source_view)
 
-    def _open_recent(self, path: str, *_checked) -> None:
-        if not Path(path).exists():
-            settings.remove_recent_file(path)
-            self.show_message("error", f"{path} no longer exists; removed from the recent files.")
-            return
-        self.open_path(path)
-
-    def attach_dialog(self) -> None:
-        path = self.ask_open_path("Attach material map", IMAGE_FILTER, "last_open_dir")
-        if path:
-            self.attach_map(path)
-
-    def attach_map(self, path: str) -> None:
-        """Load ``path`` as a material map of the source (kind guessed from its name)."""
-        if not self.doc.has_source:
-            self.show_message("warning", "Open a source image before attaching material maps.")
-            return
-        self._read("attach", load_image, path, self._on_map_loaded)
-
-    def _on_map_loaded(self, path: str, loaded) -> None:
-        kind = infer_kind(Path(path).stem)
-        name = kind if kind not in ("color", "other") else safe_name(Path(path).stem).lower()
-        base, k = name, 2
-        while name in self.doc.source.maps:
-            name, k = f"{base}{k}", k + 1
-        try:
-            self.doc.attach_map(name, loaded.pixels, path, kind)
-        except ValueError as exc:
-            self.show_message("error", str(exc))
-            return
-        self.show_message(
-            "info",
-            f"Attached {Path(path).name} as the “{name}” map ({kind}); it follows every cut.",
-        )
+    def open_initial(self, path: str | None) -> None:
+        """Start-up: open ``path`` (image or project) or the bundled sample."""
+        self.files.open_initial(path)
 
     # ------------------------------------------------------------------ drag and drop
     def dragEnterEvent(self, event) -> None:  # noqa: N802 - Qt API
@@ -655,124 +430,13 @@ class MainWindow(QMainWindow):
         files = [u.toLocalFile() for u in event.mimeData().urls() if u.isLocalFile()]
         if files:
             event.acceptProposedAction()
-            self.open_path(files[0])
-
-    # ------------------------------------------------------------------ saving
-    def save(self, *_args, wait: bool = False) -> bool:
-        if not self.doc.project_path:
-            return self.save_as(wait=wait)
-        return self.save_to(self.doc.project_path, wait=wait)
-
-    def save_as(self, *_args, wait: bool = False) -> bool:
-        if not self.doc.has_source:
-            self.show_message("warning", "Nothing to save: open an image first.")
-            return False
-        path = self.ask_save_path()
-        return bool(path) and self.save_to(path, wait=wait)
-
-    def save_to(self, path: str, *, wait: bool = False) -> bool:
-        """Save the project to ``path``; ``wait`` saves in this thread (closing)."""
-        try:
-            project = self.doc.to_project()
-        except ValueError as exc:
-            self.show_message("error", str(exc))
-            return False
-        if wait:
-            try:
-                save_project(path, project)
-            except (ProjectError, OSError) as exc:
-                self._on_save_error(path, exc)
-                return False
-            self._on_saved(path, None)
-            return True
-        self.jobs.start(
-            "save",
-            save_project,
-            path,
-            project,
-            label=f"Saving {Path(path).name}",
-            pass_cancel=False,
-            on_done=partial(self._on_saved, path),
-            on_error=partial(self._on_save_error, path),
-        )
-        return True
-
-    def _on_saved(self, path: str, _result) -> None:
-        old_recovery = self.recovery_file()
-        self.doc.mark_saved(path)
-        for f in {old_recovery, self.recovery_file()}:
-            f.unlink(missing_ok=True)
-        self._remember(path, "last_project_dir", True)
-        self.show_message("info", f"Saved {Path(path).name}.")
-
-    def _on_save_error(self, path: str, exc) -> None:
-        self.show_message("error", f"The project was not saved. {error_text(exc)}")
-
-    def recovery_file(self) -> Path:
-        """Where autosave writes: next to the project, or in the settings folder if untitled."""
-        if self.doc.project_path:
-            return recovery_path(self.doc.project_path)
-        return recovery_dir() / f"untitled.recovery{PROJECT_SUFFIX}"
-
-    @Slot()
-    def autosave_now(self) -> jobs.Job | None:
-        """Write the recovery file in the background if there are unsaved changes."""
-        if not self.doc.modified or not self.doc.has_source or self._closing:
-            return None
-        try:
-            project = self.doc.to_project()
-        except ValueError:
-            return None
-        target = self.recovery_file()
-        target.parent.mkdir(parents=True, exist_ok=True)
-        return self.jobs.start(
-            "autosave",
-            save_project,
-            target,
-            project,
-            label="Autosaving",
-            pass_cancel=False,
-            on_error=self._on_autosave_error,
-        )
-
-    def _on_autosave_error(self, exc) -> None:
-        self.show_message("warning", f"Autosave failed: {error_text(exc)}")
-
-    def offer_recovery(self, path: Path) -> None:
-        """Offer to reopen an autosaved recovery file (non-blocking banner)."""
-        self.show_message(
-            "warning",
-            f"Quilt Studio did not close normally: unsaved work was recovered ({path.name}). "
-            "Restore it?",
-            actions=(
-                ("Restore", partial(self.restore_recovery, path)),
-                ("Discard", partial(self._discard_recovery, path)),
-            ),
-        )
-
-    def restore_recovery(self, path: Path, *_args) -> None:
-        try:
-            project = load_project(path)
-        except ProjectError as exc:
-            self.show_message("error", f"The recovery file cannot be read: {exc}")
-            return
-        saved_path = None
-        if path.name.startswith(".") and ".recovery" in path.name:
-            stem = path.name[1:].split(".recovery")[0]
-            candidate = path.with_name(stem + PROJECT_SUFFIX)
-            saved_path = str(candidate) if candidate.is_file() else None
-        self.doc.from_project(project, saved_path)
-        self.doc.mark_dirty()  # recovered work is unsaved until the user saves it
-        self.show_message("info", "Recovered the unsaved work. Save it to keep it.")
-
-    def _discard_recovery(self, path: Path, *_args) -> None:
-        path.unlink(missing_ok=True)
+            self.files.open_path(files[0])
 
     # ------------------------------------------------------------------ export
     def export_dialog(self) -> None:
         from quilt_gui.widgets.export_dialog import ExportDialog
 
-        if not self.doc.candidates:
+        if not self.doc.tileset.candidates:
             self.show_message(
                 "warning", "Nothing to export yet: generate candidates and pick the tiles to keep."
             )
@@ -802,7 +466,7 @@ class MainWindow(QMainWindow):
 
     @Slot(int)
     def reroll_candidate(self, index: int) -> None:
-        if self.doc.candidates[index].locked:
+        if self.doc.tileset.candidates[index].locked:
             self.show_message("warning", f"Candidate #{index + 1} is locked; unlock it to re-roll.")
             return
         self.pipeline.remake_candidate(index)
@@ -826,24 +490,6 @@ class MainWindow(QMainWindow):
     def run_transfer(self, *_args) -> None:
         self.tabs.setCurrentWidget(self.quilt_view)
         self.pipeline.run_transfer()
-
-    def target_dialog(self, *_args) -> None:
-        path = self.ask_open_path("Load transfer target", IMAGE_FILTER, "last_open_dir")
-        if path:
-            self.load_target(path)
-
-    def load_target(self, path: str) -> None:
-        """Load the texture-transfer target in the background."""
-        self._read("open_target", read_image, path, self._on_target_loaded)
-
-    def _on_target_loaded(self, path: str, loaded) -> None:
-        self.doc.set_transfer_target(loaded.pixels)
-        h, w = loaded.pixels.shape[:2]
-        self.show_message(
-            "info",
-            f"Transfer target {Path(path).name} ({w}×{h}) loaded. Texture "
-            "transfer (Ctrl+Shift+Return) re-creates it with the source.",
-        )
 
     @Slot(int)
     def _on_tab_changed(self, _index: int) -> None:
@@ -925,7 +571,7 @@ class MainWindow(QMainWindow):
 
     @Slot()
     def _on_seamless_changed(self) -> None:
-        s = self.doc.seamless
+        s = self.doc.tileset.seamless
         self._criteria = {} if s is None else dict(s.criterion)
         self._show_criteria()
         self._update_actions()
@@ -946,7 +592,7 @@ class MainWindow(QMainWindow):
     @Slot()
     def _update_title(self, *_args) -> None:
         name = Path(self.doc.project_path).name if self.doc.project_path else self.doc.name
-        self.setWindowTitle(f"{name}[*] — {APP_NAME}")
+        self.setWindowTitle(f"{name}[*] — {settings.APP_NAME}")
         self.setWindowModified(self.doc.modified)
 
     @Slot()
@@ -962,25 +608,24 @@ class MainWindow(QMainWindow):
             self.act_transfer,
         ):
             a.setEnabled(has)
-        self.act_generate.setEnabled(has and self.doc.seamless is not None)
-        self.act_export.setEnabled(bool(self.doc.candidates))
-        self.act_reroll_layout.setEnabled(bool(self.doc.picks))
-        n = len(self.doc.candidates)
-        title = f"Candidates — {len(self.doc.picks)} of {n} picked" if n else "Candidates"
-        if self.doc.candidates_outdated:
+        self.act_generate.setEnabled(has and self.doc.tileset.seamless is not None)
+        self.act_export.setEnabled(bool(self.doc.tileset.candidates))
+        self.act_reroll_layout.setEnabled(bool(self.doc.tileset.picks))
+        n = len(self.doc.tileset.candidates)
+        title = f"Candidates — {len(self.doc.tileset.picks)} of {n} picked" if n else "Candidates"
+        if self.doc.tileset.candidates_outdated:
             title += " — made from an earlier template (Generate to update)"
         self.docks["gallery"].setWindowTitle(title)
 
     # ------------------------------------------------------------------ closing
     def closeEvent(self, event) -> None:  # noqa: N802 - Qt API
-        if not self._confirm_discard():
+        if not self.files.confirm_discard():
             event.ignore()
             return
-        self._closing = True
-        self.autosave_timer.stop()
+        self.files.stop_autosave()
         self.pipeline.shutdown()
         self.jobs.shutdown(3000)
-        self.recovery_file().unlink(missing_ok=True)
+        self.files.remove_recovery_file()
         settings.set("window_geometry", self.saveGeometry())
         settings.set("window_state", self.saveState())
         settings.set("parameters", self.doc.params)

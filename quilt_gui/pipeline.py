@@ -18,12 +18,14 @@ from PySide6.QtCore import QObject, QTimer, Signal, Slot
 
 from engine.cancel import Cancelled
 from quilt_gui import jobs, params
-from quilt_gui.document import CandidateEntry, Document
+from quilt_gui.document import Document
 from quilt_gui.imaging import prepare_display
+from quilt_gui.jobs import error_text
+from quilt_gui.model import CandidateEntry
 
 log = logging.getLogger(__name__)
 
-__all__ = ["Pipeline", "error_text"]
+__all__ = ["Pipeline"]
 
 
 def _soon(parent: QObject, slot) -> QTimer:
@@ -33,13 +35,6 @@ def _soon(parent: QObject, slot) -> QTimer:
     timer.setInterval(0)
     timer.timeout.connect(slot)
     return timer
-
-
-def error_text(exc: BaseException) -> str:
-    """A one-line message for the user (no traceback)."""
-    cause = exc.__cause__ if isinstance(exc, jobs.JobError) and exc.__cause__ else exc
-    text = str(cause) or type(cause).__name__
-    return text.splitlines()[0] if text else type(cause).__name__
 
 
 class Pipeline(QObject):
@@ -54,20 +49,20 @@ class Pipeline(QObject):
         super().__init__(parent)
         self.doc = doc
         self.jobs = manager or jobs.manager()
-        self.seamless_inputs = None  # the inputs doc.seamless was computed from
+        self.seamless_inputs = None  # the inputs doc.tileset.seamless was computed from
         self._seamless_pending = None
         self._template_old_rect = None
         self._seamless_timer = _soon(self, self._start_seamless)
         doc.source_changed.connect(self._on_source_changed)
         doc.maps_changed.connect(self.schedule_seamless)
-        doc.map_weights_changed.connect(self.schedule_seamless)
-        doc.template_changed.connect(self.schedule_seamless)
-        doc.waypoints_changed.connect(self.schedule_seamless)
+        doc.tileset.map_weights_changed.connect(self.schedule_seamless)
+        doc.tileset.template_changed.connect(self.schedule_seamless)
+        doc.tileset.waypoints_changed.connect(self.schedule_seamless)
         doc.params_changed.connect(self._on_params_changed)
         self._preview_timer = _soon(self, self._start_preview)
-        doc.picks_changed.connect(self.schedule_preview)
-        doc.candidates_reset.connect(self.schedule_preview)
-        doc.candidate_changed.connect(self._on_candidate_changed)
+        doc.tileset.picks_changed.connect(self.schedule_preview)
+        doc.tileset.candidates_reset.connect(self.schedule_preview)
+        doc.tileset.candidate_changed.connect(self._on_candidate_changed)
         doc.exclusion_changed.connect(self.restart_quilt_if_shown)
         self._quilt_timer = _soon(self, self._restart_quilt)
         self._gen_old = ([], [])
@@ -90,10 +85,10 @@ class Pipeline(QObject):
     @Slot(object)
     def _on_params_changed(self, keys) -> None:
         if keys & params.SEAMLESS_KEYS:
-            if "overlap" in keys and self.doc.template_rect is not None:
-                clamped = self.doc.clamp_rect(self.doc.template_rect)
-                if clamped != self.doc.template_rect:
-                    self.doc.apply_template_rect(clamped)
+            if "overlap" in keys and self.doc.tileset.template_rect is not None:
+                clamped = self.doc.tileset.clamp_rect(self.doc.tileset.template_rect)
+                if clamped != self.doc.tileset.template_rect:
+                    self.doc.tileset.apply_template_rect(clamped)
                     return  # template_changed schedules the seamless job
             self.schedule_seamless()
         if keys & params.PREVIEW_KEYS:
@@ -104,13 +99,13 @@ class Pipeline(QObject):
     @Slot()
     def restart_quilt_if_shown(self) -> None:
         """Re-run quilting / transfer after an input changed, if a result is shown or running."""
-        if self.jobs.get("quilt") is not None or self.doc.quilt_result is not None:
+        if self.jobs.get("quilt") is not None or self.doc.quilting.result is not None:
             self.jobs.abort("quilt")  # its blocks are stale now
             self._quilt_timer.start()
 
     @Slot(int)
     def _on_candidate_changed(self, index: int) -> None:
-        if index in self.doc.picks:
+        if index in self.doc.tileset.picks:
             self.schedule_preview()
 
     def stop(self, key: str) -> None:
@@ -137,7 +132,7 @@ class Pipeline(QObject):
             self.message.emit("warning", "Open a source image first.")
             return None
         p = doc.params
-        self._template_old_rect = doc.template_rect
+        self._template_old_rect = doc.tileset.template_rect
         self.template_searching.emit(True)
         return self.jobs.start(
             "template",
@@ -157,11 +152,11 @@ class Pipeline(QObject):
     def _on_template_event(self, event) -> None:
         rect = getattr(event, "rect", None)
         if rect is not None:
-            self.doc.apply_template_rect(rect)
+            self.doc.tileset.apply_template_rect(rect)
 
     def _on_template_done(self, template) -> None:
-        self.doc.apply_template_rect(template.rect)
-        self.doc.commit_template_rect(self._template_old_rect)
+        self.doc.tileset.apply_template_rect(template.rect)
+        self.doc.tileset.commit_template_rect(self._template_old_rect)
         for note in template.warnings:
             self.message.emit("warning", note)
         x, y, w, h = template.rect
@@ -179,24 +174,24 @@ class Pipeline(QObject):
         self.message.emit("info", "Template search cancelled.")
 
     def _restore_template_rect(self) -> None:
-        if self.doc.template_rect != self._template_old_rect:
-            self.doc.apply_template_rect(self._template_old_rect)
+        if self.doc.tileset.template_rect != self._template_old_rect:
+            self.doc.tileset.apply_template_rect(self._template_old_rect)
         self.template_searching.emit(False)
 
     # ------------------------------------------------------------------ seamless tile
     def seamless_request(self) -> tuple | None:
         """(args, kwargs, inputs) of the seamless job for the current document, or None."""
         doc = self.doc
-        if doc.source is None or doc.template_rect is None:
+        if doc.source is None or doc.tileset.template_rect is None:
             return None
-        wps = {k: list(v) for k, v in doc.waypoints.items() if v}
+        wps = {k: list(v) for k, v in doc.tileset.waypoints.items() if v}
         kwargs = dict(overlap=doc.params["overlap"], waypoints=wps or None, **self._seam_options())
         inputs = (
-            doc.template_rect,
+            doc.tileset.template_rect,
             tuple(sorted((k, repr(v)) for k, v in kwargs.items() if k != "maps")),
             tuple(doc.source.extra_maps),
         )
-        return (doc.source.main, doc.template_rect), kwargs, inputs
+        return (doc.source.main, doc.tileset.template_rect), kwargs, inputs
 
     @Slot()
     def schedule_seamless(self) -> None:
@@ -214,8 +209,8 @@ class Pipeline(QObject):
         req = self.seamless_request()
         if req is None:
             self.jobs.abort("seamless")
-            if self.doc.seamless is not None:
-                self.doc.apply_seamless(None)
+            if self.doc.tileset.seamless is not None:
+                self.doc.tileset.apply_seamless(None)
             self.seamless_inputs = None
             return
         args, kwargs, inputs = req
@@ -239,14 +234,14 @@ class Pipeline(QObject):
 
     def _on_seamless_done(self, result) -> None:
         self.seamless_inputs = self._seamless_pending
-        self.doc.apply_seamless(result)
+        self.doc.tileset.apply_seamless(result)
         for note in result.warnings:
             self.message.emit("warning", note)
 
     def _on_seamless_error(self, exc) -> None:
         self.seamless_inputs = None
-        if self.doc.seamless is not None:
-            self.doc.apply_seamless(None)
+        if self.doc.tileset.seamless is not None:
+            self.doc.tileset.apply_seamless(None)
         if not isinstance(exc, Cancelled):
             self._error(exc)
 
@@ -261,7 +256,7 @@ class Pipeline(QObject):
             width=p["width"],
             rho=p["rho"],
             maps=self.doc.source.extra_maps or None,
-            weights=self.doc.engine_weights(),
+            weights=self.doc.tileset.engine_weights(),
             **params.seam_options(p, p["method"]),
         )
 
@@ -283,7 +278,7 @@ class Pipeline(QObject):
         if doc.source is None:
             self.message.emit("warning", "Open a source image first.")
             return False
-        if doc.seamless is None or self.seamless_inputs is None:
+        if doc.tileset.seamless is None or self.seamless_inputs is None:
             self.message.emit(
                 "warning",
                 "Make the seamless tile first: draw the tile rectangle or use Find best tile.",
@@ -314,14 +309,14 @@ class Pipeline(QObject):
             return None
         doc = self.doc
         keep, keep_picks, dropped = [], [], 0
-        for i, e in enumerate(doc.candidates):
+        for i, e in enumerate(doc.tileset.candidates):
             if not e.locked:
                 continue
-            if not doc.connects_to_template(e):
+            if not doc.tileset.connects_to_template(e):
                 dropped += 1
                 continue
-            if i in doc.picks:
-                keep_picks.append((doc.picks.index(i), len(keep)))
+            if i in doc.tileset.picks:
+                keep_picks.append((doc.tileset.picks.index(i), len(keep)))
             keep.append(e)
         if dropped:
             self.message.emit(
@@ -330,8 +325,8 @@ class Pipeline(QObject):
                 "template and do not connect to this one; dropped.",
             )
         self.jobs.abort_matching("candidate:")
-        self._gen_old = (list(doc.candidates), list(doc.picks))
-        doc.apply_candidates(keep, [k for _, k in sorted(keep_picks)])
+        self._gen_old = (list(doc.tileset.candidates), list(doc.tileset.picks))
+        doc.tileset.apply_candidates(keep, [k for _, k in sorted(keep_picks)])
         n = int(doc.params["n_candidates"]) - len(keep)
         self._gen_wanted, self._gen_next, self._gen_waiting = max(0, n), 0, {}
         if n <= 0:
@@ -341,7 +336,7 @@ class Pipeline(QObject):
             "candidates",
             excluding(iter_candidates),
             doc.source.main,
-            doc.seamless,
+            doc.tileset.seamless,
             n,
             label=f"Generating {n} candidates",
             rng=int(doc.params["seed"]),
@@ -360,23 +355,23 @@ class Pipeline(QObject):
         if hasattr(event, "tile") and hasattr(event, "patch_rect"):
             self._gen_waiting[int(event.index)] = self.entry_from(event)
             while self._gen_next in self._gen_waiting:
-                self.doc.append_candidate(self._gen_waiting.pop(self._gen_next))
+                self.doc.tileset.append_candidate(self._gen_waiting.pop(self._gen_next))
                 self._gen_next += 1
 
     def _on_candidates_done(self, _result) -> None:
         doc = self.doc
         made = self._gen_next
         for k in sorted(self._gen_waiting):  # after a cancel: the ones that did finish
-            doc.append_candidate(self._gen_waiting.pop(k))
+            doc.tileset.append_candidate(self._gen_waiting.pop(k))
             made += 1
-        doc.set_candidates(
-            list(doc.candidates),
-            list(doc.picks),
+        doc.tileset.set_candidates(
+            list(doc.tileset.candidates),
+            list(doc.tileset.picks),
             text="Generate candidates",
             old=self._gen_old,
             already_applied=True,
         )
-        what = f"{len(doc.candidates)} candidates"
+        what = f"{len(doc.tileset.candidates)} candidates"
         if made < self._gen_wanted:
             what = f"Generation stopped: {made} of {self._gen_wanted} new candidates made, {what}"
         self.message.emit(
@@ -391,7 +386,7 @@ class Pipeline(QObject):
         """Re-roll candidate ``index`` (new random patch) or rebuild it from ``origin``."""
         from engine.tiles import make_candidate
 
-        if not self._template_ready() or not 0 <= index < len(self.doc.candidates):
+        if not self._template_ready() or not 0 <= index < len(self.doc.tileset.candidates):
             return None
         doc = self.doc
         kw = self._tile_options()
@@ -408,7 +403,7 @@ class Pipeline(QObject):
             f"candidate:{index}",
             excluding(make_candidate),
             doc.source.main,
-            doc.seamless,
+            doc.tileset.seamless,
             index=index,
             label=text,
             on_done=partial(self._on_remade, text),
@@ -418,10 +413,10 @@ class Pipeline(QObject):
 
     def _on_remade(self, text: str, c) -> None:
         index = int(c.index)
-        if index >= len(self.doc.candidates):
+        if index >= len(self.doc.tileset.candidates):
             return
-        entry = replace(self.entry_from(c), weight=self.doc.candidates[index].weight)
-        self.doc.replace_candidate(index, entry, text=text)
+        entry = replace(self.entry_from(c), weight=self.doc.tileset.candidates[index].weight)
+        self.doc.tileset.replace_candidate(index, entry, text=text)
 
     def _on_remake_error(self, index: int, exc) -> None:
         self._error(exc)
@@ -436,15 +431,15 @@ class Pipeline(QObject):
     @Slot()
     def _start_preview(self) -> None:
         doc = self.doc
-        tiles = [e.tile for e in doc.picked_entries()]
+        tiles = [e.tile for e in doc.tileset.picked_entries()]
         if not tiles or doc.source is None:
             self.jobs.abort("preview")
-            if doc.preview is not None or doc.layout is not None:
-                doc.apply_layout(None)
-                doc.apply_preview(None, None)
+            if doc.tileset.preview is not None or doc.tileset.layout is not None:
+                doc.tileset.apply_layout(None)
+                doc.tileset.apply_preview(None, None)
             return
         p = doc.params
-        weights = [e.weight for e in doc.picked_entries()]
+        weights = [e.weight for e in doc.tileset.picked_entries()]
         self.jobs.start(
             "preview",
             make_preview,
@@ -462,8 +457,8 @@ class Pipeline(QObject):
 
     def _on_preview_done(self, result) -> None:
         layout, image, score = result
-        self.doc.apply_layout(layout)
-        self.doc.apply_preview(image, score)
+        self.doc.tileset.apply_layout(layout)
+        self.doc.tileset.apply_preview(image, score)
 
     # ------------------------------------------------------------------ quilting
     def run_quilt(self) -> jobs.Job | None:
@@ -475,7 +470,7 @@ class Pipeline(QObject):
         self._quilt_mode = "quilt"
         p = doc.params
         shape = (int(p["out_height"]), int(p["out_width"]))
-        doc.start_quilt(shape)
+        doc.quilting.start(shape)
         return self.jobs.start(
             "quilt",
             quilt_job,
@@ -502,12 +497,12 @@ class Pipeline(QObject):
         if doc.source is None:
             self.message.emit("warning", "Open a sample image first.")
             return None
-        if doc.transfer_target is None:
+        if doc.quilting.target is None:
             self.message.emit("warning", "Load a target image first (Quilting ▸ Load target).")
             return None
         self._quilt_mode = "transfer"
         p = doc.params
-        doc.start_quilt(doc.transfer_target.shape[:2])
+        doc.quilting.start(doc.quilting.target.shape[:2])
         opts = quilt_options(p)
         for key in ("select", "candidates", "tileable", "adaptive_threshold", "min_block", "mode"):
             opts.pop(key)
@@ -515,7 +510,7 @@ class Pipeline(QObject):
             "quilt",
             transfer_job,
             doc.source.main,
-            doc.transfer_target,
+            doc.quilting.target,
             label="Texture transfer",
             exclusion=self.exclusion(),
             alpha=None if p["alpha_ramp"] else p["alpha"],
@@ -530,15 +525,15 @@ class Pipeline(QObject):
         )
 
     def _on_quilt_event(self, event) -> None:
-        if self.doc.quilt_output is None:
+        if self.doc.quilting.output is None:
             return
         if hasattr(event, "record") and hasattr(event, "pixels"):
-            self.doc.place_block(event.record, np.asarray(event.pixels))
+            self.doc.quilting.place_block(event.record, np.asarray(event.pixels))
         elif hasattr(event, "iteration") and hasattr(event, "image"):
-            self.doc.finish_iteration(event)
+            self.doc.quilting.finish_iteration(event)
 
     def _on_quilt_done(self, result) -> None:
-        self.doc.finish_quilt(result)
+        self.doc.quilting.finish(result)
         h, w = result.image.shape[:2]
         passes = getattr(result, "iterations", ())
         what = (
@@ -551,7 +546,7 @@ class Pipeline(QObject):
 
     def _on_quilt_cancel(self) -> None:
         what = "Texture transfer" if self._quilt_mode == "transfer" else "Quilting"
-        n = len(self.doc.quilt_blocks)
+        n = len(self.doc.quilting.blocks)
         where = " of this pass" if self._quilt_mode == "transfer" else ""
         self.message.emit("info", f"{what} cancelled after {n} blocks{where}.")
 

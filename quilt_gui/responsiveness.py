@@ -124,7 +124,7 @@ def recompute_latency(window, method: str, repeats: int = 3) -> float:
         doc.set_param("rho", rho)
 
         def shown(rho=rho) -> bool:
-            s = doc.seamless
+            s = doc.tileset.seamless
             return s is not None and s.parameters.get("rho") == rho and not window.pipeline.busy()
 
         if not wait_until(shown, 60):
@@ -154,12 +154,12 @@ def measure_all(window, *, repeats: int = 3, heavy: bool = False) -> dict[str, d
     doc.set_param("n_candidates", 400)
     rows["cancel candidates"] = {
         "ms": cancel_latency(
-            window, window.pipeline.generate_candidates, lambda: len(doc.candidates) >= 3
+            window, window.pipeline.generate_candidates, lambda: len(doc.tileset.candidates) >= 3
         )
     }
     doc.set_param("n_candidates", n)
     rows["cancel quilting"] = {
-        "ms": cancel_latency(window, window.run_quilt, lambda: len(doc.quilt_blocks) >= 3)
+        "ms": cancel_latency(window, window.run_quilt, lambda: len(doc.quilting.blocks) >= 3)
     }
     method = doc.params["method"]
     for m in ("dp", "oscillating", "oscillating-optimal"):  # the methods with a cyclic seam

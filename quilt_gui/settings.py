@@ -2,7 +2,7 @@
 
 Every key has a default in :data:`DEFAULTS`; reading or writing an unknown key raises
 ``KeyError`` so a typo cannot silently create a new setting. Values are stored with
-``QSettings`` (organisation and application names come from :mod:`quilt_gui.app`), so
+``QSettings`` (under the organisation and application names set by :func:`set_names`), so
 tests can redirect them to a temporary folder with ``QSettings.setPath``.
 """
 
@@ -11,8 +11,10 @@ from __future__ import annotations
 import json
 from typing import Any
 
-from PySide6.QtCore import QByteArray, QSettings
+from PySide6.QtCore import QByteArray, QCoreApplication, QSettings
 
+APP_NAME = "Quilt Studio"
+ORG_NAME = "QuiltStudio"
 MAX_RECENT = 10
 
 DEFAULTS: dict[str, Any] = {
@@ -31,6 +33,12 @@ DEFAULTS: dict[str, Any] = {
     "thumbnail_size": 112,
     "parameters": {},  # the last used tile-set / quilting parameters (JSON-able dict)
 }
+
+
+def set_names() -> None:
+    """Organisation and application names (they locate the QSettings file)."""
+    QCoreApplication.setOrganizationName(ORG_NAME)
+    QCoreApplication.setApplicationName(APP_NAME)
 
 
 def _store() -> QSettings:

@@ -38,7 +38,7 @@ def main() -> int:
     out = ROOT / "docs"
     out.mkdir(exist_ok=True)
     w = MainWindow()
-    w.ask_save_changes = lambda: "discard"
+    w.files.ask_save_changes = lambda: "discard"
     w.resize(1600, 1000)
     w.show()
     w.open_initial(None)
@@ -54,9 +54,9 @@ def main() -> int:
     # -- template step: rectangle, shaded overlaps, heat overlays, seams, a waypoint
     w.act_find.trigger()
     wait_until(idle)
-    x, y, tw, th = doc.template_rect
+    x, y, tw, th = doc.tileset.template_rect
     ov = doc.params["overlap"]
-    doc.add_waypoint("horizontal", (th // 2, ov // 2))
+    doc.tileset.add_waypoint("horizontal", (th // 2, ov // 2))
     wait_until(idle)
     w.message_bar.dismiss()
     v = w.source_view
@@ -73,7 +73,7 @@ def main() -> int:
     # -- candidates gallery with picks
     w.act_generate.trigger()
     wait_until(idle)
-    doc.set_picks([1, 4, 6, 9, 13])
+    doc.tileset.set_picks([1, 4, 6, 9, 13])
     w.gallery.setCurrentIndex(w.gallery.model().index(4))
     w.open_candidate(4).move(w.geometry().right() - 660, w.geometry().top() + 60)
     wait_until(idle)
@@ -93,10 +93,10 @@ def main() -> int:
     # -- quilting, caught in progress
     doc.set_params({"out_width": 768, "out_height": 512, "block": 48})
     w.act_quilt.trigger()
-    wait_until(lambda: len(doc.quilt_blocks) >= 60)
+    wait_until(lambda: len(doc.quilting.blocks) >= 60)
     shot(w, "quilting.png")
     wait_until(idle)
-    w.quilt_view.select(min(57, len(doc.quilt_blocks) - 1))
+    w.quilt_view.select(min(57, len(doc.quilting.blocks) - 1))
     w.message_bar.dismiss()
     shot(w, "quilting_inspect.png")
 

@@ -15,7 +15,8 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from quilt_gui.document import CandidateEntry, Document
+from quilt_gui.document import Document
+from quilt_gui.model import CandidateEntry
 from quilt_gui.widgets.canvas import ImageCanvas, PixelSetItem
 from quilt_gui.widgets.tile_view import TiledImageView
 
@@ -103,13 +104,13 @@ class CandidateDialog(QDialog):
         lay.addLayout(row)
         self.resize(900, 640)
         self.view.repeats_changed.connect(self._place_loop)
-        doc.candidate_changed.connect(self._on_changed)
-        doc.candidates_reset.connect(self._on_reset)
-        doc.picks_changed.connect(self._refresh_buttons)
+        doc.tileset.candidate_changed.connect(self._on_changed)
+        doc.tileset.candidates_reset.connect(self._on_reset)
+        doc.tileset.picks_changed.connect(self._refresh_buttons)
         self.set_index(index)
 
     def entry(self) -> CandidateEntry | None:
-        cands = self.doc.candidates
+        cands = self.doc.tileset.candidates
         return cands[self.index] if 0 <= self.index < len(cands) else None
 
     def set_index(self, index: int) -> None:
@@ -165,7 +166,7 @@ class CandidateDialog(QDialog):
         e = self.entry()
         if e is None:
             return
-        self.pick_button.setText("Unpick" if self.index in self.doc.picks else "Pick")
+        self.pick_button.setText("Unpick" if self.index in self.doc.tileset.picks else "Pick")
         self.lock_button.setText("Unlock" if e.locked else "Lock")
         self.reroll_button.setEnabled(not e.locked)
 
@@ -180,11 +181,11 @@ class CandidateDialog(QDialog):
 
     @Slot()
     def _toggle_pick(self) -> None:
-        self.doc.toggle_pick(self.index)
+        self.doc.tileset.toggle_pick(self.index)
 
     @Slot()
     def _toggle_lock(self) -> None:
-        self.doc.set_locked(self.index, not self.doc.candidates[self.index].locked)
+        self.doc.tileset.set_locked(self.index, not self.doc.tileset.candidates[self.index].locked)
 
     @Slot()
     def _reroll(self) -> None:

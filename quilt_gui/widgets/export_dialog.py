@@ -24,9 +24,9 @@ from PySide6.QtWidgets import (
 )
 
 from engine.project import export_project
-from quilt_gui import jobs, settings
+from quilt_gui import jobs, project_io, settings
 from quilt_gui.document import Document, safe_name
-from quilt_gui.pipeline import error_text
+from quilt_gui.jobs import error_text
 
 
 def _spin(lo: int, hi: int, value: int, tip: str, special: str | None = None) -> QSpinBox:
@@ -152,17 +152,17 @@ class ExportDialog(QDialog):
         self.name.setText(doc.name)
         base = settings.get("last_export_dir") or str(Path.home())
         self.folder.setText(str(Path(base) / f"{doc.name}_export"))
-        n = len(doc.picks) or len(doc.candidates)
-        what = "picked" if doc.picks else "(none picked: all)"
+        n = len(doc.tileset.picks) or len(doc.tileset.candidates)
+        what = "picked" if doc.tileset.picks else "(none picked: all)"
         maps = list(doc.source.maps) if doc.source else []
         size = ""
-        if doc.candidates:
-            h, w = doc.candidates[0].tile.shape[:2]
+        if doc.tileset.candidates:
+            h, w = doc.tileset.candidates[0].tile.shape[:2]
             size = f", {w}×{h} px"
         lay = (
             ""
-            if doc.layout is None
-            else f", preview layout {doc.layout.shape[0]}×{doc.layout.shape[1]}"
+            if doc.tileset.layout is None
+            else f", preview layout {doc.tileset.layout.shape[0]}×{doc.tileset.layout.shape[1]}"
         )
         depth = doc.source.bit_depth if doc.source else 8
         self.summary.setText(
@@ -205,7 +205,7 @@ class ExportDialog(QDialog):
             self._fail(problem)
             return None
         try:
-            project = self.doc.to_project()
+            project = project_io.to_project(self.doc)
         except ValueError as exc:
             self._fail(str(exc))
             return None

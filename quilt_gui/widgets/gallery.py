@@ -23,8 +23,9 @@ from PySide6.QtGui import QAction, QColor, QFont, QGuiApplication, QPainter, QPe
 from PySide6.QtWidgets import QListView, QMenu, QStyle, QStyledItemDelegate
 
 from quilt_gui import settings
-from quilt_gui.document import CandidateEntry, Document
+from quilt_gui.document import Document
 from quilt_gui.imaging import to_qimage
+from quilt_gui.model import CandidateEntry
 
 PICK_ROLE = Qt.ItemDataRole.UserRole + 1  # 1-based pick order, 0 = not picked
 LOCKED_ROLE = Qt.ItemDataRole.UserRole + 2
@@ -43,13 +44,13 @@ class CandidateModel(QAbstractListModel):
         super().__init__(parent)
         self.doc = doc
         self.thumb = int(thumb or settings.get("thumbnail_size"))
-        self._rows: list[CandidateEntry] = list(doc.candidates)
+        self._rows: list[CandidateEntry] = list(doc.tileset.candidates)
         self._pick_order: dict[int, int] = {}
         self._thumbs: dict[int, QPixmap] = {}  # id(entry) -> pixmap
-        doc.candidate_inserted.connect(self._on_inserted)
-        doc.candidate_changed.connect(self._on_changed)
-        doc.candidates_reset.connect(self._on_reset)
-        doc.picks_changed.connect(self._on_picks_changed)
+        doc.tileset.candidate_inserted.connect(self._on_inserted)
+        doc.tileset.candidate_changed.connect(self._on_changed)
+        doc.tileset.candidates_reset.connect(self._on_reset)
+        doc.tileset.picks_changed.connect(self._on_picks_changed)
         self._on_picks_changed()
 
     # ------------------------------------------------------------------ Qt model API
@@ -121,30 +122,34 @@ class CandidateModel(QAbstractListModel):
     @Slot(int)
     def _on_inserted(self, row: int) -> None:
         self.beginInsertRows(QModelIndex(), row, row)
-        self._rows.insert(row, self.doc.candidates[row])
+        self._rows.insert(row, self.doc.tileset.candidates[row])
         self.endInsertRows()
 
     @Slot(int)
     def _on_changed(self, row: int) -> None:
         old = self._rows[row]
         self._thumbs.pop(id(old), None)
-        self._rows[row] = self.doc.candidates[row]
+        self._rows[row] = self.doc.tileset.candidates[row]
         ix = self.index(row)
         self.dataChanged.emit(ix, ix)
 
     @Slot()
     def _on_reset(self) -> None:
         self.beginResetModel()
-        self._rows = list(self.doc.candidates)
+        self._rows = list(self.doc.tileset.candidates)
         alive = {id(e) for e in self._rows}
         self._thumbs = {k: v for k, v in self._thumbs.items() if k in alive}
-        self._pick_order = {i: k + 1 for k, i in enumerate(self.doc.picks) if i < len(self._rows)}
+        self._pick_order = {
+            i: k + 1 for k, i in enumerate(self.doc.tileset.picks) if i < len(self._rows)
+        }
         self.endResetModel()
 
     @Slot()
     def _on_picks_changed(self) -> None:
         old = set(self._pick_order)
-        self._pick_order = {i: k + 1 for k, i in enumerate(self.doc.picks) if i < len(self._rows)}
+        self._pick_order = {
+            i: k + 1 for k, i in enumerate(self.doc.tileset.picks) if i < len(self._rows)
+        }
         rows = old | set(self._pick_order)
         if rows and self._rows:
             lo, hi = min(rows), min(max(rows), len(self._rows) - 1)
@@ -245,7 +250,7 @@ class CandidateView(QListView):
 
     def pick_range(self, a: int, b: int) -> None:
         lo, hi = sorted((a, b))
-        self.doc.set_picks([*self.doc.picks, *range(lo, hi + 1)], text="Pick tiles")
+        self.doc.tileset.set_picks([*self.doc.tileset.picks, *range(lo, hi + 1)], text="Pick tiles")
 
     def mousePressEvent(self, event) -> None:  # noqa: N802 - Qt API
         index = self.indexAt(event.position().toPoint())
@@ -257,7 +262,7 @@ class CandidateView(QListView):
         if event.modifiers() & Qt.KeyboardModifier.ShiftModifier and self._anchor is not None:
             self.pick_range(self._anchor, row)
         else:
-            self._click = (row, self.doc.toggle_pick(row))
+            self._click = (row, self.doc.tileset.toggle_pick(row))
         self._anchor = row
 
     def mouseDoubleClickEvent(self, event) -> None:  # noqa: N802 - Qt API
@@ -269,7 +274,7 @@ class CandidateView(QListView):
         row = index.row()
         click, self._click = self._click, None
         if click is not None and click[0] == row:
-            self.doc.retract(click[1])
+            self.doc.tileset.retract(click[1])
         self.setCurrentIndex(index)
         self.open_requested.emit(row)
         event.accept()
@@ -281,14 +286,16 @@ class CandidateView(QListView):
             if event.modifiers() & Qt.KeyboardModifier.ShiftModifier and self._anchor is not None:
                 self.pick_range(self._anchor, row)
             else:
-                self.doc.toggle_pick(row)
+                self.doc.tileset.toggle_pick(row)
             self._anchor = row
         elif key == Qt.Key.Key_A and event.modifiers() & Qt.KeyboardModifier.ControlModifier:
-            self.doc.set_picks(range(len(self.doc.candidates)), text="Pick all tiles")
+            self.doc.tileset.set_picks(
+                range(len(self.doc.tileset.candidates)), text="Pick all tiles"
+            )
         elif key in (Qt.Key.Key_Return, Qt.Key.Key_Enter) and row >= 0:
             self.open_requested.emit(row)
         elif key == Qt.Key.Key_L and row >= 0:
-            self.doc.set_locked(row, not self.doc.candidates[row].locked)
+            self.doc.tileset.set_locked(row, not self.doc.tileset.candidates[row].locked)
         elif key == Qt.Key.Key_R and row >= 0:
             self.reroll_requested.emit(row)
         else:
@@ -297,13 +304,13 @@ class CandidateView(QListView):
         event.accept()
 
     def _set_weight(self, row: int, weight: float, *_checked) -> None:
-        self.doc.set_weight(row, weight)
+        self.doc.tileset.set_weight(row, weight)
 
     def _menu(self, what: str, row: int, *_checked) -> None:
         if what == "pick":
-            self.doc.toggle_pick(row)
+            self.doc.tileset.toggle_pick(row)
         elif what == "lock":
-            self.doc.set_locked(row, not self.doc.candidates[row].locked)
+            self.doc.tileset.set_locked(row, not self.doc.tileset.candidates[row].locked)
         elif what == "reroll":
             self.reroll_requested.emit(row)
         else:
@@ -315,9 +322,9 @@ class CandidateView(QListView):
         if not index.isValid():
             return
         row = index.row()
-        entry = self.doc.candidates[row]
+        entry = self.doc.tileset.candidates[row]
         menu = QMenu(self)
-        pick = QAction("Unpick" if row in self.doc.picks else "Pick", menu)
+        pick = QAction("Unpick" if row in self.doc.tileset.picks else "Pick", menu)
         pick.triggered.connect(partial(self._menu, "pick", row))
         lock = QAction("Unlock" if entry.locked else "Lock", menu)
         lock.triggered.connect(partial(self._menu, "lock", row))

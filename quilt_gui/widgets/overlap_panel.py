@@ -173,36 +173,36 @@ class OverlapPanel(QWidget):
         row = QHBoxLayout()
         self.clear_button = QPushButton("Clear waypoints")
         self.clear_button.setToolTip("Remove every waypoint of both seams")
-        self.clear_button.clicked.connect(doc.clear_waypoints)
+        self.clear_button.clicked.connect(doc.tileset.clear_waypoints)
         row.addStretch(1)
         row.addWidget(self.clear_button)
         lay.addLayout(row)
         self.frames: dict[str, tuple | None] = {k: None for k in self.views}  # (rect, w_T) shown
         self._shown: dict[str, object] = {k: None for k in self.views}  # error map shown
-        doc.seamless_changed.connect(self._on_seamless_changed)
-        doc.waypoints_changed.connect(self._on_waypoints_changed)
+        doc.tileset.seamless_changed.connect(self._on_seamless_changed)
+        doc.tileset.waypoints_changed.connect(self._on_waypoints_changed)
         pipeline.seam_updated.connect(self._on_seam_updated)
         self._on_seamless_changed()
 
     @Slot(object)
     def _add_horizontal(self, pt) -> None:
-        self.doc.add_waypoint("horizontal", pt)
+        self.doc.tileset.add_waypoint("horizontal", pt)
 
     @Slot(object)
     def _add_vertical(self, pt) -> None:
-        self.doc.add_waypoint("vertical", pt)
+        self.doc.tileset.add_waypoint("vertical", pt)
 
     @Slot(object)
     def _remove_horizontal(self, pt) -> None:
-        self.doc.remove_waypoint("horizontal", pt)
+        self.doc.tileset.remove_waypoint("horizontal", pt)
 
     @Slot(object)
     def _remove_vertical(self, pt) -> None:
-        self.doc.remove_waypoint("vertical", pt)
+        self.doc.tileset.remove_waypoint("vertical", pt)
 
     @Slot()
     def _on_seamless_changed(self) -> None:
-        s = self.doc.seamless
+        s = self.doc.tileset.seamless
         if s is None:
             for which, v in self.views.items():
                 v.clear()
@@ -224,7 +224,7 @@ class OverlapPanel(QWidget):
 
     def current_frame(self) -> tuple | None:
         """(rect, w_T) of the document's tile rectangle: what live seams belong to."""
-        rect = self.doc.template_rect
+        rect = self.doc.tileset.template_rect
         return None if rect is None else (tuple(rect), int(self.doc.params["overlap"]))
 
     def _show_live_frame(self, update, frame) -> None:
@@ -234,7 +234,7 @@ class OverlapPanel(QWidget):
         view = self.views[which]
         r1, r2 = (update.regions[k] for k in LIVE_REGIONS[which])
         view.show_overlap(r1, r2, update.error, stacked=which == "vertical")
-        view.set_waypoints(self.doc.waypoints[which])
+        view.set_waypoints(self.doc.tileset.waypoints[which])
         self.frames[which] = frame
         self._shown[which] = update.error
         other = "vertical"
@@ -265,4 +265,4 @@ class OverlapPanel(QWidget):
     @Slot()
     def _on_waypoints_changed(self) -> None:
         for which, v in self.views.items():
-            v.set_waypoints(self.doc.waypoints[which])
+            v.set_waypoints(self.doc.tileset.waypoints[which])

@@ -245,7 +245,7 @@ class MaterialWeights(QGroupBox):
         )
         doc.source_changed.connect(self.refresh)
         doc.maps_changed.connect(self.refresh)
-        doc.map_weights_changed.connect(self.refresh)
+        doc.tileset.map_weights_changed.connect(self.refresh)
         self.refresh()
 
     @Slot()
@@ -270,8 +270,8 @@ class MaterialWeights(QGroupBox):
                 self.spins[name] = spin
         for name, spin in self.spins.items():
             with signals_blocked(spin):
-                spin.setValue(self.doc.map_weight(name))
+                spin.setValue(self.doc.tileset.map_weight(name))
         self.setVisible(self.wanted and len(names) > 1)
 
     def _edit(self, name: str, value: float) -> None:
-        self.doc.set_map_weight(name, value)
+        self.doc.tileset.set_map_weight(name, value)

@@ -20,7 +20,7 @@ from quilt_gui.widgets.canvas import ImageCanvas, cosmetic_pen
 
 
 class PreviewView(QWidget):
-    """Canvas of ``doc.preview`` with an optional tile grid and the grid score."""
+    """Canvas of ``doc.tileset.preview`` with an optional tile grid and the grid score."""
 
     def __init__(self, doc: Document, reroll_action=None, grid_action=None, parent=None) -> None:
         super().__init__(parent)
@@ -56,7 +56,7 @@ class PreviewView(QWidget):
         lay.addLayout(bar)
         lay.addWidget(self.canvas, 1)
         self._shape = None
-        doc.preview_changed.connect(self._on_preview_changed)
+        doc.tileset.preview_changed.connect(self._on_preview_changed)
         self._on_preview_changed()
 
     @Slot(bool)
@@ -70,7 +70,7 @@ class PreviewView(QWidget):
 
     @Slot()
     def _on_preview_changed(self) -> None:
-        img = self.doc.preview
+        img = self.doc.tileset.preview
         fit = img is None or self._shape != (None if img is None else img.shape)
         self._shape = None if img is None else img.shape
         self.canvas.set_image(img, fit=fit)
@@ -78,9 +78,9 @@ class PreviewView(QWidget):
         if img is None:
             self.info.setText("Pick tiles in the Candidates gallery to see them assembled here.")
         else:
-            lay = self.doc.layout
-            n = len(self.doc.picks)
-            score = self.doc.grid_score
+            lay = self.doc.tileset.layout
+            n = len(self.doc.tileset.picks)
+            score = self.doc.tileset.grid_score
             s = "n/a" if score is None else f"{score:.3f}"
             rows, cols = lay.shape if lay is not None else (0, 0)
             self.info.setText(
@@ -92,8 +92,8 @@ class PreviewView(QWidget):
         for item in self._lines:
             self.canvas.scene().removeItem(item)
         self._lines = []
-        lay, picks = self.doc.layout, self.doc.picked_entries()
-        if not self.grid or self.doc.preview is None or lay is None or not picks:
+        lay, picks = self.doc.tileset.layout, self.doc.tileset.picked_entries()
+        if not self.grid or self.doc.tileset.preview is None or lay is None or not picks:
             return
         th, tw = picks[0].tile.shape[:2]
         rows, cols = lay.shape

@@ -146,11 +146,11 @@ class QuiltView(QWidget):
         self.output.pixel_clicked.connect(self._on_output_clicked)
         self.sample.pixel_clicked.connect(self._on_sample_clicked)
         doc.source_changed.connect(self._on_source_changed)
-        doc.quilt_reset.connect(self._on_reset)
-        doc.block_placed.connect(self._on_block_placed)
-        doc.quilt_finished.connect(self._on_finished)
-        doc.quilt_iteration.connect(self._on_iteration)
-        doc.target_changed.connect(self._on_target_changed)
+        doc.quilting.reset.connect(self._on_reset)
+        doc.quilting.block_placed.connect(self._on_block_placed)
+        doc.quilting.finished.connect(self._on_finished)
+        doc.quilting.iteration_finished.connect(self._on_iteration)
+        doc.quilting.target_changed.connect(self._on_target_changed)
         self._on_source_changed()
 
     # ------------------------------------------------------------------ document -> view
@@ -162,7 +162,7 @@ class QuiltView(QWidget):
 
     @Slot()
     def _on_reset(self) -> None:
-        out = self.doc.quilt_output
+        out = self.doc.quilting.output
         self.select(None)
         if out is None:
             self.output.set_image(None)
@@ -179,8 +179,8 @@ class QuiltView(QWidget):
 
     @Slot(int)
     def _on_block_placed(self, index: int) -> None:
-        out = self.doc.quilt_output
-        rec = self.doc.quilt_blocks[index]
+        out = self.doc.quilting.output
+        rec = self.doc.quilting.blocks[index]
         H, W = out.shape[:2]
         (r, c), (h, w) = rec.position, rec.size
         for rr, nh in wrapped_pieces(r, h, H):
@@ -193,11 +193,11 @@ class QuiltView(QWidget):
 
     @Slot()
     def _on_finished(self) -> None:
-        out = self.doc.quilt_output
+        out = self.doc.quilting.output
         self.output.set_image(out)
         self.raster.reset(0, 0)
         self.block_rect.hide()
-        res = self.doc.quilt_result
+        res = self.doc.quilting.result
         h, w = out.shape[:2]
         passes = getattr(res, "iterations", ())
         how = (
@@ -207,31 +207,31 @@ class QuiltView(QWidget):
             else f"{res.select}, {res.seam} seams"
         )
         self.counter.setText(f"{w}×{h} from {len(res.blocks)} blocks ({how})")
-        self.select(len(self.doc.quilt_blocks) - 1 if self.doc.quilt_blocks else None)
+        self.select(len(self.doc.quilting.blocks) - 1 if self.doc.quilting.blocks else None)
 
     @Slot(int)
     def _on_iteration(self, iteration: int) -> None:
         """A transfer pass ended: show its image; the next pass paints over it."""
-        self.output.set_image(self.doc.quilt_output)
-        self.raster.reset(*self.doc.quilt_output.shape[:2])
+        self.output.set_image(self.doc.quilting.output)
+        self.raster.reset(*self.doc.quilting.output.shape[:2])
         self.select(None)
         self.counter.setText(f"transfer pass {iteration} of {self.doc.params['iterations']} done")
 
     @Slot()
     def _on_target_changed(self) -> None:
-        self.target.set_image(self.doc.transfer_target, fit=True)
-        if self.doc.transfer_target is not None:
+        self.target.set_image(self.doc.quilting.target, fit=True)
+        if self.doc.quilting.target is not None:
             self.inputs.setCurrentWidget(self.target)
 
     # ------------------------------------------------------------------ inspection
     @Slot()
     def _inspect_newest(self) -> None:
-        if self.doc.quilt_blocks and self.doc.quilt_result is None:
-            self.select(len(self.doc.quilt_blocks) - 1)
+        if self.doc.quilting.blocks and self.doc.quilting.result is None:
+            self.select(len(self.doc.quilting.blocks) - 1)
 
     @Slot(object, object)
     def _on_output_clicked(self, px, _modifiers) -> None:
-        self.select(self.doc.block_at(*px))
+        self.select(self.doc.quilting.block_at(*px))
 
     @Slot(object, object)
     def _on_sample_clicked(self, px, modifiers) -> None:
@@ -247,14 +247,14 @@ class QuiltView(QWidget):
     def select(self, index: int | None) -> None:
         """Show block ``index`` in the inspector (None clears it)."""
         self.selected = index
-        if index is None or not 0 <= index < len(self.doc.quilt_blocks):
+        if index is None or not 0 <= index < len(self.doc.quilting.blocks):
             self.selected = None
             self.inspector.clear()
             self.source_rect.hide()
             self.selection_changed.emit()
             return
-        rec = self.doc.quilt_blocks[index]
-        out = self.doc.quilt_output
+        rec = self.doc.quilting.blocks[index]
+        out = self.doc.quilting.output
         H, W = out.shape[:2]
         (r, c), (h, w) = rec.position, rec.size
         x, y, sw, sh = rec.source
@@ -290,4 +290,6 @@ class QuiltView(QWidget):
     def selected_block(self):
         """The engine record of the inspected block, or None."""
         i = self.selected
-        return None if i is None or i >= len(self.doc.quilt_blocks) else self.doc.quilt_blocks[i]
+        return (
+            None if i is None or i >= len(self.doc.quilting.blocks) else self.doc.quilting.blocks[i]
+        )

@@ -96,12 +96,12 @@ class SourceView(ImageCanvas):
         self.patch_item.drag_finished.connect(self._on_patch_dropped)
         self.zoom_changed.connect(self._on_zoom)
         doc.source_changed.connect(self._on_source_changed)
-        doc.template_changed.connect(self._on_template_changed)
+        doc.tileset.template_changed.connect(self._on_template_changed)
         doc.params_changed.connect(self._on_params_changed)
-        doc.seamless_changed.connect(self._on_seamless_changed)
-        doc.waypoints_changed.connect(self._on_waypoints_changed)
-        doc.candidate_changed.connect(self._on_candidate_changed)
-        doc.candidates_reset.connect(self._on_candidates_reset)
+        doc.tileset.seamless_changed.connect(self._on_seamless_changed)
+        doc.tileset.waypoints_changed.connect(self._on_waypoints_changed)
+        doc.tileset.candidate_changed.connect(self._on_candidate_changed)
+        doc.tileset.candidates_reset.connect(self._on_candidates_reset)
         pipeline.seam_updated.connect(self._on_seam_updated)
         pipeline.candidate_failed.connect(self._on_candidate_changed)  # the patch snaps back
         pipeline.template_searching.connect(self._on_searching)
@@ -134,7 +134,7 @@ class SourceView(ImageCanvas):
 
     @Slot()
     def _on_template_changed(self) -> None:
-        rect = self.doc.template_rect
+        rect = self.doc.tileset.template_rect
         overlap = int(self.doc.params["overlap"])
         if rect is None:
             for item in (self.rect_item, *self.shades.values()):
@@ -154,16 +154,16 @@ class SourceView(ImageCanvas):
             item.hide()
 
     def seamless_is_current(self) -> bool:
-        s = self.doc.seamless
+        s = self.doc.tileset.seamless
         return (
             s is not None
-            and tuple(s.rect) == self.doc.template_rect
+            and tuple(s.rect) == self.doc.tileset.template_rect
             and s.overlap == self.doc.params["overlap"]
         )
 
     @Slot()
     def _on_seamless_changed(self) -> None:
-        s = self.doc.seamless
+        s = self.doc.tileset.seamless
         if not self.seamless_is_current():
             self._hide_results()
             self._on_waypoints_changed()
@@ -190,11 +190,11 @@ class SourceView(ImageCanvas):
         for it in self._waypoint_items:
             self.scene().removeItem(it)
         self._waypoint_items = []
-        rect = self.doc.template_rect
+        rect = self.doc.tileset.template_rect
         if rect is None:
             return
         x, y = rect[0], rect[1]
-        for pts in self.doc.waypoints.values():
+        for pts in self.doc.tileset.waypoints.values():
             for r, c in pts:
                 it = WaypointItem(y + r, x + c)
                 self.scene().addItem(it)
@@ -210,8 +210,8 @@ class SourceView(ImageCanvas):
     def show_patch(self, index: int | None) -> None:
         """Show the patch source rectangle of candidate ``index`` (None hides it)."""
         entry = None
-        if index is not None and 0 <= index < len(self.doc.candidates):
-            entry = self.doc.candidates[index]
+        if index is not None and 0 <= index < len(self.doc.tileset.candidates):
+            entry = self.doc.tileset.candidates[index]
         if entry is None or entry.patch_rect is None:
             self.patch_index = None
             self.patch_item.hide()
@@ -239,14 +239,14 @@ class SourceView(ImageCanvas):
     # ------------------------------------------------------------------ user edits
     @Slot(object, int)
     def _on_rect_edited(self, rect, merge_id: int) -> None:
-        self.doc.set_template_rect(rect, merge_id=merge_id)
+        self.doc.tileset.set_template_rect(rect, merge_id=merge_id)
 
     def nudge(self, dx: int, dy: int, *, merge_id: int | None = None) -> None:
-        rect = self.doc.template_rect
+        rect = self.doc.tileset.template_rect
         if rect is None:
             return
         x, y, w, h = rect
-        self.doc.set_template_rect(
+        self.doc.tileset.set_template_rect(
             (x + dx, y + dy, w, h), merge_id=merge_id, text="Nudge tile rectangle"
         )
 
@@ -257,7 +257,7 @@ class SourceView(ImageCanvas):
             Qt.Key.Key_Up: (0, -1),
             Qt.Key.Key_Down: (0, 1),
         }
-        if event.key() in steps and self.doc.template_rect is not None:
+        if event.key() in steps and self.doc.tileset.template_rect is not None:
             dx, dy = steps[event.key()]
             n = 10 if event.modifiers() & Qt.KeyboardModifier.ShiftModifier else 1
             if not event.isAutoRepeat() or self._nudge_merge is None:
@@ -269,7 +269,7 @@ class SourceView(ImageCanvas):
 
     def waypoint_target(self, row: int, col: int) -> tuple[str, tuple[int, int]] | None:
         """Which overlap a source pixel lies in, and its (row, col) in that overlap's frame."""
-        rect = self.doc.template_rect
+        rect = self.doc.tileset.template_rect
         if rect is None:
             return None
         overlap = int(self.doc.params["overlap"])
@@ -290,11 +290,11 @@ class SourceView(ImageCanvas):
             if target is not None:
                 which, pt = target
                 if event.button() == Qt.MouseButton.RightButton:
-                    near = nearest_waypoint(self.doc.waypoints[which], pt)
+                    near = nearest_waypoint(self.doc.tileset.waypoints[which], pt)
                     if near is not None:
-                        self.doc.remove_waypoint(which, near)
+                        self.doc.tileset.remove_waypoint(which, near)
                 else:
-                    self.doc.add_waypoint(which, pt)
+                    self.doc.tileset.add_waypoint(which, pt)
                 event.accept()
                 return
         super().mousePressEvent(event)

@@ -157,12 +157,12 @@ class TileView(TiledImageView):
             "itself (1.0 = invisible).\nDetail ratio: Laplacian variance of the "
             "tile vs. the source (below 0.95 means blur)."
         )
-        doc.seamless_changed.connect(self._on_seamless_changed)
+        doc.tileset.seamless_changed.connect(self._on_seamless_changed)
         self._on_seamless_changed()
 
     @Slot()
     def _on_seamless_changed(self) -> None:
-        s = self.doc.seamless
+        s = self.doc.tileset.seamless
         self.set_tile(None if s is None else np.asarray(s.tile))
         self.metrics = None
         if s is None or self.doc.source is None:

@@ -5,13 +5,12 @@ from __future__ import annotations
 import pytest
 from PySide6.QtCore import QSettings
 
-from quilt_gui import app as app_module
-from quilt_gui import jobs
+from quilt_gui import jobs, settings
 
 
 @pytest.fixture(autouse=True)
 def _isolated_settings(tmp_path, qapp):
-    app_module.set_names()
+    settings.set_names()
     QSettings.setDefaultFormat(QSettings.Format.IniFormat)
     QSettings.setPath(QSettings.Format.IniFormat, QSettings.Scope.UserScope, str(tmp_path / "cfg"))
     QSettings().clear()

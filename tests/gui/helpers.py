@@ -19,15 +19,15 @@ def open_sample(qtbot, window: MainWindow, name: str | None = None) -> None:
         if name is None:
             window.open_initial(None)
         else:
-            window.open_path(str(sample_path(name)), confirm=False)
+            window.files.open_path(str(sample_path(name)), confirm=False)
     wait_idle(qtbot, window)
 
 
 def template(qtbot, window: MainWindow, rect=(150, 120, 128, 112)) -> None:
     """Draw the tile rectangle and wait for its seamless tile."""
-    window.doc.set_template_rect(rect)
+    window.doc.tileset.set_template_rect(rect)
     wait_idle(qtbot, window)
-    assert window.doc.seamless is not None
+    assert window.doc.tileset.seamless is not None
 
 
 def generate(qtbot, window: MainWindow, n: int = 30, rect=(150, 120, 128, 112)) -> None:
@@ -36,7 +36,7 @@ def generate(qtbot, window: MainWindow, n: int = 30, rect=(150, 120, 128, 112)) 
     window.doc.set_param("n_candidates", n)
     window.act_generate.trigger()
     wait_idle(qtbot, window)
-    assert len(window.doc.candidates) == n
+    assert len(window.doc.tileset.candidates) == n
 
 
 def click_candidate(qtbot, window: MainWindow, row: int, modifier=Qt.KeyboardModifier.NoModifier):
@@ -50,7 +50,7 @@ def click_candidate(qtbot, window: MainWindow, row: int, modifier=Qt.KeyboardMod
 def make_window(qtbot) -> MainWindow:
     w = MainWindow()
     qtbot.addWidget(w)
-    w.ask_save_changes = lambda: "discard"  # never a modal dialog in tests
+    w.files.ask_save_changes = lambda: "discard"  # never a modal dialog in tests
     w.resize(1400, 900)
     w.show()
     qtbot.waitExposed(w)

@@ -38,9 +38,9 @@ def test_cli_project_opens_in_the_editor(qtbot, tmp_path):
     cli = load_project(proj)
     w = make_window(qtbot)
     with qtbot.waitSignal(w.doc.path_changed, timeout=20_000):
-        w.open_path(str(proj), confirm=False)
+        w.files.open_path(str(proj), confirm=False)
     wait_idle(qtbot, w)
-    d = w.doc
+    d = w.doc.tileset
     assert len(d.candidates) == 4 and d.picks == cli.picks == [0, 2]
     assert d.template_rect == cli.template_rect
     assert w.gallery.model().rowCount() == 4 and d.seamless is not None
@@ -52,10 +52,10 @@ def test_editor_project_exports_with_the_cli(qtbot, tmp_path):
     w = make_window(qtbot)
     open_sample(qtbot, w)
     generate(qtbot, w, 3)
-    w.doc.set_picks([2, 0])
+    w.doc.tileset.set_picks([2, 0])
     wait_idle(qtbot, w)
     path = tmp_path / "editor.quiltproj"
-    assert w.save_to(str(path), wait=True)
+    assert w.files.save_to(str(path), wait=True)
     out = tmp_path / "bundle"
     assert cli_main(["export", str(path), "--out", str(out)]) == 0
     manifest = json.loads((out / f"{w.doc.name}.json").read_text())

@@ -52,7 +52,7 @@ def test_editor_patch_ring_defaults_to_auto_which_is_the_engine_default(qtbot):
     w.doc.set_param("overlap", 24)  # default ring 12, not 24 nor 8
     assert w.pipeline._tile_options()["patch_overlap"] is None
     generate(qtbot, w, n=2)
-    st, entry = w.doc.seamless, w.doc.candidates[0]
+    st, entry = w.doc.tileset.seamless, w.doc.tileset.candidates[0]
     assert default_patch_overlap(st.overlap) == 12
     h, wd = entry.tile.shape[:2]
     r, c = entry.loop[:, 0], entry.loop[:, 1]

@@ -113,39 +113,39 @@ def test_drag_rectangle_is_one_undo_step_and_nudge(qtbot, win):
     v = win.source_view
     v.set_zoom(1.0)
     v.center_on_pixel(176, 214)
-    x, y, w, h = win.doc.template_rect
+    x, y, w, h = win.doc.tileset.template_rect
     start = v.view_pos_of_pixel(y + h // 2, x + w // 2).toPoint()
     n0 = win.doc.undo_stack.count()
     qtbot.mousePress(v.viewport(), Qt.MouseButton.LeftButton, pos=start)
     for k in range(1, 11):
         qtbot.mouseMove(v.viewport(), start + QPoint(2 * k, k))
     qtbot.mouseRelease(v.viewport(), Qt.MouseButton.LeftButton, pos=start + QPoint(20, 10))
-    assert win.doc.template_rect == (x + 20, y + 10, w, h)
+    assert win.doc.tileset.template_rect == (x + 20, y + 10, w, h)
     assert win.doc.undo_stack.count() == n0 + 1
     # arrow keys nudge by 1 px, Shift by 10
     v.setFocus()
     qtbot.keyClick(v, Qt.Key.Key_Left)
     qtbot.keyClick(v, Qt.Key.Key_Down, Qt.KeyboardModifier.ShiftModifier)
-    assert win.doc.template_rect == (x + 19, y + 20, w, h)
+    assert win.doc.tileset.template_rect == (x + 19, y + 20, w, h)
     win.doc.undo_stack.undo()
     win.doc.undo_stack.undo()
     win.doc.undo_stack.undo()
-    assert win.doc.template_rect == (x, y, w, h)
+    assert win.doc.tileset.template_rect == (x, y, w, h)
     wait_idle(qtbot, win)
-    assert win.doc.seamless.rect == (x, y, w, h)  # the seams follow the rectangle
+    assert win.doc.tileset.seamless.rect == (x, y, w, h)  # the seams follow the rectangle
 
 
 def test_resize_handle(qtbot, win):
     template(qtbot, win)
     v = win.source_view
     v.set_zoom(1.0)
-    x, y, w, h = win.doc.template_rect
+    x, y, w, h = win.doc.tileset.template_rect
     v.center_on_pixel(y + h, x + w)
     corner = v.mapFromScene(QPointF(x + w, y + h))
     qtbot.mousePress(v.viewport(), Qt.MouseButton.LeftButton, pos=corner)
     qtbot.mouseMove(v.viewport(), corner + QPoint(-16, -8))
     qtbot.mouseRelease(v.viewport(), Qt.MouseButton.LeftButton, pos=corner + QPoint(-16, -8))
-    assert win.doc.template_rect == (x, y, w - 16, h - 8)
+    assert win.doc.tileset.template_rect == (x, y, w - 16, h - 8)
 
 
 def test_slider_drag_in_parameters_panel_is_one_step(qtbot, win):
@@ -165,20 +165,20 @@ def test_waypoint_click_in_overlap_panel_steers_the_seam(qtbot, win):
     template(qtbot, win)
     view = win.overlap_panel.views["horizontal"]
     h, w = view.frame_shape
-    path = {tuple(p) for p in win.doc.seamless.paths["horizontal"].tolist()}
+    path = {tuple(p) for p in win.doc.tileset.seamless.paths["horizontal"].tolist()}
     row = h // 2
     col = next(c for c in range(2, w - 2) if (row, c) not in path)
     ox, oy = view.offsets[2]  # the error-map panel
     pos = view.mapFromScene(QPointF(ox + col + 0.5, oy + row + 0.5))
     qtbot.mouseClick(view.viewport(), Qt.MouseButton.LeftButton, pos=pos)
-    assert win.doc.waypoints["horizontal"] == [(row, col)]
+    assert win.doc.tileset.waypoints["horizontal"] == [(row, col)]
     wait_idle(qtbot, win)
-    assert (row, col) in {tuple(p) for p in win.doc.seamless.paths["horizontal"].tolist()}
-    x, y = win.doc.template_rect[:2]
+    assert (row, col) in {tuple(p) for p in win.doc.tileset.seamless.paths["horizontal"].tolist()}
+    x, y = win.doc.tileset.template_rect[:2]
     src = {tuple(p) for p in win.source_view.seams["horizontal"].points.tolist()}
     assert (y + row, x + col) in src  # drawn on the source too, at the same pixel
     qtbot.mouseClick(view.viewport(), Qt.MouseButton.RightButton, pos=pos)
-    assert win.doc.waypoints["horizontal"] == []
+    assert win.doc.tileset.waypoints["horizontal"] == []
 
 
 def test_live_seams_of_a_new_rectangle_are_drawn_on_both_its_overlaps(qtbot, win):
@@ -189,7 +189,7 @@ def test_live_seams_of_a_new_rectangle_are_drawn_on_both_its_overlaps(qtbot, win
 
     template(qtbot, win, (150, 120, 128, 112))
     panel, ov = win.overlap_panel, win.doc.params["overlap"]
-    old = win.doc.seamless
+    old = win.doc.tileset.seamless
     new = (60, 40, 100, 90)
     seen = []
 
@@ -198,7 +198,7 @@ def test_live_seams_of_a_new_rectangle_are_drawn_on_both_its_overlaps(qtbot, win
         seen.append(
             (
                 update.which,
-                win.doc.seamless is old,
+                win.doc.tileset.seamless is old,
                 view.frame_shape,
                 panel.frames[update.which],
                 view.array.copy(),
@@ -209,11 +209,11 @@ def test_live_seams_of_a_new_rectangle_are_drawn_on_both_its_overlaps(qtbot, win
     win.pipeline.seam_updated.connect(record)
     win.doc.set_param("method", "oscillating")  # streams improvements on both overlaps
     wait_idle(qtbot, win)
-    old = win.doc.seamless
+    old = win.doc.tileset.seamless
     seen.clear()
-    win.doc.apply_template_rect(new)
+    win.doc.tileset.apply_template_rect(new)
     wait_idle(qtbot, win)
-    assert win.doc.seamless is not old and tuple(win.doc.seamless.rect) == new
+    assert win.doc.tileset.seamless is not old and tuple(win.doc.tileset.seamless.rect) == new
     live = [s for s in seen if s[1]]  # delivered while the old result was still shown
     assert {s[0] for s in live} == {"horizontal", "vertical"}, [s[0] for s in seen]
     shapes = {"horizontal": (90 + ov, ov), "vertical": (ov, 100)}
@@ -236,9 +236,12 @@ def test_live_seams_of_a_new_rectangle_are_drawn_on_both_its_overlaps(qtbot, win
 def test_changing_a_parameter_supersedes_and_no_stale_result_is_drawn(qtbot, win):
     template(qtbot, win, (60, 60, 300, 300))
     applied, live = [], []
-    win.doc.seamless_changed.connect(
+    win.doc.tileset.seamless_changed.connect(
         lambda: applied.append(
-            (win.doc.seamless and win.doc.seamless.parameters["method"], win.doc.params["method"])
+            (
+                win.doc.tileset.seamless and win.doc.tileset.seamless.parameters["method"],
+                win.doc.params["method"],
+            )
         )
     )
     win.pipeline.seam_updated.connect(
@@ -260,7 +263,10 @@ def test_changing_a_parameter_supersedes_and_no_stale_result_is_drawn(qtbot, win
     qtbot.waitUntil(lambda: all(j.state == "aborted" for j in superseded), timeout=5000)
     assert applied and all(m is None or m == cur for m, cur in applied)
     assert all(m == cur for m, cur in live)
-    assert win.doc.seamless.parameters["method"] == "dp" and win.doc.seamless.parameters["rho"] == 5
+    assert (
+        win.doc.tileset.seamless.parameters["method"] == "dp"
+        and win.doc.tileset.seamless.parameters["rho"] == 5
+    )
 
 
 # ---------------------------------------------------------------------- gallery model
@@ -272,8 +278,8 @@ def test_candidate_model_passes_qtmodeltester(qtbot, qtmodeltester, win):
     wait_idle(qtbot, win)
     qtmodeltester.check(model)
     assert model.rowCount() == 30
-    win.doc.toggle_pick(3)
-    win.doc.set_locked(3, True)
+    win.doc.tileset.toggle_pick(3)
+    win.doc.tileset.set_locked(3, True)
     win.doc.undo_stack.undo()
     qtmodeltester.check(model)
 
@@ -283,29 +289,31 @@ def test_lock_reroll_and_patch_drag(qtbot, win):
     win.doc.set_param("n_candidates", 6)
     win.act_generate.trigger()
     wait_idle(qtbot, win)
-    before = [e.tile for e in win.doc.candidates]
-    win.doc.set_locked(1, True)
+    before = [e.tile for e in win.doc.tileset.candidates]
+    win.doc.tileset.set_locked(1, True)
     win.reroll_candidate(2)
     wait_idle(qtbot, win)
-    assert not np.array_equal(win.doc.candidates[2].tile, before[2])
+    assert not np.array_equal(win.doc.tileset.candidates[2].tile, before[2])
     assert win.doc.undo_stack.undoText() == "Re-roll candidate #3"
     # dragging the patch source rectangle rebuilds that candidate from the new place
     win.gallery.setCurrentIndex(win.gallery.model().index(4))
     item = win.source_view.patch_item
-    assert item.isVisible() and item.rect == win.doc.candidates[4].patch_rect
+    assert item.isVisible() and item.rect == win.doc.tileset.candidates[4].patch_rect
     px, py, pw, ph = item.rect
     H, W = win.doc.source.shape
     new = (min(px + 15, W - pw), min(py + 9, H - ph))
     item.set_rect((new[0], new[1], pw, ph))
     item.drag_finished.emit()
     wait_idle(qtbot, win)
-    assert win.doc.candidates[4].patch_origin == (new[1], new[0])
+    assert win.doc.tileset.candidates[4].patch_origin == (new[1], new[0])
     # generating again keeps the locked candidate (and its pick)
-    win.doc.toggle_pick(1)
+    win.doc.tileset.toggle_pick(1)
     win.act_generate.trigger()
     wait_idle(qtbot, win)
-    assert len(win.doc.candidates) == 6 and np.array_equal(win.doc.candidates[0].tile, before[1])
-    assert win.doc.picks == [0]
+    assert len(win.doc.tileset.candidates) == 6 and np.array_equal(
+        win.doc.tileset.candidates[0].tile, before[1]
+    )
+    assert win.doc.tileset.picks == [0]
     dlg = win.open_candidate(0)
     assert dlg.isVisible() and dlg.lock_button.text() == "Unlock"
     assert dlg.loop_item.isVisible()
@@ -338,7 +346,7 @@ def test_corrupt_file_dropped_shows_message_and_keeps_editor_usable(qtbot, win, 
     assert win.doc.source is source  # nothing lost
     win.act_find.trigger()  # still usable
     wait_idle(qtbot, win)
-    assert win.doc.seamless is not None
+    assert win.doc.tileset.seamless is not None
 
 
 def test_drop_opens_an_image_and_remembers_it(qtbot, win, tmp_path):
@@ -372,7 +380,7 @@ def test_opened_message_names_the_colour_model_in_words(qtbot, win, tmp_path, mo
         im = im.convert(mode)
     im.save(path)
     with qtbot.waitSignal(win.doc.source_changed, timeout=5000):
-        win.open_path(str(path), confirm=False)
+        win.files.open_path(str(path), confirm=False)
     assert f"50×40, {shown}." in win.last_message()
 
 
@@ -388,17 +396,17 @@ def test_image_too_small_for_the_tile(qtbot, win, tmp_path):
     tiny = tmp_path / "tiny.png"
     Image.fromarray(np.zeros((24, 24, 3), np.uint8) + 100).save(tiny)
     with qtbot.waitSignal(win.doc.source_changed, timeout=5000):
-        win.open_path(str(tiny), confirm=False)
+        win.files.open_path(str(tiny), confirm=False)
     win.act_find.trigger()
     wait_idle(qtbot, win)
     assert "smaller than the minimum tile" in win.last_message("error")
-    assert win.doc.template_rect is None
-    win.doc.set_template_rect((0, 0, 10, 10))  # a hand-drawn rectangle too small for w_T
+    assert win.doc.tileset.template_rect is None
+    win.doc.tileset.set_template_rect((0, 0, 10, 10))  # a hand-drawn rectangle too small for w_T
     wait_idle(qtbot, win)
-    assert "at least 2*overlap" in win.last_message("error") and win.doc.seamless is None
+    assert "at least 2*overlap" in win.last_message("error") and win.doc.tileset.seamless is None
     win.doc.set_param("overlap", 4)  # fixing the parameter recovers
     wait_idle(qtbot, win)
-    assert win.doc.seamless is not None
+    assert win.doc.tileset.seamless is not None
 
 
 def test_unwritable_folder_for_export_and_save(qtbot, win, tmp_path):
@@ -413,7 +421,7 @@ def test_unwritable_folder_for_export_and_save(qtbot, win, tmp_path):
     wait_idle(qtbot, win)
     assert "Export failed" in dlg.status.text() and "/sys/fs/quilt_bundle" in dlg.status.text()
     assert "Export failed" in win.last_message("error")
-    win.save_to("/sys/fs/quilt_session.quiltproj")
+    win.files.save_to("/sys/fs/quilt_session.quiltproj")
     wait_idle(qtbot, win)
     assert "The project was not saved" in win.last_message("error")
     assert win.doc.modified  # still unsaved, nothing lost
@@ -438,7 +446,7 @@ def test_close_while_jobs_run_does_not_hang(qtbot, win):
     win.doc.set_param("n_candidates", 500)
     win.act_generate.trigger()
     win.doc.set_param("method", "oscillating")
-    qtbot.waitUntil(lambda: len(win.doc.candidates) > 0, timeout=10_000)
+    qtbot.waitUntil(lambda: len(win.doc.tileset.candidates) > 0, timeout=10_000)
     assert win.jobs.running()
     t0 = time.perf_counter()
     assert win.close()
@@ -449,11 +457,11 @@ def test_close_while_jobs_run_does_not_hang(qtbot, win):
 def test_unsaved_changes_prompt_on_close(qtbot, win, tmp_path):
     win.doc.set_param("overlap", 12)
     assert win.doc.modified and win.isWindowModified()
-    win.ask_save_changes = lambda: "cancel"
+    win.files.ask_save_changes = lambda: "cancel"
     assert not win.close() and win.isVisible()
     target = tmp_path / "kept.quiltproj"
-    win.ask_save_changes = lambda: "save"
-    win.ask_save_path = lambda: str(target)
+    win.files.ask_save_changes = lambda: "save"
+    win.files.ask_save_path = lambda: str(target)
     assert win.close()
     assert target.is_file()
 
@@ -463,10 +471,10 @@ def test_autosave_and_recovery_after_a_crash(qtbot, win):
     win.doc.set_param("n_candidates", 4)
     win.act_generate.trigger()
     wait_idle(qtbot, win)
-    win.doc.toggle_pick(1)
-    job = win.autosave_now()
+    win.doc.tileset.toggle_pick(1)
+    job = win.files.autosave_now()
     wait_idle(qtbot, win)
-    assert job.state == "done" and win.recovery_file().is_file()
+    assert job.state == "done" and win.files.recovery_file().is_file()
     # "crash": the first window never closes; a new session starts
     w2 = make_window(qtbot)
     open_sample(qtbot, w2)
@@ -474,8 +482,11 @@ def test_autosave_and_recovery_after_a_crash(qtbot, win):
     restore = next(b for b in w2.message_bar.findChildren(QPushButton) if b.text() == "Restore")
     restore.click()
     wait_idle(qtbot, w2)
-    assert w2.doc.template_rect == win.doc.template_rect and w2.doc.picks == [1]
-    assert len(w2.doc.candidates) == 4 and w2.doc.modified
+    assert (
+        w2.doc.tileset.template_rect == win.doc.tileset.template_rect
+        and w2.doc.tileset.picks == [1]
+    )
+    assert len(w2.doc.tileset.candidates) == 4 and w2.doc.modified
     win.doc.mark_saved()
 
 
@@ -510,7 +521,7 @@ def test_window_fits_a_1280_px_screen_whatever_the_labels_say(qtbot, win):
     from tests.gui.helpers import generate
 
     generate(qtbot, win, 4)
-    win.doc.set_picks([0, 1, 2])
+    win.doc.tileset.set_picks([0, 1, 2])
     wait_idle(qtbot, win)
     win.show_help()  # the longest banner
     for tab in (win.source_view, win.preview_view, win.quilt_view):
@@ -537,7 +548,9 @@ def test_only_the_options_of_the_seam_method_in_use_are_editable(qtbot, win):
 
 def test_open_dialog_lists_images_and_projects_together(win, monkeypatch):
     asked = []
-    monkeypatch.setattr(win, "ask_open_path", lambda caption, filters, key: asked.append(filters))
-    win.open_dialog()
+    monkeypatch.setattr(
+        win.files, "ask_open_path", lambda caption, filters, key: asked.append(filters)
+    )
+    win.files.open_dialog()
     first = asked[0].split(";;")[0]
     assert "*.png" in first and "*.quiltproj" in first

@@ -43,17 +43,17 @@ def test_double_click_opens_the_candidate_and_leaves_no_pick_or_undo_step(qtbot)
         _mouse(g, kind, 2)
     _mouse(g, T.MouseButtonRelease, 2)
     assert 2 in w._dialogs and w._dialogs[2].isVisible()
-    assert w.doc.picks == [] and w.doc.undo_stack.count() == steps
+    assert w.doc.tileset.picks == [] and w.doc.undo_stack.count() == steps
     assert not w.doc.undo_stack.canRedo()
     # QTest's double-click sends the double-click event alone
     qtbot.mouseDClick(
         g.viewport(), Qt.MouseButton.LeftButton, pos=g.visualRect(g.model().index(4)).center()
     )
-    assert 4 in w._dialogs and w.doc.picks == []
+    assert 4 in w._dialogs and w.doc.tileset.picks == []
     # a plain click still picks
     _mouse(g, T.MouseButtonPress, 1)
     _mouse(g, T.MouseButtonRelease, 1)
-    assert w.doc.picks == [1]
+    assert w.doc.tileset.picks == [1]
 
 
 def test_candidates_are_numbered_by_their_seed_and_a_stop_says_so(qtbot):
@@ -61,13 +61,15 @@ def test_candidates_are_numbered_by_their_seed_and_a_stop_says_so(qtbot):
     open_sample(qtbot, w)
     generate(qtbot, w, 12)
     seed = int(w.doc.params["seed"])
-    assert [e.seed for e in w.doc.candidates] == [candidate_seed(seed, k) for k in range(12)]
+    assert [e.seed for e in w.doc.tileset.candidates] == [
+        candidate_seed(seed, k) for k in range(12)
+    ]
     w.doc.set_param("n_candidates", 400)
     w.act_generate.trigger()
-    qtbot.waitUntil(lambda: len(w.doc.candidates) >= 4, timeout=20_000)
+    qtbot.waitUntil(lambda: len(w.doc.tileset.candidates) >= 4, timeout=20_000)
     w.act_cancel.trigger()
     wait_idle(qtbot, w)
-    n = len(w.doc.candidates)
+    n = len(w.doc.tileset.candidates)
     assert n < 400
     assert w.last_message().startswith(f"Generation stopped: {n} of 400 new candidates made")
     assert w.doc.undo_stack.undoText() == "Generate candidates"
@@ -79,7 +81,7 @@ def test_candidate_dialog_shows_seam_on_tile_and_patch_source_and_keeps_it_in_pr
     w = make_window(qtbot)
     open_sample(qtbot, w)
     generate(qtbot, w, 3)
-    e = w.doc.candidates[1]
+    e = w.doc.tileset.candidates[1]
     dlg = w.open_candidate(1)
     h, w_ = e.tile.shape[:2]
     dlg.view.repeat_buttons.button(1).click()  # 1x1: the seam sits on the only tile
@@ -95,11 +97,11 @@ def test_candidate_dialog_shows_seam_on_tile_and_patch_source_and_keeps_it_in_pr
     assert "Pixels that differ from the template" in dlg.info.text()
     dlg.close()
     path = str(tmp_path / "p.quiltproj")
-    assert w.save_to(path, wait=True)
+    assert w.files.save_to(path, wait=True)
     with qtbot.waitSignal(w.doc.path_changed, timeout=10_000):
-        w.open_path(path, confirm=False)
+        w.files.open_path(path, confirm=False)
     wait_idle(qtbot, w)
-    back = w.doc.candidates[1]
+    back = w.doc.tileset.candidates[1]
     np.testing.assert_array_equal(back.loop, e.loop)
     assert back.target_rect == e.target_rect
     assert w.open_candidate(1).loop_item.isVisible()
@@ -110,11 +112,13 @@ def test_candidates_from_an_earlier_template_are_marked_until_regenerated(qtbot)
     open_sample(qtbot, w)
     generate(qtbot, w, 4)
     title = w.docks["gallery"].windowTitle
-    assert not w.doc.candidates_outdated and "earlier template" not in title()
-    x, y, tw, th = w.doc.template_rect
-    w.doc.set_template_rect((x + 4, y + 2, tw - 6, th))
+    assert not w.doc.tileset.candidates_outdated and "earlier template" not in title()
+    x, y, tw, th = w.doc.tileset.template_rect
+    w.doc.tileset.set_template_rect((x + 4, y + 2, tw - 6, th))
     wait_idle(qtbot, w)
-    assert w.doc.candidates_outdated and "earlier template" in title()
-    assert len(w.doc.candidates) == 4  # kept (they still connect to each other), not dropped
+    assert w.doc.tileset.candidates_outdated and "earlier template" in title()
+    assert (
+        len(w.doc.tileset.candidates) == 4
+    )  # kept (they still connect to each other), not dropped
     generate(qtbot, w, 4)
-    assert not w.doc.candidates_outdated and "earlier template" not in title()
+    assert not w.doc.tileset.candidates_outdated and "earlier template" not in title()

@@ -26,21 +26,21 @@ def test_attached_normal_map_follows_every_cut_and_exports(qtbot, tmp_path):
     path = tmp_path / "cobbles_normal.png"
     Image.fromarray(normal_map_of(src.mean(axis=2))).save(path)
     with qtbot.waitSignal(w.doc.maps_changed, timeout=5000):
-        w.attach_map(str(path))
+        w.files.attach_map(str(path))
     assert list(w.doc.source.maps) == ["albedo", "normal"]
     assert w.doc.source.kinds["normal"] == "normal"
-    w.doc.set_template_rect((150, 120, 128, 112))
+    w.doc.tileset.set_template_rect((150, 120, 128, 112))
     wait_idle(qtbot, w)
-    s = w.doc.seamless
+    s = w.doc.tileset.seamless
     assert "normal" in s.maps and s.maps["normal"].shape == s.tile.shape
     w.doc.set_param("n_candidates", 4)
     w.act_generate.trigger()
     wait_idle(qtbot, w)
-    for e in w.doc.candidates:
+    for e in w.doc.tileset.candidates:
         assert set(e.maps) == {"albedo", "normal"}
         v = decode_normals(e.maps["normal"])
         assert np.allclose(np.linalg.norm(v, axis=2), 1.0, atol=0.02)
-    w.doc.set_picks([0, 2])
+    w.doc.tileset.set_picks([0, 2])
     wait_idle(qtbot, w)
     w.export_dialog()
     dlg = w._export_dialog
@@ -52,7 +52,7 @@ def test_attached_normal_map_follows_every_cut_and_exports(qtbot, tmp_path):
     # a map of the wrong size is refused with a message naming it
     wrong = tmp_path / "wrong_roughness.png"
     Image.fromarray(np.zeros((10, 12), np.uint8)).save(wrong)
-    w.attach_map(str(wrong))
+    w.files.attach_map(str(wrong))
     qtbot.waitUntil(lambda: "wrong_roughness.png" in w.last_message("error"), timeout=5000)
     assert list(w.doc.source.maps) == ["albedo", "normal"]
 
@@ -61,12 +61,12 @@ def test_preview_weight_zero_removes_a_tile_from_the_layout(qtbot):
     w = make_window(qtbot)
     open_sample(qtbot, w)
     generate(qtbot, w, 4)
-    w.doc.set_picks([0, 1, 2])
+    w.doc.tileset.set_picks([0, 1, 2])
     wait_idle(qtbot, w)
-    assert set(np.unique(w.doc.layout)) == {0, 1, 2}
-    w.doc.set_weight(1, 0.0)  # candidate 1 is the second picked tile (id 1)
+    assert set(np.unique(w.doc.tileset.layout)) == {0, 1, 2}
+    w.doc.tileset.set_weight(1, 0.0)  # candidate 1 is the second picked tile (id 1)
     wait_idle(qtbot, w)
-    assert 1 not in set(np.unique(w.doc.layout))
+    assert 1 not in set(np.unique(w.doc.tileset.layout))
     tip = w.gallery.model().index(1).data(Qt.ItemDataRole.ToolTipRole)
     assert "preview weight 0" in tip  # also drawn as a ×0 tag on the thumbnail
 
@@ -92,13 +92,13 @@ def test_seam_weights_of_the_maps_steer_the_cut_undo_and_survive_a_reopen(qtbot,
     path = tmp_path / "cobbles_height.png"
     Image.fromarray(height).save(path)
     with qtbot.waitSignal(w.doc.maps_changed, timeout=5000):
-        w.attach_map(str(path))
+        w.files.attach_map(str(path))
     assert box.isVisible() and list(box.spins) == ["albedo", "height"]
     assert box.spins["albedo"].value() == 1.0 and box.spins["height"].value() == 0.0
     rect = (150, 120, 128, 112)
-    w.doc.set_template_rect(rect)
+    w.doc.tileset.set_template_rect(rect)
     wait_idle(qtbot, w)
-    plain = w.doc.seamless.paths["horizontal"].copy()
+    plain = w.doc.tileset.seamless.paths["horizontal"].copy()
     box.spins["height"].setValue(2.0)  # what typing 2 and Enter does
     assert w.doc.undo_stack.undoText() == "Seam weight of height"
     wait_idle(qtbot, w)
@@ -111,12 +111,14 @@ def test_seam_weights_of_the_maps_steer_the_cut_undo_and_survive_a_reopen(qtbot,
         maps={"height": src.maps["height"]},
         weights={"main": 1.0, "height": 2.0},
     )
-    np.testing.assert_array_equal(w.doc.seamless.paths["horizontal"], expected.paths["horizontal"])
+    np.testing.assert_array_equal(
+        w.doc.tileset.seamless.paths["horizontal"], expected.paths["horizontal"]
+    )
     assert not np.array_equal(plain, expected.paths["horizontal"])
     project = str(tmp_path / "w.quiltproj")
-    assert w.save_to(project, wait=True)
+    assert w.files.save_to(project, wait=True)
     w.doc.undo_stack.undo()
-    assert box.spins["height"].value() == 0.0 and w.doc.engine_weights() is None
+    assert box.spins["height"].value() == 0.0 and w.doc.tileset.engine_weights() is None
     with qtbot.waitSignal(w.doc.path_changed, timeout=10_000):
-        w.open_path(project, confirm=False)
-    assert w.doc.map_weights == {"height": 2.0} and box.spins["height"].value() == 2.0
+        w.files.open_path(project, confirm=False)
+    assert w.doc.tileset.map_weights == {"height": 2.0} and box.spins["height"].value() == 2.0

@@ -5,9 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from quilt_gui import params, settings
+from quilt_gui import params, project_io, settings
 from quilt_gui.commands import new_merge_id
-from quilt_gui.document import CandidateEntry, Document, Source
+from quilt_gui.document import Document
+from quilt_gui.model import CandidateEntry, Source
 
 
 def test_settings_typed_defaults_and_unknown_keys():
@@ -82,61 +83,73 @@ def test_slider_drag_is_one_undo_step(qtbot):
 def test_rect_drag_merges_and_is_clamped():
     doc = make_doc()
     mid = new_merge_id()
-    doc.set_template_rect((0, 0, 30, 30), merge_id=mid)
-    doc.set_template_rect((5, 5, 30, 30), merge_id=mid)
-    doc.set_template_rect((500, -3, 30, 30))  # footprint (rect + overlap) clamped into 80x64
+    doc.tileset.set_template_rect((0, 0, 30, 30), merge_id=mid)
+    doc.tileset.set_template_rect((5, 5, 30, 30), merge_id=mid)
+    doc.tileset.set_template_rect(
+        (500, -3, 30, 30)
+    )  # footprint (rect + overlap) clamped into 80x64
     ov = doc.params["overlap"]
-    assert doc.template_rect == (80 - ov - 30, 0, 30, 30)
+    assert doc.tileset.template_rect == (80 - ov - 30, 0, 30, 30)
     assert doc.undo_stack.count() == 2
     doc.undo_stack.undo()
-    assert doc.template_rect == (5, 5, 30, 30)
+    assert doc.tileset.template_rect == (5, 5, 30, 30)
     doc.undo_stack.undo()
-    assert doc.template_rect is None
+    assert doc.tileset.template_rect is None
 
 
 def test_picks_waypoints_candidates_undo(qtbot):
     doc = make_doc()
-    old = (list(doc.candidates), list(doc.picks))
+    old = (list(doc.tileset.candidates), list(doc.tileset.picks))
     for v in (0.1, 0.2, 0.3):
-        doc.append_candidate(entry(v))
-    doc.set_candidates(list(doc.candidates), [], text="Generate", old=old, already_applied=True)
-    assert len(doc.candidates) == 3 and doc.modified
-    doc.toggle_pick(2)
-    doc.toggle_pick(0)
-    assert doc.picks == [2, 0]
-    doc.toggle_pick(2)
-    assert doc.picks == [0]
-    doc.add_waypoint("horizontal", (3, 4))
-    doc.add_waypoint("horizontal", (3, 4))  # no duplicate step
-    doc.remove_waypoint("horizontal", (3, 4))
-    doc.set_locked(1, True)
-    assert doc.candidates[1].locked
+        doc.tileset.append_candidate(entry(v))
+    doc.tileset.set_candidates(
+        list(doc.tileset.candidates), [], text="Generate", old=old, already_applied=True
+    )
+    assert len(doc.tileset.candidates) == 3 and doc.modified
+    doc.tileset.toggle_pick(2)
+    doc.tileset.toggle_pick(0)
+    assert doc.tileset.picks == [2, 0]
+    doc.tileset.toggle_pick(2)
+    assert doc.tileset.picks == [0]
+    doc.tileset.add_waypoint("horizontal", (3, 4))
+    doc.tileset.add_waypoint("horizontal", (3, 4))  # no duplicate step
+    doc.tileset.remove_waypoint("horizontal", (3, 4))
+    doc.tileset.set_locked(1, True)
+    assert doc.tileset.candidates[1].locked
     n = doc.undo_stack.count()
     for _ in range(n):
         doc.undo_stack.undo()
-    assert doc.candidates == [] and doc.picks == [] and doc.waypoints["horizontal"] == []
+    assert (
+        doc.tileset.candidates == []
+        and doc.tileset.picks == []
+        and doc.tileset.waypoints["horizontal"] == []
+    )
     for _ in range(n):
         doc.undo_stack.redo()
-    assert len(doc.candidates) == 3 and doc.picks == [0] and doc.candidates[1].locked
+    assert (
+        len(doc.tileset.candidates) == 3
+        and doc.tileset.picks == [0]
+        and doc.tileset.candidates[1].locked
+    )
 
 
 def test_project_round_trip_of_document(tmp_path):
     from engine.project import load_project, save_project
 
     doc = make_doc()
-    doc.set_template_rect((4, 4, 8, 8))
+    doc.tileset.set_template_rect((4, 4, 8, 8))
     for v in (0.1, 0.2, 0.3):
-        doc.append_candidate(entry(v))
-    doc.set_picks([2, 1])
-    doc.apply_layout(np.array([[0, 1], [1, 0]]))
-    doc.add_waypoint("vertical", (1, 2))
+        doc.tileset.append_candidate(entry(v))
+    doc.tileset.set_picks([2, 1])
+    doc.tileset.apply_layout(np.array([[0, 1], [1, 0]]))
+    doc.tileset.add_waypoint("vertical", (1, 2))
     doc.set_param("overlap", 9)
-    path = save_project(tmp_path / "p.quiltproj", doc.to_project())
+    path = save_project(tmp_path / "p.quiltproj", project_io.to_project(doc))
     other = Document()
-    other.from_project(load_project(path), str(path))
-    assert other.template_rect == (4, 4, 8, 8)
-    assert other.picks == [2, 1] and other.params["overlap"] == 9
-    assert other.waypoints["vertical"] == [(1, 2)]
-    assert np.array_equal(other.layout, [[0, 1], [1, 0]])
-    assert np.allclose(other.candidates[2].tile, 0.3, atol=1 / 255)
+    project_io.apply_project(other, load_project(path), str(path))
+    assert other.tileset.template_rect == (4, 4, 8, 8)
+    assert other.tileset.picks == [2, 1] and other.params["overlap"] == 9
+    assert other.tileset.waypoints["vertical"] == [(1, 2)]
+    assert np.array_equal(other.tileset.layout, [[0, 1], [1, 0]])
+    assert np.allclose(other.tileset.candidates[2].tile, 0.3, atol=1 / 255)
     assert not other.modified and other.project_path == str(path)

@@ -17,13 +17,13 @@ def test_blocks_stream_in_and_a_click_inspects_one(qtbot):
     open_sample(qtbot, w)
     small(w)
     placed = []
-    w.doc.block_placed.connect(placed.append)
+    w.doc.quilting.block_placed.connect(placed.append)
     w.act_quilt.trigger()
     assert w.tabs.currentWidget() is w.quilt_view
     assert w.params_panel.groups["Quilting"].isVisible()
     assert not w.params_panel.groups["Template"].isVisible()
     wait_idle(qtbot, w)
-    res = w.doc.quilt_result
+    res = w.doc.quilting.result
     assert res is not None and res.image.shape[:2] == (128, 160)
     assert placed == list(range(len(res.blocks)))  # one event per block, in order
     assert np.array_equal(w.quilt_view.output.array, res.image)
@@ -34,7 +34,7 @@ def test_blocks_stream_in_and_a_click_inspects_one(qtbot):
     out.fit()
     pos = out.mapFromScene(QPointF(c + wd - 3.5, r + h - 3.5))
     qtbot.mouseClick(out.viewport(), Qt.MouseButton.LeftButton, pos=pos)
-    assert w.quilt_view.selected == w.doc.block_at(r + h - 4, c + wd - 4)
+    assert w.quilt_view.selected == w.doc.quilting.block_at(r + h - 4, c + wd - 4)
     sel = res.blocks[w.quilt_view.selected]
     assert w.quilt_view.inspector.frame_shape == tuple(sel.size)
     assert f"Block #{sel.index + 1}" in w.quilt_view.info.text()
@@ -52,15 +52,15 @@ def test_parameter_change_restarts_quilting_without_stale_blocks(qtbot):
     open_sample(qtbot, w)
     small(w, out_width=256, out_height=256)
     w.act_quilt.trigger()
-    qtbot.waitUntil(lambda: len(w.doc.quilt_blocks) >= 2, timeout=10_000)
+    qtbot.waitUntil(lambda: len(w.doc.quilting.blocks) >= 2, timeout=10_000)
     first = w.jobs.get("quilt")
     w.doc.set_param("block", 24)
     assert not first.alive
     wait_idle(qtbot, w)
-    res = w.doc.quilt_result
+    res = w.doc.quilting.result
     assert res.block == (24, 24)
-    assert all(max(b.size) <= 24 for b in w.doc.quilt_blocks)
-    assert np.array_equal(w.doc.quilt_output, res.image)
+    assert all(max(b.size) <= 24 for b in w.doc.quilting.blocks)
+    assert np.array_equal(w.doc.quilting.output, res.image)
 
 
 def test_excluded_colour_is_never_copied(qtbot):
@@ -80,7 +80,7 @@ def test_excluded_colour_is_never_copied(qtbot):
 
     mask = excluded_mask(src, w.doc.params["exclude_color"], w.doc.params["exclude_tolerance"])
     assert mask.any()
-    for b in w.doc.quilt_result.blocks:
+    for b in w.doc.quilting.result.blocks:
         x, y, bw, bh = b.source
         assert not mask[y : y + bh, x : x + bw].any()
     assert sample.array is src
@@ -95,15 +95,15 @@ def test_texture_transfer_streams_passes_and_follows_the_target(qtbot, tmp_path)
     target = np.where((xx - 64) ** 2 + (yy - 48) ** 2 < 30**2, 230, 25).astype(np.uint8)
     path = tmp_path / "disc.png"
     Image.fromarray(target).save(path)
-    with qtbot.waitSignal(w.doc.target_changed, timeout=5000):
-        w.load_target(str(path))
+    with qtbot.waitSignal(w.doc.quilting.target_changed, timeout=5000):
+        w.files.load_target(str(path))
     assert w.quilt_view.target.array.shape[:2] == (96, 128)
     w.doc.set_params({"block": 24, "iterations": 2})
     passes = []
-    w.doc.quilt_iteration.connect(passes.append)
+    w.doc.quilting.iteration_finished.connect(passes.append)
     w.act_transfer.trigger()
     wait_idle(qtbot, w)
-    res = w.doc.quilt_result
+    res = w.doc.quilting.result
     assert passes == [1, 2] and len(res.iterations) == 2
     assert res.image.shape[:2] == (96, 128)
     lum = res.image[:, :, :3].mean(axis=2)
@@ -113,10 +113,10 @@ def test_texture_transfer_streams_passes_and_follows_the_target(qtbot, tmp_path)
     assert "transfer passes" in w.quilt_view.counter.text()
     w.doc.set_param("alpha_ramp", False)  # a parameter change re-runs the transfer
     wait_idle(qtbot, w)
-    assert w.doc.quilt_result is not res and len(w.doc.quilt_result.iterations) == 2
-    w.doc.set_transfer_target(w.doc.source.main)  # 512 px: long enough to stop midway
+    assert w.doc.quilting.result is not res and len(w.doc.quilting.result.iterations) == 2
+    w.doc.quilting.set_target(w.doc.source.main)  # 512 px: long enough to stop midway
     w.doc.set_params({"iterations": 3, "block": 32})
-    running = lambda: w.jobs.get("quilt") is not None and len(w.doc.quilt_blocks) > 0  # noqa: E731
+    running = lambda: w.jobs.get("quilt") is not None and len(w.doc.quilting.blocks) > 0  # noqa: E731
     qtbot.waitUntil(running, timeout=10_000)
     w.act_cancel.trigger()
     wait_idle(qtbot, w)
@@ -142,7 +142,7 @@ def test_painted_exclusion_is_one_undo_step_and_never_copied(qtbot):
     assert w.quilt_view.excluded.isVisible()
     w.act_quilt.trigger()
     wait_idle(qtbot, w)
-    for blk in w.doc.quilt_result.blocks:
+    for blk in w.doc.quilting.result.blocks:
         x, y, bw, bh = blk.source
         assert not mask[y : y + bh, x : x + bw].any()
     w.doc.undo_stack.undo()

@@ -41,7 +41,7 @@ def test_shift_drag_on_the_source_paints_one_undoable_exclusion(qtbot, win):
     assert win.doc.undo_stack.count() == n0 + 1
     assert mask[220, 200] and mask[240, 300] and mask[230, 250] and not mask[100, 100]
     assert v.painter.overlay.isVisible() and win.quilt_view.excluded.isVisible()  # one mask
-    assert win.doc.template_rect is None  # painting did not draw a rectangle
+    assert win.doc.tileset.template_rect is None  # painting did not draw a rectangle
     # Shift+right-drag erases; Ctrl+Shift+click excludes the colour under the cursor
     qtbot.mousePress(v.viewport(), Qt.MouseButton.RightButton, shift, a)
     qtbot.mouseRelease(v.viewport(), Qt.MouseButton.RightButton, shift, a)
@@ -64,15 +64,15 @@ def test_template_search_and_candidates_avoid_the_excluded_pixels(qtbot, win):
     doc.set_params({"tile_min": 96, "tile_max": 128, "n_candidates": 6})
     win.act_find.trigger()
     wait_idle(qtbot, win)
-    first = doc.template_rect
+    first = doc.tileset.template_rect
     ov = doc.params["overlap"]
     painted = np.zeros(doc.source.shape, bool)
     painted[footprint(first, ov)] = True  # exactly where the best tile was
     doc.set_painted(painted)
     win.act_find.trigger()
     wait_idle(qtbot, win)
-    assert doc.template_rect != first
-    assert not painted[footprint(doc.template_rect, ov)].any()
+    assert doc.tileset.template_rect != first
+    assert not painted[footprint(doc.tileset.template_rect, ov)].any()
     # a colour range too: the candidates' patches avoid both
     src = doc.source.main
     row, col = np.unravel_index(np.argmin(src.sum(axis=2)), src.shape[:2])
@@ -81,13 +81,13 @@ def test_template_search_and_candidates_avoid_the_excluded_pixels(qtbot, win):
     assert mask.sum() > painted.sum()
     win.act_generate.trigger()
     wait_idle(qtbot, win)
-    assert len(doc.candidates) == 6
-    for e in doc.candidates:
+    assert len(doc.tileset.candidates) == 6
+    for e in doc.tileset.candidates:
         x, y, w, h = e.patch_rect
         assert not mask[y : y + h, x : x + w].any(), e.patch_rect
     win.reroll_candidate(2)
     wait_idle(qtbot, win)
-    x, y, w, h = doc.candidates[2].patch_rect
+    x, y, w, h = doc.tileset.candidates[2].patch_rect
     assert not mask[y : y + h, x : x + w].any()
     # dragging a patch onto the excluded region is refused with a message, not a crash
     win.pipeline.remake_candidate(0, origin=(first[1], first[0]))
@@ -102,10 +102,10 @@ def test_painted_exclusion_is_saved_in_the_project(qtbot, win, tmp_path):
     win.doc.set_painted(painted)
     template(qtbot, win)
     path = str(tmp_path / "p.quiltproj")
-    assert win.save_to(path, wait=True)
+    assert win.files.save_to(path, wait=True)
     w2 = make_window(qtbot)
     with qtbot.waitSignal(w2.doc.exclusion_changed, timeout=10_000):
-        w2.open_path(path, confirm=False)
+        w2.files.open_path(path, confirm=False)
     wait_idle(qtbot, w2)
     np.testing.assert_array_equal(w2.doc.exclude_painted, painted)
     assert w2.source_view.painter.overlay.isVisible()

@@ -23,7 +23,7 @@ def test_tile_set_workflow_open_to_reopen(qtbot, tmp_path):
     # -- find template: runs in the background, the rectangle is drawn where the search ended
     w.act_find.trigger()
     wait_idle(qtbot, w)
-    x, y, tw, th = doc.template_rect
+    x, y, tw, th = doc.tileset.template_rect
     p = doc.params
     assert p["tile_min"] <= tw <= p["tile_max"] and p["tile_min"] <= th <= p["tile_max"]
     assert w.source_view.rect_item.isVisible() and w.source_view.rect_item.rect == (x, y, tw, th)
@@ -34,7 +34,7 @@ def test_tile_set_workflow_open_to_reopen(qtbot, tmp_path):
     assert w.source_view.shades["R_R"].rect().getRect() == (x + tw, y, ov, th + ov)
 
     # -- seamless tile: error maps, seams and the wrapped 3x3 view
-    s = doc.seamless
+    s = doc.tileset.seamless
     assert s is not None and s.tile.shape[:2] == (th, tw)
     assert w.source_view.heat["horizontal"].isVisible()
     seam_pts = w.source_view.seams["horizontal"].points
@@ -52,10 +52,10 @@ def test_tile_set_workflow_open_to_reopen(qtbot, tmp_path):
     w.gallery.model().rowsInserted.connect(lambda *a: inserted.append(a[1]))
     w.act_generate.trigger()
     wait_idle(qtbot, w)
-    assert len(doc.candidates) == 30 and w.gallery.model().rowCount() == 30
+    assert len(doc.tileset.candidates) == 30 and w.gallery.model().rowCount() == 30
     assert len(inserted) == 30  # one row at a time, as they arrived
     m = doc.params["margin"]
-    for e in doc.candidates:  # every candidate keeps the template's border: they connect
+    for e in doc.tileset.candidates:  # every candidate keeps the template's border: they connect
         assert np.array_equal(e.tile[:m], s.tile[:m])
         assert np.array_equal(e.tile[:, -m:], s.tile[:, -m:])
     assert doc.undo_stack.undoText() == "Generate candidates"
@@ -65,32 +65,34 @@ def test_tile_set_workflow_open_to_reopen(qtbot, tmp_path):
     click_candidate(qtbot, w, 7)
     click_candidate(qtbot, w, 10)
     click_candidate(qtbot, w, 12, Qt.KeyboardModifier.ShiftModifier)
-    assert doc.picks == [2, 7, 10, 11, 12]
+    assert doc.tileset.picks == [2, 7, 10, 11, 12]
     model = w.gallery.model()
     from quilt_gui.widgets.gallery import PICK_ROLE
 
     assert [model.index(i).data(PICK_ROLE) for i in (2, 7, 10, 11, 12, 0)] == [1, 2, 3, 4, 5, 0]
     click_candidate(qtbot, w, 7)  # toggles off ...
-    assert doc.picks == [2, 10, 11, 12]
+    assert doc.tileset.picks == [2, 10, 11, 12]
     doc.undo_stack.undo()  # ... and undo brings it back
-    assert doc.picks == [2, 7, 10, 11, 12]
+    assert doc.tileset.picks == [2, 7, 10, 11, 12]
 
     # -- preview: the picked tiles assembled by the layout, with its grid score
     wait_idle(qtbot, w)
     w.tabs.setCurrentWidget(w.preview_view)
     rows, cols = doc.params["preview_rows"], doc.params["preview_cols"]
-    assert doc.layout.shape == (rows, cols) and set(np.unique(doc.layout)) <= set(range(5))
-    assert (doc.layout[:, 1:] != doc.layout[:, :-1]).all()  # no equal neighbours
-    assert doc.preview.shape[:2] == (rows * th, cols * tw)
-    cell = doc.layout[1, 2]
-    tile = doc.candidates[doc.picks[cell]].tile
-    assert np.array_equal(doc.preview[th : 2 * th, 2 * tw : 3 * tw], tile)
-    assert w.preview_view.canvas.array is doc.preview
-    assert "grid score" in w.preview_view.info.text() and doc.grid_score is not None
-    old_layout = doc.layout.copy()
+    assert doc.tileset.layout.shape == (rows, cols) and set(np.unique(doc.tileset.layout)) <= set(
+        range(5)
+    )
+    assert (doc.tileset.layout[:, 1:] != doc.tileset.layout[:, :-1]).all()  # no equal neighbours
+    assert doc.tileset.preview.shape[:2] == (rows * th, cols * tw)
+    cell = doc.tileset.layout[1, 2]
+    tile = doc.tileset.candidates[doc.tileset.picks[cell]].tile
+    assert np.array_equal(doc.tileset.preview[th : 2 * th, 2 * tw : 3 * tw], tile)
+    assert w.preview_view.canvas.array is doc.tileset.preview
+    assert "grid score" in w.preview_view.info.text() and doc.tileset.grid_score is not None
+    old_layout = doc.tileset.layout.copy()
     w.act_reroll_layout.trigger()
     wait_idle(qtbot, w)
-    assert not np.array_equal(doc.layout, old_layout)
+    assert not np.array_equal(doc.tileset.layout, old_layout)
 
     # -- export through the dialog, into tmp_path
     w.act_export.trigger()
@@ -106,14 +108,14 @@ def test_tile_set_workflow_open_to_reopen(qtbot, tmp_path):
     on_disk = json.loads((out / f"{doc.name}.json").read_text())
     assert on_disk["tiles"] == manifest["tiles"]
     layout = json.loads((out / f"{doc.name}_layout.json").read_text())
-    assert np.array_equal(layout["cells"], doc.layout)
+    assert np.array_equal(layout["cells"], doc.tileset.layout)
     assert any(out.glob("*.tsx")) and any(out.glob("*.tmx")) and any(out.glob("*.tres"))
     assert len(list(out.glob(f"{doc.name}_0*_albedo.png"))) == 5
     assert "Exported 5 tiles" in dlg.status.text()
 
     # -- save the project, then reopen it in a fresh window
     path = tmp_path / "session.quiltproj"
-    w.ask_save_path = lambda: str(path)
+    w.files.ask_save_path = lambda: str(path)
     with qtbot.waitSignal(doc.path_changed, timeout=20_000):
         w.act_save.trigger()
     assert not doc.modified and not w.isWindowModified()
@@ -122,15 +124,15 @@ def test_tile_set_workflow_open_to_reopen(qtbot, tmp_path):
 
     w2 = make_window(qtbot)
     with qtbot.waitSignal(w2.doc.path_changed, timeout=20_000):
-        w2.open_path(str(path), confirm=False)
+        w2.files.open_path(str(path), confirm=False)
     wait_idle(qtbot, w2)
-    d2 = w2.doc
-    assert d2.template_rect == doc.template_rect and d2.picks == doc.picks
-    assert np.array_equal(d2.layout, doc.layout)
+    d2 = w2.doc.tileset
+    assert d2.template_rect == doc.tileset.template_rect and d2.picks == doc.tileset.picks
+    assert np.array_equal(d2.layout, doc.tileset.layout)
     assert len(d2.candidates) == 30 and w2.gallery.model().rowCount() == 30
-    for a, b in zip(d2.candidates, doc.candidates, strict=True):
+    for a, b in zip(d2.candidates, doc.tileset.candidates, strict=True):
         assert np.abs(a.tile - b.tile).max() <= 0.5 / 255 + 1e-6  # 8-bit PNG in the project
-    assert d2.seamless is not None and d2.seamless.rect == doc.seamless.rect  # recomputed
-    assert w2.source_view.rect_item.rect == doc.template_rect
+    assert d2.seamless is not None and d2.seamless.rect == doc.tileset.seamless.rect  # recomputed
+    assert w2.source_view.rect_item.rect == doc.tileset.template_rect
     assert d2.preview is not None and "grid score" in w2.preview_view.info.text()
-    assert not d2.modified
+    assert not w2.doc.modified

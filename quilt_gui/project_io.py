@@ -1,0 +1,176 @@
+"""The document as a project file's :class:`engine.project.Project`, and back.
+
+:func:`to_project` reads every part of the document (the source, the parameters, the tile
+set's template, candidates, picks and layout, the painted exclusion); :func:`apply_project`
+replaces the whole document by a project (the undo history starts empty).
+"""
+
+from __future__ import annotations
+
+import base64
+import zlib
+
+import numpy as np
+
+from engine.project import Candidate, Project
+from quilt_gui import params
+from quilt_gui.model import WAYPOINT_KEYS, CandidateEntry, Source
+
+__all__ = ["apply_project", "to_project"]
+
+
+def to_project(doc) -> Project:
+    """``doc`` (a :class:`quilt_gui.document.Document`) as an engine Project."""
+    if doc.source is None:
+        raise ValueError("nothing to save: no source image is open")
+    ts = doc.tileset
+    names = list(doc.source.maps)
+    template = None
+    if ts.seamless is not None:
+        template = _tile_maps(ts.seamless, names)
+    cands = [
+        Candidate(
+            maps={m: e.maps[m] for m in names},
+            patch_origin=e.patch_origin,
+            seed=e.seed,
+            locked=e.locked,
+            score=e.score,
+            params={
+                "weight": e.weight,
+                "scores": dict(e.scores),
+                "patch_rect": list(e.patch_rect) if e.patch_rect else None,
+                "target_rect": list(e.target_rect) if e.target_rect else None,
+                "loop": None if e.loop is None else np.asarray(e.loop).tolist(),
+            },
+        )
+        for e in ts.candidates
+        if all(m in e.maps for m in names)
+    ]
+    layout = ts.layout
+    if layout is not None and (not ts.picks or layout.max(initial=-1) >= len(ts.picks)):
+        layout = None
+    preview = None
+    if ts.preview is not None and layout is not None:
+        preview = {names[0]: ts.preview}
+    return Project(
+        sources=dict(doc.source.maps),
+        name=doc.name,
+        source_paths=dict(doc.source.paths),
+        map_kinds=dict(doc.source.kinds),
+        map_weights={k: v for k, v in ts.map_weights.items() if k in doc.source.maps},
+        bit_depth=doc.source.bit_depth,
+        parameters=dict(doc.params),
+        seeds={"candidates": doc.params["seed"], "layout": doc.params["layout_seed"]},
+        template_rect=ts.template_rect,
+        template=template,
+        candidates=cands,
+        picks=list(ts.picks),
+        layout=layout,
+        waypoints={k: [tuple(p) for p in v] for k, v in ts.waypoints.items()},
+        preview=preview,
+        extra={"editor": "quilt-studio", **_painted_extra(doc.exclude_painted)},
+    )
+
+
+def apply_project(doc, project: Project, path: str | None) -> None:
+    """Replace the whole of ``doc`` by ``project`` (clears the undo history)."""
+    source = Source(
+        maps=dict(project.sources),
+        paths=dict(project.source_paths),
+        bit_depth=project.bit_depth,
+        kinds=dict(project.map_kinds),
+    )
+    doc.set_source(source, name=project.name)
+    doc.params = params.coerce_all(project.parameters)
+    ts = doc.tileset
+    ts.template_rect = (
+        None if project.template_rect is None else tuple(int(v) for v in project.template_rect)
+    )
+    ts.waypoints = {k: [tuple(p) for p in project.waypoints.get(k, [])] for k in WAYPOINT_KEYS}
+    ts.map_weights = {k: float(v) for k, v in project.map_weights.items()}
+    ts.candidates = [
+        CandidateEntry(
+            maps=dict(c.maps),
+            patch_origin=c.patch_origin,
+            patch_rect=_rect(c.params.get("patch_rect")),
+            target_rect=_rect(c.params.get("target_rect")),
+            loop=_points(c.params.get("loop")),
+            seed=c.seed,
+            score=c.score,
+            scores=dict(c.params.get("scores") or {}),
+            locked=c.locked,
+            weight=float(c.params.get("weight", 1.0)),
+        )
+        for c in project.candidates
+    ]
+    ts.picks = list(project.picks)
+    ts.layout = None if project.layout is None else np.asarray(project.layout)
+    if project.preview is not None:
+        ts.preview = next(iter(project.preview.values()))
+    doc.project_path = path
+    doc.apply_painted(_painted_from_extra(project.extra, source.shape))
+    doc.params_changed.emit(frozenset(doc.params))
+    ts.emit_all()
+    doc.path_changed.emit()
+    doc.mark_saved()
+
+
+PAINTED_KEY = "exclude_painted"
+
+
+def _painted_extra(mask: np.ndarray | None) -> dict:
+    """The painted exclusion as JSON for ``Project.extra`` (the project format has no field
+    for it): shape and the bit-packed, zlib-compressed mask in base64."""
+    if mask is None or not mask.any():
+        return {}
+    packed = zlib.compress(np.packbits(np.asarray(mask, bool)).tobytes(), 9)
+    return {
+        PAINTED_KEY: {
+            "shape": list(mask.shape),
+            "packbits_zlib_base64": base64.b64encode(packed).decode("ascii"),
+        }
+    }
+
+
+def _painted_from_extra(extra: dict, shape: tuple[int, int]) -> np.ndarray | None:
+    """The painted exclusion saved by :func:`_painted_extra`; None if absent or not a mask of
+    the source's ``shape`` (a damaged entry is dropped, the rest of the project opens)."""
+    entry = extra.get(PAINTED_KEY) if isinstance(extra, dict) else None
+    if not isinstance(entry, dict) or entry.get("shape") != list(shape):
+        return None
+    n = int(shape[0]) * int(shape[1])
+    try:
+        raw = base64.b64decode(entry["packbits_zlib_base64"], validate=True)
+        bits = zlib.decompressobj().decompress(raw, (n + 7) // 8 + 1)
+    except (KeyError, TypeError, ValueError, zlib.error):
+        return None
+    if len(bits) != (n + 7) // 8:
+        return None
+    mask = np.unpackbits(np.frombuffer(bits, np.uint8), count=n).astype(bool).reshape(shape)
+    return mask if mask.any() else None
+
+
+def _rect(value) -> tuple[int, int, int, int] | None:
+    """An (x, y, w, h) rectangle read from a project's JSON, None if it is not one."""
+    if isinstance(value, list) and len(value) == 4 and all(isinstance(v, int) for v in value):
+        return tuple(value)
+    return None
+
+
+def _points(value) -> np.ndarray | None:
+    """(N, 2) int (row, col) points read from a project's JSON, None if they are not."""
+    try:
+        a = np.asarray(value, dtype=np.int64)
+    except (TypeError, ValueError):
+        return None
+    return a if a.ndim == 2 and a.shape[1] == 2 and len(a) else None
+
+
+def _tile_maps(seamless, names: list[str]) -> dict[str, np.ndarray] | None:
+    """Per-map template tiles of an engine SeamlessTile: the main map is ``tile``, the
+    material maps are in ``maps``; None if a map is missing (a result from before it was
+    attached)."""
+    maps = {names[0]: seamless.tile, **dict(seamless.maps or {})}
+    if not all(m in maps for m in names):
+        return None
+    return {m: maps[m] for m in names}

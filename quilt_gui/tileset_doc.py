@@ -1,0 +1,291 @@
+"""The tile-set workflow's part of the document: template rectangle, waypoints, seamless
+tile, candidates, picks, preview layout, and the material maps' seam weights.
+
+User edits push :mod:`quilt_gui.commands` on :attr:`TileSetDocument.undo_stack`; their
+``redo``/``undo`` call the ``apply_*`` methods. Results streamed by jobs (the template
+search's moving rectangle, candidates arriving one by one) are applied directly and are not
+undo steps; a finished job pushes one command for its final result.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+from PySide6.QtCore import QObject, Signal
+
+from quilt_gui import commands
+from quilt_gui.model import WAYPOINT_KEYS, CandidateEntry
+
+
+class TileSetDocument(QObject):
+    """Template, seamless tile, candidates, picks, layout, waypoints of ``root``'s source.
+
+    ``root`` is the :class:`quilt_gui.document.Document` (source, parameters, undo).
+    """
+
+    map_weights_changed = Signal()
+    template_changed = Signal()  # template rectangle
+    waypoints_changed = Signal()
+    seamless_changed = Signal()
+    candidates_reset = Signal()
+    candidate_inserted = Signal(int)  # row
+    candidate_changed = Signal(int)  # row
+    picks_changed = Signal()
+    layout_changed = Signal()
+    preview_changed = Signal()
+
+    def __init__(self, root, undo_stack) -> None:
+        super().__init__(root)
+        self.root = root
+        self.undo_stack = undo_stack
+        self.template_rect: tuple[int, int, int, int] | None = None
+        self.waypoints: dict[str, list[tuple[int, int]]] = {k: [] for k in WAYPOINT_KEYS}
+        self.map_weights: dict[str, float] = {}  # seam-error weight per map; {} = main only
+        self.seamless = None  # engine SeamlessTile (derived)
+        self.candidates: list[CandidateEntry] = []
+        self.picks: list[int] = []
+        self.layout: np.ndarray | None = None
+        self.preview: np.ndarray | None = None  # derived
+        self.grid_score: float | None = None
+
+    def clear(self) -> None:
+        """Forget every result (a new source); emits every signal."""
+        self.template_rect = None
+        self.waypoints = {k: [] for k in WAYPOINT_KEYS}
+        self.map_weights = {}
+        self.seamless = None
+        self.candidates, self.picks, self.layout = [], [], None
+        self.preview, self.grid_score = None, None
+        self.emit_all()
+
+    def emit_all(self) -> None:
+        """Every view redraws (after a whole-document change)."""
+        for signal in (
+            self.template_changed,
+            self.waypoints_changed,
+            self.map_weights_changed,
+            self.seamless_changed,
+            self.candidates_reset,
+            self.picks_changed,
+            self.layout_changed,
+            self.preview_changed,
+        ):
+            signal.emit()
+
+    # ------------------------------------------------------------------ state
+    def picked_entries(self) -> list[CandidateEntry]:
+        return [self.candidates[i] for i in self.picks]
+
+    def connects_to_template(self, entry: CandidateEntry) -> bool:
+        """True when ``entry`` was made from the current seamless template (same size and
+        outer margin), i.e. it connects to tiles made from it."""
+        if self.seamless is None:
+            return False
+        template = np.asarray(self.seamless.tile)
+        tile, m = np.asarray(entry.tile), max(1, int(self.root.params["margin"]))
+        return tile.shape == template.shape and bool(
+            np.array_equal(tile[:m], template[:m])
+            and np.array_equal(tile[-m:], template[-m:])
+            and np.array_equal(tile[:, :m], template[:, :m])
+            and np.array_equal(tile[:, -m:], template[:, -m:])
+        )
+
+    @property
+    def candidates_outdated(self) -> bool:
+        """The candidates were made from an earlier template (they still connect to each
+        other, not to tiles of the current one)."""
+        return (
+            bool(self.candidates)
+            and self.seamless is not None
+            and not (self.connects_to_template(self.candidates[0]))
+        )
+
+    def clamp_rect(self, rect) -> tuple[int, int, int, int]:
+        """``rect`` (x, y, w, h) moved and shrunk so its footprint (the rectangle plus the
+        overlap to the right and below) lies inside the source."""
+        x, y, w, h = (int(round(v)) for v in rect)
+        source = self.root.source
+        if source is None:
+            return x, y, max(1, w), max(1, h)
+        H, W = source.shape
+        e = min(int(self.root.params["overlap"]), max(0, min(H, W) - 1))
+        w, h = max(1, min(w, W - e)), max(1, min(h, H - e))
+        x, y = min(max(0, x), W - e - w), min(max(0, y), H - e - h)
+        return x, y, w, h
+
+    # ------------------------------------------------------------------ user edits (undoable)
+    def set_template_rect(
+        self, rect, *, merge_id: int | None = None, text: str = "Move tile rectangle"
+    ) -> None:
+        rect = self.clamp_rect(rect)
+        if rect == self.template_rect:
+            return
+        self.undo_stack.push(commands.SetTemplateRect(self, rect, merge_id=merge_id, text=text))
+
+    def commit_template_rect(self, old, *, text: str = "Find best tile") -> None:
+        """One undo step for a rectangle the template search already streamed in."""
+        if old != self.template_rect:
+            self.undo_stack.push(
+                commands.SetTemplateRect(
+                    self, self.template_rect, text=text, old=old, already_applied=True
+                )
+            )
+
+    def add_waypoint(self, key: str, point: tuple[int, int]) -> None:
+        pt = (int(point[0]), int(point[1]))
+        if pt in self.waypoints[key]:
+            return
+        new = {**self.waypoints, key: [*self.waypoints[key], pt]}
+        self.undo_stack.push(commands.SetWaypoints(self, new, "Add waypoint"))
+
+    def remove_waypoint(self, key: str, point: tuple[int, int]) -> None:
+        new = {**self.waypoints, key: [p for p in self.waypoints[key] if p != tuple(point)]}
+        if new[key] != self.waypoints[key]:
+            self.undo_stack.push(commands.SetWaypoints(self, new, "Remove waypoint"))
+
+    def clear_waypoints(self) -> None:
+        if any(self.waypoints.values()):
+            new = {k: [] for k in WAYPOINT_KEYS}
+            self.undo_stack.push(commands.SetWaypoints(self, new, "Clear waypoints"))
+
+    def set_picks(self, picks, *, text: str = "Pick tiles") -> commands.SetPicks | None:
+        """Pick these candidates (in this order); returns the undo step, None if unchanged."""
+        picks = [int(i) for i in dict.fromkeys(picks) if 0 <= int(i) < len(self.candidates)]
+        if picks == self.picks:
+            return None
+        command = commands.SetPicks(self, picks, text)
+        self.undo_stack.push(command)
+        return command
+
+    def toggle_pick(self, index: int) -> commands.SetPicks | None:
+        if index in self.picks:
+            return self.set_picks([i for i in self.picks if i != index], text="Unpick tile")
+        return self.set_picks([*self.picks, index], text="Pick tile")
+
+    def retract(self, command) -> bool:
+        """Undo ``command`` and drop it from the history if it is the newest step.
+
+        For a click that turns out to be the first half of a double-click: the double-click
+        leaves neither the pick nor an undo (or redo) step behind.
+        """
+        st = self.undo_stack
+        n = st.count()
+        if command is None or not n or st.index() != n or st.command(n - 1) is not command:
+            return False
+        command.undo()
+        command.setObsolete(True)  # QUndoStack.undo() deletes an obsolete command unapplied
+        st.undo()
+        return True
+
+    def set_candidates(
+        self,
+        entries: list[CandidateEntry],
+        picks: list[int],
+        *,
+        text: str,
+        old=None,
+        already_applied: bool = False,
+    ) -> None:
+        """Replace all candidates and picks (one undo step); ``already_applied`` when the
+        entries streamed in already and ``old`` is the (candidates, picks) before that."""
+        self.undo_stack.push(
+            commands.SetCandidates(
+                self, entries, picks, text, old=old, already_applied=already_applied
+            )
+        )
+
+    def replace_candidate(self, index: int, entry: CandidateEntry, *, text: str) -> None:
+        self.undo_stack.push(commands.ReplaceCandidate(self, index, entry, text))
+
+    def set_locked(self, index: int, locked: bool) -> None:
+        entry = self.candidates[index]
+        if entry.locked != locked:
+            self.replace_candidate(
+                index, replace(entry, locked=locked), text="Lock tile" if locked else "Unlock tile"
+            )
+
+    def set_weight(self, index: int, weight: float) -> None:
+        entry = self.candidates[index]
+        if entry.weight != weight:
+            self.replace_candidate(
+                index, replace(entry, weight=float(weight)), text="Change tile weight"
+            )
+
+    def set_map_weight(self, name: str, weight: float) -> None:
+        """How much map ``name`` counts in the seam error (main map 1, others 0 by default)."""
+        source = self.root.source
+        if source is None or name not in source.maps:
+            raise ValueError(f"no material map named {name!r}")
+        weight = max(0.0, float(weight))
+        if self.map_weight(name) == weight:
+            return
+        new = {**self.map_weights, name: weight}
+        self.undo_stack.push(commands.SetMapWeights(self, new, f"Seam weight of {name}"))
+
+    def map_weight(self, name: str) -> float:
+        source = self.root.source
+        default = 1.0 if source is not None and name == source.main_name else 0.0
+        return float(self.map_weights.get(name, default))
+
+    def engine_weights(self) -> dict[str, float] | None:
+        """The ``weights`` of the engine's seam calls ("main" is the source), None when only
+        the main map counts (the engine's default)."""
+        source = self.root.source
+        if source is None:
+            return None
+        names = list(source.maps)
+        w = {("main" if n == names[0] else n): self.map_weight(n) for n in names}
+        if w["main"] == 1.0 and not any(v for k, v in w.items() if k != "main"):
+            return None
+        return w
+
+    # ------------------------------------------------------------------ apply (commands, jobs)
+    def apply_template_rect(self, rect) -> None:
+        self.template_rect = None if rect is None else tuple(int(v) for v in rect)
+        self.template_changed.emit()
+
+    def apply_waypoints(self, waypoints: dict) -> None:
+        self.waypoints = {k: list(waypoints.get(k, [])) for k in WAYPOINT_KEYS}
+        self.waypoints_changed.emit()
+
+    def apply_map_weights(self, weights: dict) -> None:
+        self.map_weights = {k: float(v) for k, v in weights.items()}
+        self.map_weights_changed.emit()
+
+    def apply_picks(self, picks: list[int]) -> None:
+        self.picks = list(picks)
+        self.picks_changed.emit()
+
+    def apply_candidates(
+        self, entries: list[CandidateEntry], picks: list[int] | None = None
+    ) -> None:
+        self.candidates = list(entries)
+        self.picks = [i for i in (picks if picks is not None else []) if i < len(entries)]
+        self.candidates_reset.emit()
+        self.picks_changed.emit()
+
+    def append_candidate(self, entry: CandidateEntry) -> int:
+        """Add a streamed candidate (not an undo step; the finished job pushes one)."""
+        self.candidates.append(entry)
+        row = len(self.candidates) - 1
+        self.candidate_inserted.emit(row)
+        self.root.mark_dirty()
+        return row
+
+    def apply_candidate(self, index: int, entry: CandidateEntry) -> None:
+        self.candidates[index] = entry
+        self.candidate_changed.emit(index)
+
+    def apply_layout(self, layout) -> None:
+        self.layout = None if layout is None else np.asarray(layout, dtype=np.int64)
+        self.layout_changed.emit()
+
+    def apply_seamless(self, result) -> None:
+        self.seamless = result
+        self.seamless_changed.emit()
+
+    def apply_preview(self, image: np.ndarray | None, grid_score: float | None) -> None:
+        self.preview = image
+        self.grid_score = grid_score
+        self.preview_changed.emit()
