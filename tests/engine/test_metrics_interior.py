@@ -5,6 +5,7 @@ import pytest
 from scipy import ndimage
 
 from engine.metrics import (
+    _harmonic_spectra,
     duplicates,
     edge_distance,
     frame,
@@ -14,7 +15,6 @@ from engine.metrics import (
     ring_tone,
     template_share,
 )
-from engine.metrics import _harmonic_spectra
 
 
 @pytest.fixture(scope="module")
