@@ -28,11 +28,11 @@ from scipy import ndimage
 if __package__ in (None, ""):  # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-import engine.seams as seams  # noqa: E402
+import engine.seams.search as seam_search  # noqa: E402
 import resources  # noqa: E402
 from benchmarks._util import format_table, median_time  # noqa: E402
 from engine.events import drain  # noqa: E402
-from engine.seams import find_seam, iter_find_seam, warmup  # noqa: E402
+from engine.seams import SeamSpec, find_seam, iter_find_seam, warmup  # noqa: E402
 
 SIZES = ((32, 6), (256, 16), (512, 64), (2048, 128))
 
@@ -214,17 +214,17 @@ def random_overlaps(n_per_sample=8, h=64, w=16, seed=0) -> list[Overlap]:
 @contextmanager
 def recording_oscillating(store: list):
     """Record (as :class:`Overlap`) every map the oscillating search is run on meanwhile."""
-    original = seams.iter_oscillating
+    original = seam_search.iter_oscillating
 
     def record(error, pins, **kw):
         store.append(Overlap(error.copy(), pins.copy(), kw["cyclic"]))
         return original(error, pins, **kw)
 
-    seams.iter_oscillating = record
+    seam_search.iter_oscillating = record
     try:
         yield store
     finally:
-        seams.iter_oscillating = original
+        seam_search.iter_oscillating = original
 
 
 def product_overlaps(names=None, *, quilting=True) -> dict[str, list[Overlap]]:
@@ -242,9 +242,9 @@ def product_overlaps(names=None, *, quilting=True) -> dict[str, list[Overlap]]:
         short = min(S.shape[:2])
         template = find_template(S, tile_min=short // 4, tile_max=short // 2)
         with recording_oscillating(sets["template"]):
-            tile = make_seamless(S, template, method="oscillating")
+            tile = make_seamless(S, template, seam=SeamSpec("oscillating"))
         with recording_oscillating(sets["patch ring"]):
-            candidates(S, tile, 4, method="oscillating", rng=0, workers=1)
+            candidates(S, tile, 4, seam=SeamSpec("oscillating", blend="adaptive"), rng=0, workers=1)
         if quilting:
             with recording_oscillating(sets["quilting"]):
                 quilt(S, (192, 192), block=48, seam="oscillating", rng=0, threads=1)

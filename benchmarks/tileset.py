@@ -462,12 +462,11 @@ def stage_scaling(S: np.ndarray, tile: int, seed: int, calls: int = 20) -> list:
     from concurrent.futures import ThreadPoolExecutor
 
     from engine.materials import apply_cut
-    from engine.stitch import patch_cut
+    from engine.stitch import PATCH_SEAM, patch_cut
     from engine.tiles.candidates import _Setup
     from engine.tiles.seamless import MAIN, seam_error
 
     st = make_seamless(S, find_template(S, tile_min=tile, tile_max=tile))
-    opts = dict(method="dp", metric="euclid", blend="adaptive", width=4, rho=3)
     setup = _Setup(
         S,
         st,
@@ -478,19 +477,18 @@ def stage_scaling(S: np.ndarray, tile: int, seed: int, calls: int = 20) -> list:
         excluded=None,
         maps=None,
         weights=None,
-        seam_options={},
-        **opts,
+        seam=PATCH_SEAM,
     )
     origin = setup.random_origin(np.random.default_rng(seed))
     (sy, sx), _ = setup.refine(origin, setup.n)
     Q = {k: v[sy : sy + setup.ph, sx : sx + setup.pw] for k, v in setup.stack.items()}
     err = seam_error(Q, setup.U, None, "euclid")
-    cut = patch_cut(Q[MAIN], setup.U[MAIN], ring=setup.ring, margin=2, error=err, **opts)
+    cut = patch_cut(Q[MAIN], setup.U[MAIN], ring=setup.ring, margin=2, error=err)
     stages = {
         "position refinement (numba)": lambda: setup.refine(origin, setup.n),
         "seam error map": lambda: seam_error(Q, setup.U, None, "euclid"),
         "patch_cut (4 seams, EDT ramp)": lambda: patch_cut(
-            Q[MAIN], setup.U[MAIN], ring=setup.ring, margin=2, error=err, **opts
+            Q[MAIN], setup.U[MAIN], ring=setup.ring, margin=2, error=err
         ),
         "apply_cut": lambda: apply_cut(Q, setup.U, cut.alpha),
         "whole candidate": lambda: setup.make(0, None, origin, setup.n, None),

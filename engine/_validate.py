@@ -1,12 +1,17 @@
-"""Eager input validation and conversion helpers shared by the engine."""
+"""Eager input validation and conversion helpers shared by the engine.
+
+The scalar checks (``positive_int``, ``non_negative_number``, ``choice``) live in
+:mod:`engine._checks` (no numpy) and are re-exported here.
+"""
 
 from __future__ import annotations
 
-import math
 import numbers
 
 import numpy as np
 from skimage.util import img_as_float32
+
+from engine._checks import choice, non_negative_number, positive_int
 
 
 def as_rng(rng: int | np.random.Generator | None) -> np.random.Generator:
@@ -59,24 +64,11 @@ def as_error_map(error, name: str = "error") -> np.ndarray:
     return e
 
 
-def positive_int(value, name: str, *, minimum: int = 1) -> int:
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-        raise TypeError(f"{name} must be an integer, got {value!r}")
-    if value < minimum:
-        raise ValueError(f"{name} must be >= {minimum}, got {value}")
-    return int(value)
-
-
-def non_negative_number(value, name: str) -> float:
-    """A finite real number >= 0 (not a bool) as float."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise TypeError(f"{name} must be a number, got {value!r}")
-    if not (math.isfinite(value) and value >= 0):
-        raise ValueError(f"{name} must be a finite number >= 0, got {value}")
-    return float(value)
-
-
-def choice(value: str, name: str, options) -> str:
-    if value not in options:
-        raise ValueError(f"{name} must be one of {', '.join(map(repr, options))}, got {value!r}")
-    return value
+__all__ = [
+    "as_error_map",
+    "as_image",
+    "as_rng",
+    "choice",
+    "non_negative_number",
+    "positive_int",
+]

@@ -35,8 +35,7 @@ from scipy import ndimage
 from skimage.util import img_as_float32
 
 from engine._validate import as_error_map, choice, positive_int
-
-BLEND_MODES = ("none", "feather", "adaptive")
+from engine.seams.spec import BLEND_MODES
 
 __all__ = [
     "BLEND_MODES",

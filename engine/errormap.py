@@ -17,8 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from engine._validate import as_image, choice
-
-METRICS = ("euclid", "ssd", "lab")
+from engine.seams.spec import METRICS
 
 __all__ = ["METRICS", "colour_channels", "error_map"]
 

@@ -27,9 +27,7 @@ from scipy import ndimage
 
 from engine._validate import as_error_map, as_image, choice, positive_int
 from engine.blend import (
-    BLEND_MODES,
     adaptive_half_widths,
-    blend_weights,
     clamped_half_widths,
     composite,
     cut_columns,
@@ -37,16 +35,21 @@ from engine.blend import (
 )
 from engine.cancel import check
 from engine.errormap import error_map
-from engine.seams import _MINIMAX_METRIC, METHODS, Seam, find_seam, graph_path
-from engine.seams import OPTIONS as SEAM_OPTIONS
+from engine.seams._result import Seam
+from engine.seams.graph import graph_path
+from engine.seams.search import MINIMAX_METRIC
+from engine.seams.spec import SeamSpec, as_seam_spec
 
 ORIENTATIONS = ("right", "left", "bottom", "top")
 GRAPH_METHODS = ("dijkstra", "minimax")
+#: the default cut of :func:`patch_cut`: dp with adaptive blending (Somol & Haindl)
+PATCH_SEAM = SeamSpec(blend="adaptive")
 
 __all__ = [
     "GRAPH_METHODS",
     "LCut",
     "ORIENTATIONS",
+    "PATCH_SEAM",
     "PatchCut",
     "PatchResult",
     "StitchResult",
@@ -116,22 +119,6 @@ def _given_error(error, shape, name: str = "error") -> np.ndarray:
     return e.astype(np.float32)
 
 
-def _seam_kwargs(start, end, waypoints, cyclic, cancel) -> dict:
-    """Only the constraints that are set (methods without them keep working)."""
-    kw = {}
-    if start is not None:
-        kw["start"] = start
-    if end is not None:
-        kw["end"] = end
-    if len(waypoints):
-        kw["waypoints"] = waypoints
-    if cyclic:
-        kw["cyclic"] = True
-    if cancel is not None:
-        kw["cancel"] = cancel
-    return kw
-
-
 # ----------------------------------------------------------------------------- stitch
 @dataclass(frozen=True)
 class StitchResult:
@@ -182,18 +169,13 @@ def stitch(
     r2,
     *,
     orientation: str = "right",
-    method: str = "dp",
-    metric: str = "euclid",
-    blend: str = "none",
-    width: float = 4,
-    rho: int = 3,
+    seam: SeamSpec | None = None,
     start: int | None = None,
     end: int | None = None,
     waypoints=(),
     cyclic: bool = False,
     error=None,
     cancel=None,
-    **seam_options,
 ) -> StitchResult:
     """Stitch two equally sized overlap regions along a minimum-error seam (§1.4).
 
@@ -203,12 +185,9 @@ def stitch(
         R1 (kept on its side, see the module docstring) and R2.
     orientation : {"right", "left", "bottom", "top"}
         Where R2 lies relative to R1.
-    method, **seam_options
-        Seam method and its options (:func:`engine.seams.find_seam`).
-    metric : {"euclid", "ssd", "lab"}
-        Error metric (:func:`engine.errormap.error_map`); ignored when ``error`` is given.
-    blend, width, rho
-        Blending after the cut (:func:`engine.blend.blend_weights`).
+    seam : SeamSpec, optional
+        Seam method and options, the error metric (ignored when ``error`` is given) and the
+        blending after the cut; default ``SeamSpec()`` (dp, euclid, hard cut).
     start, end : int, optional
         Column of the first / last row of the path in the canonical orientation.
     waypoints : iterable of (row, col)
@@ -222,8 +201,8 @@ def stitch(
     """
     a, b = _pair(r1, r2)
     choice(orientation, "orientation", ORIENTATIONS)
-    choice(blend, "blend", BLEND_MODES)
-    err = error_map(a, b, metric=metric) if error is None else _given_error(error, a.shape[:2])
+    spec = as_seam_spec(seam)
+    err = error_map(a, b, metric=spec.metric) if error is None else _given_error(error, a.shape[:2])
     ce = np.ascontiguousarray(to_canonical(err, orientation))
     wps = ()
     if len(waypoints):
@@ -232,15 +211,14 @@ def stitch(
         except (TypeError, ValueError):
             raise ValueError(f"waypoints must be (row, col) pairs, got {waypoints!r}") from None
         wps = [tuple(p) for p in map_points(wp, orientation, err.shape).tolist()]
-    kw = _seam_kwargs(start, end, wps, cyclic, cancel)
-    seam = find_seam(ce, method=method, **kw, **seam_options)
-    alpha_c = blend_weights(seam, ce, mode=blend, width=width, rho=rho, cyclic=bool(cyclic))
+    found = spec.find(ce, start=start, end=end, waypoints=wps, cyclic=cyclic, cancel=cancel)
+    alpha_c = spec.blend_weights(found, ce, cyclic=bool(cyclic))
     alpha = np.ascontiguousarray(from_canonical(alpha_c, orientation))
-    mask = np.ascontiguousarray(from_canonical(np.asarray(seam.mask), orientation))
-    path = map_points(np.asarray(seam.path), orientation, err.shape, inverse=True)
+    mask = np.ascontiguousarray(from_canonical(np.asarray(found.mask), orientation))
+    path = map_points(np.asarray(found.path), orientation, err.shape, inverse=True)
     image = composite(alpha, a, b)
     _frozen(image, err, path, mask, alpha)
-    return StitchResult(image, err, seam, path, mask, alpha, orientation)
+    return StitchResult(image, err, found, path, mask, alpha, orientation)
 
 
 # ----------------------------------------------------------------------------- L-shaped cut
@@ -401,16 +379,15 @@ def _dp_l_cut(e, ovl, ovt):  # pragma: no cover - compiled
     return path[:n].copy(), _old_side_of_barrier(barrier, True, True), qr, qc
 
 
-def _strip_path(strip: np.ndarray, method: str, start, cancel, options) -> np.ndarray:
-    """Top-to-bottom path through a vertical strip with ``method`` (dp inline for speed)."""
+def _strip_path(strip: np.ndarray, spec: SeamSpec, start, cancel) -> np.ndarray:
+    """Top-to-bottom path through a vertical strip with ``spec`` (dp inline for speed)."""
     strip = np.ascontiguousarray(strip)
-    if method == "dp":
+    if spec.method == "dp":
         cost, step = _dp_to_bottom(strip)
         c0 = int(np.argmin(cost[0])) if start is None else start
         cols = _trace_down(step, 0, c0)
         return np.column_stack([np.arange(strip.shape[0]), cols])
-    kw = _seam_kwargs(start, None, (), False, cancel)
-    return np.asarray(find_seam(strip, method=method, **kw, **options).path)
+    return np.asarray(spec.find(strip, start=start, cancel=cancel).path)
 
 
 def l_cut(
@@ -418,9 +395,8 @@ def l_cut(
     *,
     overlap_left: int,
     overlap_top: int,
-    method: str = "dp",
+    seam: SeamSpec | None = None,
     cancel=None,
-    **seam_options,
 ) -> LCut:
     """Minimum error boundary cut of a block against its left and top overlaps (§2.3).
 
@@ -432,8 +408,8 @@ def l_cut(
         read.
     overlap_left, overlap_top : int
         Overlap widths; one of them may be 0 (a single strip: first row / column of blocks).
-    method : str
-        A seam method (:data:`engine.seams.METHODS`).
+    seam : SeamSpec, optional
+        The seam method and its options (default dp; metric and blend are the caller's).
 
         * ``dp``: the vertical strip is solved bottom-up and the horizontal strip right-to-left;
           the arms join at the corner pixel q of lowest combined cost
@@ -462,26 +438,24 @@ def l_cut(
         raise ValueError(f"overlap_left must be <= the block width {bw}, got {ovl}")
     if ovt > bh:
         raise ValueError(f"overlap_top must be <= the block height {bh}, got {ovt}")
-    choice(method, "method", METHODS)
-    unknown = sorted(set(seam_options) - set(SEAM_OPTIONS[method]))
-    if unknown:
-        raise TypeError(f"unexpected option(s) for method {method!r}: {', '.join(unknown)}")
+    spec = as_seam_spec(seam)
+    method = spec.method
     check(cancel)
     meeting = mask = None
     if ovt == 0:
-        path = _strip_path(e[:, :ovl], method, None, cancel, seam_options)[::-1]
+        path = _strip_path(e[:, :ovl], spec, None, cancel)[::-1]
     elif ovl == 0:
-        path = _strip_path(e[:ovt].T, method, None, cancel, seam_options)[:, ::-1]
+        path = _strip_path(e[:ovt].T, spec, None, cancel)[:, ::-1]
     elif method in GRAPH_METHODS:
-        path = _graph_l_path(e, ovl, ovt, method, cancel, seam_options)
+        path = _graph_l_path(e, ovl, ovt, spec, cancel)
     elif method == "dp":
         path, mask, qr, qc = _dp_l_cut(e, ovl, ovt)
         meeting = (int(qr), int(qc))
     else:
         qr, qc, _, _ = _dp_meeting(e, ovl, ovt)
         meeting = (int(qr), int(qc))
-        down = _strip_path(e[qr:, :ovl], method, qc, cancel, seam_options) + (qr, 0)
-        right = _strip_path(e[:ovt, qc:].T, method, qr, cancel, seam_options)
+        down = _strip_path(e[qr:, :ovl], spec, qc, cancel) + (qr, 0)
+        right = _strip_path(e[:ovt, qc:].T, spec, qr, cancel)
         path = _unique_in_order(np.concatenate([down[::-1], right[:, ::-1] + (0, qc)]))
     if mask is None:
         path = np.ascontiguousarray(path, dtype=np.intp)
@@ -491,12 +465,11 @@ def l_cut(
     return LCut(mask, path, float(values.sum()), float(values.max()), meeting)
 
 
-def _graph_l_path(e, ovl, ovt, method, cancel, options) -> np.ndarray:
-    opts = dict(options)
+def _graph_l_path(e, ovl, ovt, spec: SeamSpec, cancel) -> np.ndarray:
+    opts = dict(spec.options)
     metric = "sum"
-    if method == "minimax":
-        variant = choice(opts.pop("variant", "exact"), "variant", tuple(_MINIMAX_METRIC))
-        metric = _MINIMAX_METRIC[variant]
+    if spec.method == "minimax":
+        metric = MINIMAX_METRIC[opts.pop("variant")]
     bh, bw = e.shape
     domain = np.zeros(e.shape, dtype=bool)
     domain[:, :ovl] = True
@@ -569,14 +542,9 @@ def patch_cut(
     *,
     ring: int,
     margin: int = 2,
-    method: str = "dp",
-    metric: str = "euclid",
-    blend: str = "adaptive",
-    width: float = 4,
-    rho: int = 3,
+    seam: SeamSpec | None = None,
     error=None,
     cancel=None,
-    **seam_options,
 ) -> PatchCut:
     """Closed-path cut for moving window ``q`` onto ``u`` (ALGORITHMS §1.5).
 
@@ -587,19 +555,22 @@ def patch_cut(
     loop. The mask is everything not 4-connected to the window border (loop included); the
     blend is the EDT ramp with each side's half-widths (adaptive: §1.3 per side; feather:
     ``width / 2``); the outer ``margin`` pixels keep alpha exactly 0 (U untouched).
+
+    ``seam`` gives the method, its options, the metric (unless ``error`` is given) and the
+    blending; default :data:`PATCH_SEAM` (dp, adaptive blending).
     """
     qq, uu = _pair(q, u, ("q", "u"))
     wp = positive_int(ring, "ring", minimum=1)
     m = positive_int(margin, "margin", minimum=0)
     if m >= wp:
         raise ValueError(f"margin must be smaller than ring, got margin={m}, ring={wp}")
-    choice(blend, "blend", BLEND_MODES)
+    spec = as_seam_spec(seam, default=PATCH_SEAM)
     ph, pw = qq.shape[:2]
     if min(ph, pw) < 2 * wp:
         raise ValueError(
             f"the window ({pw}x{ph}) must be at least 2 * ring = {2 * wp} pixels on each side"
         )
-    d = error_map(qq, uu, metric=metric) if error is None else _given_error(error, (ph, pw))
+    d = error_map(qq, uu, metric=spec.metric) if error is None else _given_error(error, (ph, pw))
     d64 = d.astype(np.float64)
     n = wp - m
     tl = _corner(d64, m, m, n, False)
@@ -638,13 +609,12 @@ def patch_cut(
     for name, (ce, start, end, to_window) in specs.items():
         check(cancel)
         ce = np.ascontiguousarray(ce)
-        kw = _seam_kwargs(start, end, (), False, cancel)
-        seam = find_seam(ce, method=method, **kw, **seam_options)
-        sides[name] = seam
-        p = np.asarray(seam.path)
+        side = spec.find(ce, start=start, end=end, cancel=cancel)
+        sides[name] = side
+        p = np.asarray(side.path)
         rows, cols = to_window(p)
         pieces[name] = np.column_stack([rows, cols]).astype(np.intp)
-        b_rows = _side_half_widths(seam, ce, blend, width, rho)
+        b_rows = _side_half_widths(side, ce, spec)
         np.maximum.at(b_at, (rows, cols), b_rows[p[:, 0]])
     loop = _ordered_loop(pieces)
     barrier = np.zeros((ph, pw), dtype=bool)
@@ -652,7 +622,8 @@ def patch_cut(
     labels, _ = ndimage.label(~barrier)
     border = np.concatenate([labels[0], labels[-1], labels[:, 0], labels[:, -1]])
     mask = ~np.isin(labels, np.unique(border[border > 0]))
-    alpha = mask.astype(np.float32) if blend == "none" else _ring_ramp(mask, barrier, b_at, wp)
+    hard = spec.blend == "none"
+    alpha = mask.astype(np.float32) if hard else _ring_ramp(mask, barrier, b_at, wp)
     if m:
         alpha[:m] = 0
         alpha[-m:] = 0
@@ -699,15 +670,15 @@ def _ring_ramp(mask: np.ndarray, barrier: np.ndarray, b_at: np.ndarray, ring: in
     return alpha
 
 
-def _side_half_widths(seam: Seam, ce: np.ndarray, blend: str, width: float, rho: int):
+def _side_half_widths(seam: Seam, ce: np.ndarray, spec: SeamSpec):
     """Per canonical row half-widths of one side (§1.3 per side, clamped inside the ring)."""
     h = ce.shape[0]
-    if blend == "none":
+    if spec.blend == "none":
         return np.zeros(h)
     b = (
-        np.full(h, float(width) / 2.0)
-        if blend == "feather"
-        else adaptive_half_widths(seam, ce, rho=rho)
+        np.full(h, spec.width / 2.0)
+        if spec.blend == "feather"
+        else adaptive_half_widths(seam, ce, rho=spec.rho)
     )
     cols = cut_columns(seam.mask)
     return clamped_half_widths(cols, b, ce.shape[1]) if cols is not None else b

@@ -12,9 +12,18 @@ import re
 from dataclasses import dataclass
 from typing import Any
 
-SEAM_METHODS = ("dp", "dijkstra", "minimax", "oscillating", "oscillating-optimal", "resistance")
-METRICS = ("euclid", "ssd", "lab")
-BLENDS = ("none", "feather", "adaptive")
+from engine.seams.spec import (
+    BLEND_MODES,
+    METHODS,
+    METRICS,
+    MINIMAX_VARIANTS,
+    OPTIONS,
+    OSCILLATING_VARIANTS,
+    SeamSpec,
+)
+
+SEAM_METHODS = METHODS
+BLENDS = BLEND_MODES
 QUILT_SELECTIONS = ("best", "sampled", "random", "bhatia")
 QUILT_SEAMS = ("straight", *SEAM_METHODS)
 
@@ -396,7 +405,7 @@ PARAMS: tuple[Param, ...] = (
         "oscillating: resume (continue from the "
         "last improvement) or faithful (restart the sweep, as in the paper).",
         "Seam options",
-        choices=("resume", "faithful"),
+        choices=OSCILLATING_VARIANTS,
     ),
     _P(
         "osc_init",
@@ -432,7 +441,7 @@ PARAMS: tuple[Param, ...] = (
         "Minimax variant",
         "minimax: exact (smallest peak, then sum), lm (Long & Mould) or sorted.",
         "Seam options",
-        choices=("exact", "lm", "sorted"),
+        choices=MINIMAX_VARIANTS,
     ),
     _P(
         "levels",
@@ -522,8 +531,6 @@ def coerce_all(values: dict) -> dict:
 
 def seam_option_keys(method: str) -> frozenset[str]:
     """The "Seam options" parameters that seam ``method`` uses (the others do nothing)."""
-    from engine.seams import OPTIONS
-
     allowed = OPTIONS.get(method, {})
     names = {
         "variant": "minimax_variant" if method == "minimax" else "osc_variant",
@@ -532,10 +539,21 @@ def seam_option_keys(method: str) -> frozenset[str]:
     return frozenset(names.get(k, k) for k in allowed if names.get(k, k) in BY_KEY)
 
 
+def seam_spec(p: dict) -> SeamSpec:
+    """The :class:`engine.seams.SeamSpec` of the tile set (seamless tile and candidates)."""
+    method = p["method"]
+    return SeamSpec(
+        method,
+        seam_options(p, method),
+        metric=p["metric"],
+        blend=p["blend"],
+        width=p["width"],
+        rho=p["rho"],
+    )
+
+
 def seam_options(p: dict, method: str) -> dict:
     """The options seam ``method`` takes (engine.seams.OPTIONS), from the parameters."""
-    from engine.seams import OPTIONS
-
     allowed = OPTIONS.get(method, {})
     values = {
         "o_max": p["o_max"],

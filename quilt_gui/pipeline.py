@@ -185,7 +185,7 @@ class Pipeline(QObject):
         if doc.source is None or doc.tileset.template_rect is None:
             return None
         wps = {k: list(v) for k, v in doc.tileset.waypoints.items() if v}
-        kwargs = dict(overlap=doc.params["overlap"], waypoints=wps or None, **self._seam_options())
+        kwargs = dict(overlap=doc.params["overlap"], waypoints=wps or None, **self._cut_options())
         inputs = (
             doc.tileset.template_rect,
             tuple(sorted((k, repr(v)) for k, v in kwargs.items() if k != "maps")),
@@ -245,19 +245,17 @@ class Pipeline(QObject):
         if not isinstance(exc, Cancelled):
             self._error(exc)
 
-    def _seam_options(self) -> dict:
-        """Seam method, error metric, blending and material maps (with their seam-error
-        weights) of the seamless tile and the candidates, from the parameters."""
-        p = self.doc.params
+    def seam_spec(self):
+        """The seam of the seamless tile and the candidates, from the parameters."""
+        return params.seam_spec(self.doc.params)
+
+    def _cut_options(self) -> dict:
+        """The seam and the material maps (with their seam-error weights) of the seamless
+        tile and the candidates."""
         return dict(
-            method=p["method"],
-            metric=p["metric"],
-            blend=p["blend"],
-            width=p["width"],
-            rho=p["rho"],
+            seam=self.seam_spec(),
             maps=self.doc.source.extra_maps or None,
             weights=self.doc.tileset.engine_weights(),
-            **params.seam_options(p, p["method"]),
         )
 
     # ------------------------------------------------------------------ candidates
@@ -270,7 +268,7 @@ class Pipeline(QObject):
             patch_size=p["patch_size"] or None,
             patch_overlap=p["patch_overlap"] or None,
             margin=p["margin"],
-            **self._seam_options(),
+            **self._cut_options(),
         )
 
     def _template_ready(self) -> bool:

@@ -125,7 +125,7 @@ def recompute_latency(window, method: str, repeats: int = 3) -> float:
 
         def shown(rho=rho) -> bool:
             s = doc.tileset.seamless
-            return s is not None and s.parameters.get("rho") == rho and not window.pipeline.busy()
+            return s is not None and s.seam.rho == rho and not window.pipeline.busy()
 
         if not wait_until(shown, 60):
             raise TimeoutError(f"no seamless tile for method {method}")

@@ -13,10 +13,8 @@ import json
 import sys
 import time
 
-from engine.blend import BLEND_MODES
 from engine.cli._args import add_seam_options, int_at_least, non_negative_float
-from engine.errormap import METRICS
-from engine.seams import METHODS
+from engine.seams.spec import BLEND_MODES, METHODS, METRICS, SeamSpec
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -54,7 +52,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     )
     p.add_argument("--metric", choices=METRICS, default="euclid", help="error metric")
     p.add_argument("--blend", choices=BLEND_MODES, default="none", help="blend of --save-composite")
-    p.add_argument("--rho", type=int, default=3, help="rho of adaptive blending (default 3)")
+    p.add_argument(
+        "--rho", type=int_at_least(0), default=3, help="rho of adaptive blending (default 3)"
+    )
     p.add_argument(
         "--width", type=non_negative_float, default=4, help="feather width in pixels (default 4)"
     )
@@ -81,13 +81,18 @@ def _point(text: str) -> tuple[int, int]:
 def run(args) -> int:
     import numpy as np
 
-    from engine.blend import blend_weights, composite
+    from engine.blend import composite
     from engine.errormap import error_map
     from engine.io import check_output, load_image, save_image, to_rgb
-    from engine.seams import find_seam
 
     if args.o_max is not None and args.method != "oscillating":
         raise ValueError(f"--o-max applies to --method oscillating only, not {args.method}")
+    options = dict(args.seam_option)
+    if args.o_max is not None:
+        options["o_max"] = args.o_max
+    spec = SeamSpec(
+        args.method, options, metric=args.metric, blend=args.blend, width=args.width, rho=args.rho
+    )
     a = load_image(args.r1)
     b = load_image(args.r2)
     (h, w), (h2, w2) = a.pixels.shape[:2], b.pixels.shape[:2]
@@ -106,27 +111,17 @@ def run(args) -> int:
     ):
         if path:
             check_output(path, bit_depth=bits, channels=channels)  # before the search
-    err = error_map(r1, r2, metric=args.metric)
-    options = dict(args.seam_option)
-    if args.o_max is not None:
-        options["o_max"] = args.o_max
+    err = error_map(r1, r2, metric=spec.metric)
     # a fresh process loads (or compiles) the method's numba kernels on first use, ~0.2 s:
     # do that on a tiny map so the time printed is the search's own
-    find_seam(np.ones((3, 3)), method=args.method, **options).mask  # noqa: B018
+    spec.find(np.ones((3, 3))).mask  # noqa: B018
     t0 = time.perf_counter()
-    seam = find_seam(
-        err,
-        method=args.method,
-        start=args.start,
-        end=args.end,
-        waypoints=tuple(args.waypoint),
-        **options,
-    )
+    seam = spec.find(err, start=args.start, end=args.end, waypoints=tuple(args.waypoint))
     elapsed = time.perf_counter() - t0
     if args.save_mask:
         save_image(args.save_mask, seam.mask.astype(np.float32))
     if args.save_composite:
-        alpha = blend_weights(seam, err, mode=args.blend, width=args.width, rho=args.rho)
+        alpha = spec.blend_weights(seam, err)
         save_image(args.save_composite, composite(alpha, r1, r2), bit_depth=depth)
     top = float(err.max())
     if args.save_error:

@@ -290,6 +290,7 @@ def _run(args) -> int:
     from engine.export import quantize
     from engine.export._png import encode_png
     from engine.io import load_image
+    from engine.seams import SeamSpec
     from engine.tiles import (
         CandidateTile,
         TemplateUpdate,
@@ -324,6 +325,9 @@ def _run(args) -> int:
 
     tmpl_blend = args.blend or "none"
     cand_blend = args.blend or "adaptive"
+    seam = SeamSpec(
+        args.seam, dict(args.seam_option), metric=args.metric, width=args.width, rho=args.rho
+    )
     short = min(H, W)
     tile_min = args.tile_min if args.tile_min is not None else max(8, short // 4)
     tile_max = args.tile_max if args.tile_max is not None else max(8, short // 2)
@@ -366,12 +370,7 @@ def _run(args) -> int:
             S,
             rect,
             overlap=overlap,
-            method=args.seam,
-            **dict(args.seam_option),
-            metric=args.metric,
-            blend=tmpl_blend,
-            width=args.width,
-            rho=args.rho,
+            seam=seam.replace(blend=tmpl_blend),
             maps=maps or None,
             weights=weights,
         )
@@ -407,12 +406,7 @@ def _run(args) -> int:
             patch_overlap=ring,
             margin=margin,
             neighbourhood=args.neighbourhood,
-            method=args.seam,
-            **dict(args.seam_option),
-            metric=args.metric,
-            blend=cand_blend,
-            width=args.width,
-            rho=args.rho,
+            seam=seam.replace(blend=cand_blend),
             excluded=excluded,
             maps=maps or None,
             weights=weights,

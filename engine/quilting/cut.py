@@ -14,7 +14,7 @@ import numpy as np
 from scipy import ndimage
 
 from engine.blend import ramp_from_mask
-from engine.seams import find_seam
+from engine.seams import SeamSpec, find_seam
 from engine.stitch import from_canonical, l_cut, map_points, to_canonical
 
 __all__ = ["Cut", "blend_alpha", "cut_overlap", "straight_alpha"]
@@ -57,7 +57,8 @@ def cut_overlap(err, arms, *, method: str, cancel=None, **options) -> Cut:
     keep = np.zeros((h, w), dtype=bool)
     paths, crit, peak = [], 0.0, 0.0
     if t or left:
-        lc = l_cut(err, overlap_left=left, overlap_top=t, method=method, cancel=cancel, **options)
+        spec = SeamSpec(method, options)
+        lc = l_cut(err, overlap_left=left, overlap_top=t, seam=spec, cancel=cancel)
         keep |= np.asarray(lc.mask, dtype=bool)
         paths.append(np.asarray(lc.path, dtype=np.intp).reshape(-1, 2))
         crit, peak = float(lc.criterion), float(lc.peak)

@@ -23,6 +23,7 @@ from numba import njit
 
 from engine._validate import as_error_map, choice, positive_int
 from engine.cancel import check
+from engine.seams.spec import check_connectivity
 
 GRAPH_METRICS = ("sum", "minimax", "lm", "sorted")
 _SUM, _LM, _SORTED = 0, 1, 2
@@ -365,9 +366,3 @@ def graph_path(
     if path is None:
         raise ValueError("no path from sources to targets within domain")
     return path
-
-
-def check_connectivity(connectivity) -> int:
-    if isinstance(connectivity, bool) or connectivity not in (4, 8):
-        raise ValueError(f"connectivity must be 4 or 8, got {connectivity!r}")
-    return int(connectivity)

@@ -50,9 +50,8 @@ from scipy import ndimage
 from engine.cancel import check, is_cancelled
 from engine.seams._result import Seam
 from engine.seams.dp import dp_columns
+from engine.seams.spec import INITS
 
-#: starting paths of the oscillating search (see :func:`initial_controls`)
-INITS = ("argmin", "dp", "smoothed")
 #: Gaussian sigma (rows) of the ``smoothed`` start: light, averages pixel noise over a few rows
 SMOOTH_SIGMA = 2.0
 

@@ -29,22 +29,16 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit
 
-from engine._validate import as_image, choice, positive_int
+from engine._validate import as_image, positive_int
 from engine.cancel import Cancelled, CancelToken, check, is_cancelled
-from engine.errormap import METRICS, colour_channels
+from engine.errormap import colour_channels
 from engine.events import Item, Progress, drain, frozen_array
 from engine.exclusion import valid_anchors
 from engine.materials import apply_cut
-from engine.stitch import BLEND_MODES, patch_cut
-from engine.tiles.seamless import (
-    MAIN,
-    SeamlessTile,
-    as_maps,
-    check_seam_options,
-    check_weights,
-    seam_error,
-)
-from engine.tiles.template import _excluded_mask, as_size, flat_warning
+from engine.seams.spec import SeamSpec, as_seam_spec
+from engine.stitch import PATCH_SEAM, patch_cut
+from engine.tiles.seamless import MAIN, SeamlessTile, as_maps, check_weights, seam_error
+from engine.tiles.template import as_size, excluded_mask, flat_warning
 
 __all__ = [
     "CandidateTile",
@@ -234,15 +228,10 @@ class _Setup:
         patch_overlap,
         margin,
         neighbourhood,
-        method,
-        metric,
-        blend,
-        width,
-        rho,
+        seam,
         excluded,
         maps,
         weights,
-        seam_options,
     ):
         if not isinstance(template, SeamlessTile):
             raise TypeError(
@@ -281,18 +270,7 @@ class _Setup:
         self.ph, self.pw = ph, pw
         self.ty, self.tx = (th - ph) // 2, (tw - pw) // 2
         self.n = positive_int(neighbourhood, "neighbourhood", minimum=0)
-        choice(blend, "blend", BLEND_MODES)
-        check_seam_options(method, seam_options)
-        choice(metric, "metric", METRICS)
-        self.opts = dict(
-            method=method,
-            metric=metric,
-            blend=blend,
-            width=positive_int(width, "width", minimum=0),
-            rho=positive_int(rho, "rho", minimum=0),
-            **seam_options,
-        )
-        self.metric = metric
+        self.seam = as_seam_spec(seam, default=PATCH_SEAM)
         extra = as_maps(maps, (H, W))
         if set(extra) != set(template.maps):
             raise ValueError(
@@ -308,7 +286,7 @@ class _Setup:
         self.tmaps = tmaps
         win = (slice(self.ty, self.ty + ph), slice(self.tx, self.tx + pw))
         self.U = {k: v[win] for k, v in tmaps.items()}
-        ex = _excluded_mask(excluded, (H, W))
+        ex = excluded_mask(excluded, (H, W))
         self.valid = None if ex is None else valid_anchors(ex, (ph, pw))
         if self.valid is not None and not self.valid.any():
             raise ValueError(
@@ -367,15 +345,15 @@ class _Setup:
         check(cancel)
         win = (slice(sy, sy + self.ph), slice(sx, sx + self.pw))
         Q = {k: v[win] for k, v in self.stack.items()}
-        err = seam_error(Q, self.U, self.weights, self.metric)
+        err = seam_error(Q, self.U, self.weights, self.seam.metric)
         cut = patch_cut(
             Q[MAIN],
             self.U[MAIN],
             ring=self.ring,
             margin=self.margin,
+            seam=self.seam,
             error=err,
             cancel=cancel,
-            **self.opts,
         )
         check(cancel)
         out = apply_cut(Q, self.U, cut.alpha)
@@ -437,18 +415,13 @@ def iter_candidates(
     patch_overlap=None,
     margin: int = 2,
     neighbourhood: int = 5,
-    method: str = "dp",
-    metric: str = "euclid",
-    blend: str = "adaptive",
-    width: int = 4,
-    rho: int = 3,
+    seam: SeamSpec | None = None,
     excluded=None,
     maps=None,
     weights=None,
     rng=None,
     workers: int = 2,
     cancel=None,
-    **seam_options,
 ):
     """Stream ``n`` connectable variants of ``template``; the generator's value is their list.
 
@@ -468,8 +441,9 @@ def iter_candidates(
         Outer pixels that always stay the template (default 2).
     neighbourhood : int
         n of the position refinement (search s0 + [-n, n]^2).
-    method, metric, blend, width, rho, **seam_options
-        Seam method, error metric, blending of the cut (see :mod:`engine.stitch`).
+    seam : SeamSpec, optional
+        Seam method and options, error metric and blending of the patch cuts (default
+        :data:`engine.stitch.PATCH_SEAM`: dp with adaptive blending).
     excluded : (H, W) bool or None
         Source pixels no patch may contain.
     maps, weights
@@ -491,15 +465,10 @@ def iter_candidates(
         patch_overlap=patch_overlap,
         margin=margin,
         neighbourhood=neighbourhood,
-        method=method,
-        metric=metric,
-        blend=blend,
-        width=width,
-        rho=rho,
+        seam=seam,
         excluded=excluded,
         maps=maps,
         weights=weights,
-        seam_options=seam_options,
     )
     n = positive_int(n, "n")
     workers = positive_int(workers, "workers")
@@ -573,16 +542,11 @@ def make_candidate(
     patch_size=None,
     patch_overlap=None,
     margin: int = 2,
-    method: str = "dp",
-    metric: str = "euclid",
-    blend: str = "adaptive",
-    width: int = 4,
-    rho: int = 3,
+    seam: SeamSpec | None = None,
     excluded=None,
     maps=None,
     weights=None,
     cancel=None,
-    **seam_options,
 ) -> CandidateTile:
     """Make one candidate: from a user-given ``patch_origin`` (row, col) or from a seed.
 
@@ -598,15 +562,10 @@ def make_candidate(
         patch_overlap=patch_overlap,
         margin=margin,
         neighbourhood=0 if neighbourhood is None else neighbourhood,
-        method=method,
-        metric=metric,
-        blend=blend,
-        width=width,
-        rho=rho,
+        seam=seam,
         excluded=excluded,
         maps=maps,
         weights=weights,
-        seam_options=seam_options,
     )
     if isinstance(index, bool) or not isinstance(index, numbers.Integral) or index < 0:
         raise ValueError(f"index must be a non-negative integer, got {index!r}")

@@ -20,13 +20,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from engine._validate import as_image, choice, positive_int
-from engine.blend import BLEND_MODES, blend_weights
+from engine._validate import as_image, choice
 from engine.cancel import check
 from engine.events import Progress, Snapshot, drain, frozen_array
 from engine.materials import apply_cut, material_error
-from engine.seams import CYCLIC_METHODS, METHODS, Seam, SeamUpdate, iter_find_seam
-from engine.tiles.template import Template, _check_rect, flat_warning
+from engine.seams._result import Seam
+from engine.seams.search import SeamUpdate
+from engine.seams.spec import CYCLIC_METHODS, SeamSpec, as_seam_spec
+from engine.tiles.template import Template, check_rect, flat_warning
 
 __all__ = [
     "MAIN",
@@ -93,6 +94,8 @@ class SeamlessTile:
         The same tile for every material map (same cuts).
     criterion, peak : dict
         Per overlap: sum and maximum of the error along the seam.
+    seam : SeamSpec
+        How the cuts were made (method, options, metric, blending).
     warnings : tuple of str
     """
 
@@ -110,7 +113,7 @@ class SeamlessTile:
     maps: dict = field(default_factory=dict)
     criterion: dict = field(default_factory=dict)
     peak: dict = field(default_factory=dict)
-    parameters: dict = field(default_factory=dict)
+    seam: SeamSpec = field(default_factory=SeamSpec)
     warnings: tuple[str, ...] = ()
 
     @property
@@ -158,14 +161,14 @@ def seam_error(stack_r1: dict, stack_r2: dict, weights, metric: str) -> np.ndarr
     )
 
 
-def iter_seam(error, *, method, cyclic=False, waypoints=(), cancel=None, **options):
-    """Stream the :class:`SeamUpdate` events of :func:`engine.seams.iter_find_seam`.
+def iter_seam(error, spec: SeamSpec, *, cyclic=False, waypoints=(), cancel=None):
+    """Stream the :class:`SeamUpdate` events of ``spec.iter_find``.
 
     ``cyclic`` with a method that has no cyclic mode (the graph methods, the walk) pins the
     first and last rows to one common column instead: the best column of ``E[0] + E[-1]``
     (ALGORITHMS §1.7, DP-mode fallback).
     """
-    if cyclic and method not in CYCLIC_METHODS:
+    if cyclic and spec.method not in CYCLIC_METHODS:
         e = np.asarray(error, dtype=np.float64)
         pinned = {int(r) for r, _ in waypoints}
         v = int(np.argmin(e[0] + e[-1]))
@@ -174,30 +177,12 @@ def iter_seam(error, *, method, cyclic=False, waypoints=(), cancel=None, **optio
             kw["start"] = v
         if e.shape[0] - 1 not in pinned:
             kw["end"] = v
-        return (
-            yield from iter_find_seam(
-                error, method=method, waypoints=tuple(waypoints), cancel=cancel, **kw, **options
-            )
-        )
+        return (yield from spec.iter_find(error, waypoints=tuple(waypoints), cancel=cancel, **kw))
     return (
-        yield from iter_find_seam(
-            error,
-            method=method,
-            waypoints=tuple(waypoints),
-            cyclic=bool(cyclic),
-            cancel=cancel,
-            **options,
+        yield from spec.iter_find(
+            error, waypoints=tuple(waypoints), cyclic=bool(cyclic), cancel=cancel
         )
     )
-
-
-def check_seam_options(method: str, options: dict) -> None:
-    """Validate a seam method and its options now (not in a worker), as
-    :func:`engine.seams.iter_find_seam` does; options that depend on the overlap's shape
-    (``image``) are left to the search itself."""
-    choice(method, "method", METHODS)
-    opts = {k: v for k, v in options.items() if k != "image"}
-    iter_find_seam(np.zeros((4, 4)), method=method, **opts).close()
 
 
 def _restrict(error: np.ndarray, lo: int, hi: int) -> np.ndarray:
@@ -209,9 +194,9 @@ def _restrict(error: np.ndarray, lo: int, hi: int) -> np.ndarray:
     return out
 
 
-def _allowed(width: int, blend: str, feather: int) -> tuple[int, int]:
+def _allowed(width: int, spec: SeamSpec) -> tuple[int, int]:
     """Control-point range that keeps column 0 from R1 and column width-1 from R2."""
-    pad = math.ceil(feather / 2) if blend == "feather" else 0
+    pad = math.ceil(spec.width / 2) if spec.blend == "feather" else 0
     lo, hi = pad, width - 2 - pad
     return (lo, hi) if lo <= hi else (0, width - 2)
 
@@ -235,16 +220,11 @@ def iter_make_seamless(
     rect,
     *,
     overlap=None,
-    method: str = "dp",
-    metric: str = "euclid",
-    blend: str = "none",
-    width: int = 4,
-    rho: int = 3,
+    seam: SeamSpec | None = None,
     waypoints=None,
     maps=None,
     weights=None,
     cancel=None,
-    **seam_options,
 ):
     """Make the tile of ``rect`` seamless; returns a generator whose value is a SeamlessTile.
 
@@ -256,9 +236,9 @@ def iter_make_seamless(
         gives ``overlap``.
     overlap : int
         w_T (required with a plain rectangle).
-    method, metric, blend, width, rho, **seam_options
-        Seam method (:data:`engine.seams.METHODS`), error metric, blending (``none``,
-        ``feather`` of ``width`` px, ``adaptive`` with ρ) and method options.
+    seam : SeamSpec, optional
+        Seam method and options, error metric and blending of both cuts (default
+        ``SeamSpec()``: dp, euclid, hard cut).
     waypoints : {"horizontal": [(r, c), ...], "vertical": [...]} or None
         Points the seams must pass, in each overlap region's coordinates as drawn.
     maps : {name: (H, W[, C]) image} or None
@@ -277,64 +257,22 @@ def iter_make_seamless(
         rect = rect.rect
     if overlap is None:
         raise TypeError("overlap is required when rect is a plain (x, y, w, h) rectangle")
-    x, y, a, b = _check_rect(rect, overlap, (H, W))
-    choice(blend, "blend", BLEND_MODES)
-    check_seam_options(method, seam_options)
-    positive_int(width, "width", minimum=0)
-    positive_int(rho, "rho", minimum=0)
+    x, y, a, b = check_rect(rect, overlap, (H, W))
+    spec = as_seam_spec(seam)
     extra = as_maps(maps, (H, W))
     wts = check_weights(weights, extra)
     wps = _check_waypoints(waypoints)
-    seam_error({MAIN: S[:1, :1]}, {MAIN: S[:1, :1]}, None, metric)  # validates metric early
     notes = []
     flat = flat_warning(S)
     if flat:
         notes.append(flat)
         warnings.warn(flat, stacklevel=2)
-    params = dict(
-        method=method,
-        metric=metric,
-        blend=blend,
-        width=int(width),
-        rho=int(rho),
-        **{k: v for k, v in seam_options.items() if isinstance(v, (int, float, str))},
-    )
     return _iter_make_seamless(
-        S,
-        extra,
-        (x, y, a, b),
-        int(overlap),
-        method,
-        metric,
-        blend,
-        int(width),
-        int(rho),
-        wps,
-        wts,
-        cancel,
-        seam_options,
-        params,
-        tuple(notes),
+        S, extra, (x, y, a, b), int(overlap), spec, wps, wts, cancel, tuple(notes)
     )
 
 
-def _iter_make_seamless(
-    S,
-    extra,
-    rect,
-    wT,
-    method,
-    metric,
-    blend,
-    width,
-    rho,
-    wps,
-    wts,
-    cancel,
-    seam_options,
-    params,
-    notes,
-):
+def _iter_make_seamless(S, extra, rect, wT, spec: SeamSpec, wps, wts, cancel, notes):
     x, y, a, b = rect
     stack = {MAIN: S, **extra}
     F = {k: v[y : y + b + wT, x : x + a + wT] for k, v in stack.items()}
@@ -343,23 +281,17 @@ def _iter_make_seamless(
     yield Progress(0, 2, "seamless: horizontal stitch")
 
     # ---- horizontal: R1 = R_R kept on the left (the tile's left edge), R2 = R_L; canonical
-    E_h = seam_error(R_R, R_L, wts, metric)
+    E_h = seam_error(R_R, R_L, wts, spec.metric)
     drawn_h = _drawn({"R_R": R_R[MAIN], "R_L": R_L[MAIN]}, E_h)
-    lo, hi = _allowed(wT, blend, width)
+    lo, hi = _allowed(wT, spec)
     seam_h = yield from _stream(
-        iter_seam(
-            _restrict(E_h, lo, hi),
-            method=method,
-            waypoints=wps.get("horizontal", ()),
-            cancel=cancel,
-            **seam_options,
-        ),
+        iter_seam(_restrict(E_h, lo, hi), spec, waypoints=wps.get("horizontal", ()), cancel=cancel),
         "horizontal",
         (y, x),
         drawn_h,
     )
     check(cancel)
-    alpha_h = _alpha(seam_h, E_h, blend, width, rho)
+    alpha_h = _alpha(seam_h, E_h, spec)
     strip = apply_cut(R_R, R_L, alpha_h)
     inner = {k: v[:, :a].copy() for k, v in F.items()}  # I of §1.7
     for k in inner:
@@ -370,26 +302,19 @@ def _iter_make_seamless(
     # ---- vertical: R1 = R_B kept on top; canonical = transpose (rows = tile columns), cyclic
     R_T = {k: v[:wT] for k, v in inner.items()}
     R_B = {k: v[b : b + wT] for k, v in inner.items()}
-    E_v = seam_error(R_B, R_T, wts, metric)
+    E_v = seam_error(R_B, R_T, wts, spec.metric)
     drawn_v = _drawn({"R_B": R_B[MAIN], "R_T": R_T[MAIN]}, E_v)
     Ec = np.ascontiguousarray(E_v.T)
     wv = tuple((c, r) for r, c in wps.get("vertical", ()))
     seam_v = yield from _stream(
-        iter_seam(
-            _restrict(Ec, lo, hi),
-            method=method,
-            cyclic=True,
-            waypoints=wv,
-            cancel=cancel,
-            **seam_options,
-        ),
+        iter_seam(_restrict(Ec, lo, hi), spec, cyclic=True, waypoints=wv, cancel=cancel),
         "vertical",
         (y, x),
         drawn_v,
         transpose=True,
     )
     check(cancel)
-    alpha_v = np.ascontiguousarray(_alpha(seam_v, Ec, blend, width, rho, cyclic=True).T)
+    alpha_v = np.ascontiguousarray(_alpha(seam_v, Ec, spec, cyclic=True).T)
     band = apply_cut(R_B, R_T, alpha_v)
     tiles = {k: v[:b].copy() for k, v in inner.items()}
     for k in tiles:
@@ -425,19 +350,14 @@ def _iter_make_seamless(
         maps={k: fr(v) for k, v in tiles.items() if k != MAIN},
         criterion={k: float(v[p[:, 0], p[:, 1]].sum()) for k, v, p in drawn},
         peak={k: float(v[p[:, 0], p[:, 1]].max()) for k, v, p in drawn},
-        parameters=params,
+        seam=spec,
         warnings=notes,
     )
 
 
-def _alpha(
-    seam: Seam, error: np.ndarray, blend: str, width: int, rho: int, cyclic: bool = False
-) -> np.ndarray:
+def _alpha(seam: Seam, error: np.ndarray, spec: SeamSpec, cyclic: bool = False) -> np.ndarray:
     """Canonical weight of R1 with the outer column pinned to R1 and the inner one to R2."""
-    alpha = np.array(
-        blend_weights(seam, error, mode=blend, width=width, rho=rho, cyclic=cyclic),
-        dtype=np.float32,
-    )
+    alpha = np.array(spec.blend_weights(seam, error, cyclic=cyclic), dtype=np.float32)
     alpha[:, 0] = 1.0
     alpha[:, -1] = 0.0
     return alpha

@@ -131,7 +131,7 @@ def default_overlap(tile_min, tile_max=None) -> int:
     return max(2, min(int(round(expected / 10.0)), min(lo) // 2))
 
 
-def _excluded_mask(excluded, shape: tuple[int, int]) -> np.ndarray | None:
+def excluded_mask(excluded, shape: tuple[int, int]) -> np.ndarray | None:
     if excluded is None:
         return None
     m = np.asarray(excluded)
@@ -375,15 +375,15 @@ def template_cost(
     """
     S = colour_channels(as_image(source, "source"))
     H, W = S.shape[:2]
-    x, y, a, b = _check_rect(rect, overlap, (H, W))
-    ex = _excluded_mask(excluded, (H, W))
+    x, y, a, b = check_rect(rect, overlap, (H, W))
+    ex = excluded_mask(excluded, (H, W))
     t = _make_template(
         S, None if ex is None else ~ex, (x, y, a, b), int(overlap), _joint_weight(joint_weight)
     )
     return t.cost, t.cost_horizontal, t.cost_vertical
 
 
-def _check_rect(rect, overlap, shape) -> tuple[int, int, int, int]:
+def check_rect(rect, overlap, shape) -> tuple[int, int, int, int]:
     H, W = shape
     if isinstance(overlap, bool) or not isinstance(overlap, numbers.Integral) or overlap < 1:
         raise ValueError(f"overlap must be a positive integer, got {overlap!r}")
@@ -447,7 +447,7 @@ def iter_find_template(
     S = np.ascontiguousarray(colour_channels(as_image(source, "source")))
     H, W = S.shape[:2]
     lo, hi, overlap, notes = _resolve_range((H, W), tile_min, tile_max, overlap)
-    ex = _excluded_mask(excluded, (H, W))
+    ex = excluded_mask(excluded, (H, W))
     valid = None if ex is None else ~ex
     run0 = None
     if valid is not None:

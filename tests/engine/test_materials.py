@@ -17,7 +17,7 @@ from engine.materials import (
     make_material,
     material_error,
 )
-from engine.seams import find_seam
+from engine.seams import SeamSpec, find_seam
 
 
 def random_normals(shape, rng, *, tilt=1.2):
@@ -225,9 +225,9 @@ def test_exported_material_tiles_share_every_cut_and_keep_unit_normals(tmp_path)
     g = np.random.default_rng(4)
     albedo = q8(np.clip(g.normal(0.5, 0.15, (72, 72, 3)), 0, 1))
     maps = {"normal": f_normal(albedo), "height": g_height(albedo)}
-    tmpl = make_seamless(albedo, (8, 8, 40, 36), overlap=8, maps=maps, blend="none")
+    tmpl = make_seamless(albedo, (8, 8, 40, 36), overlap=8, maps=maps)
     for blend in ("none", "adaptive"):  # the patches' cut: hard, or blended
-        cands = candidates(albedo, tmpl, 4, maps=maps, blend=blend, rng=1, workers=1)
+        cands = candidates(albedo, tmpl, 4, maps=maps, seam=SeamSpec(blend=blend), rng=1, workers=1)
         tiles = [{"albedo": c.tile, **c.maps} for c in cands]
         out = tmp_path / blend
         man = export_bundle(out, name="m", tiles=tiles, normal_convention="opengl")

@@ -10,7 +10,7 @@ from engine.blend import adaptive_half_widths, clamped_half_widths
 from engine.cancel import Cancelled, CancelToken
 from engine.io import load_image
 from engine.metrics import wrap_border_ratio
-from engine.seams import find_seam
+from engine.seams import SeamSpec, find_seam
 from engine.stitch import (
     ORIENTATIONS,
     l_cut,
@@ -46,7 +46,7 @@ def shape_for(orientation, along=24, across=9):
 @pytest.mark.parametrize("method", ["dp", "dijkstra"])
 def test_hard_cut_copies_r1_and_r2_exactly(orientation, method):
     r1, r2 = pair(*shape_for(orientation), seed=1)
-    res = stitch(r1, r2, orientation=orientation, method=method)
+    res = stitch(r1, r2, orientation=orientation, seam=SeamSpec(method))
     m = res.mask
     np.testing.assert_array_equal(res.image[m], r1[m])
     np.testing.assert_array_equal(res.image[~m], r2[~m])
@@ -78,7 +78,7 @@ def test_orientations_are_transposes_of_each_other():
 def test_adaptive_stitch_changes_only_pixels_within_its_width(orientation):
     r1, r2 = pair(*shape_for(orientation, 40, 14), seed=3)
     hard = stitch(r1, r2, orientation=orientation)
-    soft = stitch(r1, r2, orientation=orientation, blend="adaptive", rho=3)
+    soft = stitch(r1, r2, orientation=orientation, seam=SeamSpec(blend="adaptive", rho=3))
     changed = to_canonical(np.any(soft.image != hard.image, axis=2), orientation)
     assert changed.any()
     e = to_canonical(soft.error, orientation)
@@ -107,7 +107,7 @@ def test_waypoints_in_caller_coordinates_and_precomputed_error():
 
 def test_apply_same_cut_to_material_maps():
     r1, r2 = pair(18, 8, seed=6)
-    res = stitch(r1, r2, blend="feather", width=4)
+    res = stitch(r1, r2, seam=SeamSpec(blend="feather", width=4))
     n1, n2 = pair(18, 8, seed=7, channels=1)
     out = res.apply(n1, n2)
     np.testing.assert_allclose(
@@ -123,7 +123,7 @@ def test_stitch_bad_input_and_cancel():
     with pytest.raises(ValueError, match="orientation must be one of"):
         stitch(r1, r2, orientation="up")
     with pytest.raises(ValueError, match="blend must be one of"):
-        stitch(r1, r2, blend="smooth")
+        stitch(r1, r2, seam=SeamSpec(blend="smooth"))
     with pytest.raises(ValueError, match=r"error must be shaped \(8, 6\)"):
         stitch(r1, r2, error=np.zeros((6, 8)))
     token = CancelToken()
@@ -133,15 +133,20 @@ def test_stitch_bad_input_and_cancel():
 
 
 # ----------------------------------------------------------------------------- template wrap
-def make_tile(src, y, x, a, b, wt, **vertical):
+def make_tile(src, y, x, a, b, wt, *, blend, cyclic=False):
     """ALGORITHMS §1.7: stitch R_R over R_L (horizontal), then R_B over R_T (vertical)."""
     rows = src[y : y + b + wt]
     h = stitch(
-        rows[:, x + a : x + a + wt], rows[:, x : x + wt], orientation="right", blend="adaptive"
+        rows[:, x + a : x + a + wt],
+        rows[:, x : x + wt],
+        orientation="right",
+        seam=SeamSpec(blend="adaptive"),
     )
     img = rows[:, x : x + a].copy()
     img[:, :wt] = h.image
-    v = stitch(img[b : b + wt], img[:wt], orientation="bottom", **vertical)
+    v = stitch(
+        img[b : b + wt], img[:wt], orientation="bottom", seam=SeamSpec(blend=blend), cyclic=cyclic
+    )
     img[:wt] = v.image
     return img[:b], v
 
@@ -232,7 +237,7 @@ def test_l_cut_regions_for_every_method(method):
         bh, bw = rng.integers(8, 30, 2)
         ovl, ovt = (int(v) for v in rng.integers(2, 7, 2))
         e = ndimage.uniform_filter(rng.random((bh, bw)), 3) ** 2
-        cut = l_cut(e, overlap_left=ovl, overlap_top=ovt, method=method)
+        cut = l_cut(e, overlap_left=ovl, overlap_top=ovt, seam=SeamSpec(method))
         assert_two_regions(cut, ovl, ovt)
         assert cut.path[0, 0] == bh - 1 and cut.path[0, 1] < ovl
         assert cut.path[-1, 1] == bw - 1 and cut.path[-1, 0] < ovt
@@ -244,11 +249,11 @@ def test_l_cut_graph_methods_use_the_l_domain():
     e[:, 1] = 0.01  # a cheap vertical corridor ...
     e[1, :] = 0.01  # ... and a cheap horizontal one, joined in the corner
     for method in ("dijkstra", "minimax"):
-        cut = l_cut(e, overlap_left=4, overlap_top=4, method=method)
+        cut = l_cut(e, overlap_left=4, overlap_top=4, seam=SeamSpec(method))
         assert in_l(e.shape, 4, 4)[cut.path[:, 0], cut.path[:, 1]].all()
         assert cut.peak == pytest.approx(0.01)
     with pytest.raises(TypeError, match="unexpected option"):
-        l_cut(e, overlap_left=4, overlap_top=4, method="dijkstra", o_max=3)
+        l_cut(e, overlap_left=4, overlap_top=4, seam=SeamSpec("dijkstra", {"o_max": 3}))
 
 
 def test_l_cut_single_strips():
@@ -265,7 +270,7 @@ def test_l_cut_single_strips():
     np.testing.assert_array_equal(h.mask[:5], direct.mask.T)
     assert not h.mask[5:].any()
     for method in ("oscillating", "resistance", "minimax"):
-        cut = l_cut(e, overlap_left=0, overlap_top=5, method=method)
+        cut = l_cut(e, overlap_left=0, overlap_top=5, seam=SeamSpec(method))
         assert ndimage.label(cut.mask)[1] == 1 and ndimage.label(~cut.mask)[1] == 1
 
 
@@ -284,7 +289,7 @@ def test_l_cut_apply_and_bad_input():
     with pytest.raises(ValueError, match="overlap_top must be >= 0"):
         l_cut(e, overlap_left=2, overlap_top=-1)
     with pytest.raises(ValueError, match="method must be one of"):
-        l_cut(e, overlap_left=2, overlap_top=2, method="magic")
+        l_cut(e, overlap_left=2, overlap_top=2, seam=SeamSpec("magic"))
     token = CancelToken()
     token.cancel()
     with pytest.raises(Cancelled):
@@ -317,8 +322,7 @@ def test_patch_keeps_margin_and_closes_its_loop(method, blend):
         size=(64, 72),
         ring=12,
         margin=2,
-        method=method,
-        blend=blend,
+        seam=SeamSpec(method, blend=blend),
     )
     cut = res.cut
     out = res.image
@@ -352,7 +356,7 @@ def test_patch_cut_follows_low_error_and_applies_to_other_maps():
     q, u = pair(40, 40, seed=14)
     err = np.ones((40, 40), np.float32)
     err[6, 5:35] = err[33, 5:35] = err[6:34, 5] = err[6:34, 34] = 0  # a free rectangle
-    cut = patch_cut(q, u, ring=9, margin=2, error=err, blend="none")
+    cut = patch_cut(q, u, ring=9, margin=2, error=err, seam=SeamSpec())
     assert cut.criterion == 0
     assert cut.mask[7:33, 6:34].all()
     assert not (
@@ -386,7 +390,9 @@ def test_patch_ramp_on_border_strips_equals_the_whole_window_ramp(monkeypatch):
         u = ndimage.gaussian_filter(rng.random((ph, pw, 3)), (1.5, 1.5, 0))
         method = ("dp", "dijkstra", "oscillating")[k % 3]
         for blend in ("adaptive", "feather"):
-            patch_cut(q, u, ring=int(rng.integers(4, 14)), method=method, blend=blend, width=9)
+            patch_cut(
+                q, u, ring=int(rng.integers(4, 14)), seam=SeamSpec(method, blend=blend, width=9)
+            )
     assert len(strips) == 12 and all(strips)
 
 

@@ -140,15 +140,10 @@ def test_position_refinement_against_brute_force(small, channels):
         patch_overlap=None,
         margin=2,
         neighbourhood=4,
-        method="dp",
-        metric="euclid",
-        blend="adaptive",
-        width=4,
-        rho=3,
+        seam=None,
         excluded=None,
         maps=None,
         weights=None,
-        seam_options={},
     )
     (y, x), cost = setup.refine((30, 40), 4)
     h, w = st.tile.shape[:2]
@@ -207,8 +202,8 @@ def test_bad_input(small):
         candidates(S, st, 2, excluded=ex)
     with pytest.raises(ValueError, match="channels"):
         candidates(S[:, :, :1], st, 2)
-    with pytest.raises(ValueError, match="method"):
-        candidates(S, st, 2, method="magic")
+    with pytest.raises(TypeError, match="SeamSpec"):
+        candidates(S, st, 2, seam={"method": "dp"})
     with pytest.raises(TypeError, match="bogus"):
         iter_candidates(S, st, 2, bogus=3)
     with pytest.warns(UserWarning, match="margin 0"):

@@ -8,7 +8,7 @@ from engine.cancel import Cancelled, CancelToken
 from engine.events import Progress
 from engine.io import load_image
 from engine.metrics import detail_ratio, wrap_border_ratio
-from engine.seams import METHODS, find_seam
+from engine.seams import METHODS, SeamSpec, find_seam
 from engine.tiles import (
     SeamlessTile,
     SeamlessUpdate,
@@ -47,7 +47,7 @@ def check_structure(S, st, rect=RECT, w=W_T, tile=None):
 @pytest.mark.parametrize("method", METHODS)
 def test_every_method_gives_a_wrapping_tile(method):
     S = texture()
-    st = make_seamless(S, RECT, overlap=W_T, method=method)
+    st = make_seamless(S, RECT, overlap=W_T, seam=SeamSpec(method))
     assert isinstance(st, SeamlessTile)
     check_structure(S, st)
     cols = st.seams["vertical"].path  # canonical: rows = tile columns
@@ -61,7 +61,7 @@ def test_every_method_gives_a_wrapping_tile(method):
 @pytest.mark.parametrize("blend", ["none", "feather", "adaptive"])
 def test_blends_keep_the_structure_and_hard_cut_copies_pixels(blend):
     S = texture(seed=2)
-    st = make_seamless(S, RECT, overlap=W_T, blend=blend, width=4)
+    st = make_seamless(S, RECT, overlap=W_T, seam=SeamSpec(blend=blend, width=4))
     check_structure(S, st)
     a_h = st.alphas["horizontal"]
     assert a_h.shape == (RECT[3] + W_T, W_T)
@@ -105,7 +105,7 @@ def test_regions_errors_and_paths_are_consistent():
 
 def test_stream_order_and_oscillating_improvements():
     S = texture(seed=4, sigma=1.0)
-    gen = iter_make_seamless(S, RECT, overlap=W_T, method="oscillating", o_max=2)
+    gen = iter_make_seamless(S, RECT, overlap=W_T, seam=SeamSpec("oscillating", {"o_max": 2}))
     events, st = events_and_result(gen)
     ups = [e for e in events if isinstance(e, SeamlessUpdate)]
     assert all(isinstance(e, (SeamlessUpdate, Progress)) for e in events)
@@ -125,7 +125,7 @@ def test_updates_carry_each_overlaps_regions_and_error_map(method):
     read-only; later updates share the same arrays (no copy), and so does the result."""
     S = texture(seed=4, sigma=1.0)
     opts = {"o_max": 2} if method == "oscillating" else {}
-    gen = iter_make_seamless(S, RECT, overlap=W_T, method=method, **opts)
+    gen = iter_make_seamless(S, RECT, overlap=W_T, seam=SeamSpec(method, opts))
     events, st = events_and_result(gen)
     ups = [ev for ev in events if isinstance(ev, SeamlessUpdate)]
     names = {"horizontal": ("R_R", "R_L"), "vertical": ("R_B", "R_T")}
@@ -251,11 +251,11 @@ def test_bad_input():
     with pytest.raises(ValueError, match="unknown map"):
         make_seamless(S, RECT, overlap=8, weights={"normal": 1})
     with pytest.raises(ValueError, match="blend"):
-        make_seamless(S, RECT, overlap=8, blend="smudge")
-    with pytest.raises(TypeError, match="bogus"):  # eager: at the call, not in a worker
-        iter_make_seamless(S, RECT, overlap=8, method="oscillating", bogus=1)
-    with pytest.raises(ValueError, match="method"):
-        iter_make_seamless(S, RECT, overlap=8, method="magic")
+        make_seamless(S, RECT, overlap=8, seam=SeamSpec(blend="smudge"))
+    with pytest.raises(TypeError, match="SeamSpec"):  # eager: at the call, not in a worker
+        iter_make_seamless(S, RECT, overlap=8, seam="oscillating")
+    with pytest.raises(ValueError, match="straight"):
+        iter_make_seamless(S, RECT, overlap=8, seam=SeamSpec("straight"))
     token = CancelToken()
     token.cancel()
     with pytest.raises(Cancelled):

@@ -7,6 +7,7 @@ import numpy as np
 from engine.events import drain
 from engine.io import load_image
 from engine.metrics import grid_score
+from engine.seams import SeamSpec
 from engine.tiles import (
     assemble,
     default_patch_overlap,
@@ -37,7 +38,8 @@ def test_default_patch_ring_shows_less_grid_than_the_template_overlap():
     """The editor's "auto" ring (the engine default: w_T 16 -> 8 px) halves the grid."""
     source = load_image(sample_path("cobblestones")).pixels
     d = params.DEFAULTS
-    template = make_seamless(source, (187, 94, 102, 126), overlap=d["overlap"], blend=d["blend"])
+    seam = SeamSpec(blend=d["blend"])
+    template = make_seamless(source, (187, 94, 102, 126), overlap=d["overlap"], seam=seam)
     default = _preview_grid_score(source, template, d["patch_overlap"] or None)
     w_t = _preview_grid_score(source, template, template.overlap)
     assert default < 0.75 * w_t, (default, w_t)

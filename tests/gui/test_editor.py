@@ -239,7 +239,7 @@ def test_changing_a_parameter_supersedes_and_no_stale_result_is_drawn(qtbot, win
     win.doc.tileset.seamless_changed.connect(
         lambda: applied.append(
             (
-                win.doc.tileset.seamless and win.doc.tileset.seamless.parameters["method"],
+                win.doc.tileset.seamless and win.doc.tileset.seamless.seam.method,
                 win.doc.params["method"],
             )
         )
@@ -263,10 +263,7 @@ def test_changing_a_parameter_supersedes_and_no_stale_result_is_drawn(qtbot, win
     qtbot.waitUntil(lambda: all(j.state == "aborted" for j in superseded), timeout=5000)
     assert applied and all(m is None or m == cur for m, cur in applied)
     assert all(m == cur for m, cur in live)
-    assert (
-        win.doc.tileset.seamless.parameters["method"] == "dp"
-        and win.doc.tileset.seamless.parameters["rho"] == 5
-    )
+    assert win.doc.tileset.seamless.seam.method == "dp" and win.doc.tileset.seamless.seam.rho == 5
 
 
 # ---------------------------------------------------------------------- gallery model

@@ -107,7 +107,7 @@ def test_seam_weights_of_the_maps_steer_the_cut_undo_and_survive_a_reopen(qtbot,
         src.main,
         rect,
         overlap=w.doc.params["overlap"],
-        blend=w.doc.params["blend"],
+        seam=w.pipeline.seam_spec(),
         maps={"height": src.maps["height"]},
         weights={"main": 1.0, "height": 2.0},
     )
