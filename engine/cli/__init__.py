@@ -11,7 +11,7 @@ import argparse
 import importlib
 import sys
 
-SUBCOMMANDS = ("seam", "tileset", "synth", "transfer", "export")
+SUBCOMMANDS = ("seam", "tileset", "synth", "transfer", "export", "heal")
 
 
 def build_parser(prog: str = "quilt-studio") -> argparse.ArgumentParser:
