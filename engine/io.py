@@ -3,8 +3,8 @@
 Reading: PNG, JPEG, TIFF, BMP, WebP (anything Pillow opens), 8 or 16 bits per channel; gray,
 gray + alpha, RGB, RGBA and palette images stay distinct (C = 1, 2, 3, 4; palette images become
 RGB or RGBA with ``mode == "P"``); the EXIF orientation is applied. 16-bit PNG and TIFF are
-decoded exactly (Pillow would reduce 16-bit colour to 8 bits): PNG by the codec of
-:mod:`engine.export._png`, TIFF by tifffile.
+decoded exactly (Pillow would reduce 16-bit colour to 8 bits): PNG by libpng
+(:mod:`engine.png`), TIFF by tifffile.
 
 Writing: PNG and TIFF at 8 or 16 bits, JPEG / BMP / WebP at 8 bits; atomic (a temporary file
 renamed over the target).
@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 from PIL import Image, ImageOps, UnidentifiedImageError
 
-from engine._fs import atomic_path
+from engine._fs import atomic_path, write_problem
 
 DEFAULT_MAX_PIXELS = 100_000_000  # 10k x 10k; larger files are refused as decompression bombs
 READ_SUFFIXES = (".png", ".jpg", ".jpeg", ".tif", ".tiff", ".bmp", ".webp")
@@ -213,20 +213,20 @@ def _orientation(im: Image.Image) -> int:
 def _png_16bit(data: bytes, max_pixels: int, fail):
     """(pixels, mode) of a 16-bit PNG decoded without loss, else None."""
     if data.startswith(_PNG) and data[24] == 16:
-        from engine.export._png import PNGError, decode_png
+        from engine.png import PNGError, decode_png
 
         try:
             q = decode_png(data, max_pixels=max_pixels)
         except PNGError as exc:
-            if data[28] != 0:  # interlaced: Pillow decodes it (at 8 bits for colour)
-                return None
             raise fail(f"the file is truncated or corrupt ({exc})") from None
         return _from_uint16(q)
     return None
 
 
 def _from_uint16(q: np.ndarray) -> tuple[np.ndarray, str]:
-    return q.astype(np.float32) / 65535.0, ("L", "LA", "RGB", "RGBA")[q.shape[2] - 1]
+    from engine.bitdepth import to_float
+
+    return to_float(q), ("L", "LA", "RGB", "RGBA")[q.shape[2] - 1]
 
 
 def _tiff_16bit(data: bytes, fail, check_size):
@@ -283,17 +283,6 @@ def _to_array(im: Image.Image, fail) -> tuple[np.ndarray, int, str]:
 
 
 # ----------------------------------------------------------------------------- writing
-def _write_problem(folder: Path, exc: OSError) -> str:
-    """Why ``folder`` cannot take a new file: a file in the way of its path, else the OS's
-    reason."""
-    for q in (folder, *folder.parents):
-        if q.exists():
-            if not q.is_dir():
-                return f"{q} is a file, not a folder"
-            break
-    return exc.strerror or str(exc)
-
-
 def check_output(path, *, bit_depth: int = 8, channels: int = 3) -> Path:
     """Refuse, before any work, an output that :func:`save_image` could not write in that
     format: an unknown suffix, 16 bits in anything but PNG / TIFF, alpha (``channels`` 2 or
@@ -319,9 +308,9 @@ def save_image(path, pixels, *, bit_depth: int = 8) -> Path:
 
     PNG and TIFF take 8 or 16 bits per channel; JPEG, BMP and WebP 8 bits (JPEG and BMP no
     alpha). C is 1 (gray), 2 (gray + alpha), 3 (RGB) or 4 (RGBA). Values are rounded (no
-    dither; see :func:`engine.export.quantize`). Returns the path written.
+    dither; see :func:`engine.bitdepth.quantize`). Returns the path written.
     """
-    from engine.export import quantize
+    from engine.bitdepth import quantize
 
     p = Path(os.fspath(path))
     a = np.asarray(pixels)
@@ -346,11 +335,11 @@ def save_image(path, pixels, *, bit_depth: int = 8) -> Path:
                     compression="zlib",
                 )
             elif suffix == ".png":
-                from engine.export._png import encode_png
+                from engine.png import encode_png
 
                 tmp.write_bytes(encode_png(q))
             else:
                 Image.fromarray(q).save(tmp, format=Image.registered_extensions()[suffix])
     except OSError as exc:
-        raise ImageError(f"{p}: cannot write ({_write_problem(p.parent, exc)})") from None
+        raise ImageError(f"{p}: cannot write ({write_problem(p.parent, exc)})") from None
     return p

@@ -205,7 +205,7 @@ def check_output(path: str, depth: int, channels: int) -> None:
 
 def save_output(args, image, depth: int) -> None:
     """Write the result at ``depth`` bits; a 16-bit sample reduced to 8 bits is dithered."""
-    from engine.export import quantize
+    from engine.bitdepth import quantize
     from engine.io import save_image
 
     if args.dither:

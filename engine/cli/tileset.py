@@ -275,20 +275,20 @@ def _check_out(out: Path) -> None:
     """Create the --out folder and make sure files can be written there, before any work."""
     import tempfile
 
-    from engine.io import _write_problem
+    from engine._fs import write_problem
 
     try:
         out.mkdir(parents=True, exist_ok=True)
         with tempfile.TemporaryFile(dir=out):
             pass
     except OSError as exc:
-        raise ValueError(f"--out {out}: cannot write there ({_write_problem(out, exc)})") from None
+        raise ValueError(f"--out {out}: cannot write there ({write_problem(out, exc)})") from None
 
 
 def _run(args) -> int:
     from engine.events import Progress, drain
-    from engine.export import quantize
-    from engine.export._png import encode_png
+    from engine.bitdepth import quantize
+    from engine.png import encode_png
     from engine.io import load_image
     from engine.seams import SeamSpec
     from engine.tiles import (

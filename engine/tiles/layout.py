@@ -14,7 +14,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from engine._validate import as_rng, positive_int
-from engine.export import assemble_layout
+from engine.index_matrix import assemble_layout
 
 __all__ = ["assemble", "random_layout"]
 

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from engine.cli import main
-from engine.export._png import decode_png
+from engine.png import decode_png
 from engine.project import project_from_tileset, save_project
 
 

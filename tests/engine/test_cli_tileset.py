@@ -10,7 +10,7 @@ import pytest
 
 import resources
 from engine.cli import main
-from engine.export._png import decode_png, encode_png
+from engine.png import decode_png, encode_png
 from engine.io import load_image
 from engine.project import load_project
 from engine.tiles import assemble, candidates, make_seamless
@@ -323,7 +323,7 @@ def test_joint_weight_is_passed_to_the_search_and_recorded(src, tmp_path):
 def test_default_patch_ring_is_the_engines(src, tmp_path):
     """Without --patch-overlap the CLI uses engine.tiles.default_patch_overlap(w_T) (w_T 20 ->
     w_P 10, not 20): the manifest says so and the tiles are the engine's defaults' tiles."""
-    from engine.export import quantize
+    from engine.bitdepth import quantize
     from engine.tiles import default_patch_overlap
 
     out = tmp_path / "ring"

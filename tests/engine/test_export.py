@@ -13,18 +13,18 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import engine.export
+import engine.export.folder
 import engine.io
+from engine.bitdepth import quantize
 from engine.export import (
     ExportError,
-    assemble_layout,
     atlas_layout,
     export_bundle,
     godot_tres,
-    quantize,
     render_atlas,
 )
-from engine.export._png import decode_png, encode_png
+from engine.index_matrix import assemble_layout
+from engine.png import decode_png, encode_png
 
 
 def read_png(path) -> np.ndarray:
@@ -407,7 +407,7 @@ def leftovers(parent: Path, name: str):
 
 def test_full_disk_midway_leaves_nothing(tmp_path, monkeypatch):
     calls = {"n": 0}
-    real = engine.export._write_bytes
+    real = engine.export.folder._write_bytes
 
     def flaky(path, data):
         calls["n"] += 1
@@ -416,7 +416,7 @@ def test_full_disk_midway_leaves_nothing(tmp_path, monkeypatch):
             raise OSError(errno.ENOSPC, "No space left on device")
         return real(path, data)
 
-    monkeypatch.setattr(engine.export, "_write_bytes", flaky)
+    monkeypatch.setattr(engine.export.folder, "_write_bytes", flaky)
     with pytest.raises(ExportError, match="disk is full") as info:
         export_bundle(tmp_path / "b", name="a", tiles=make_tiles(3), index_matrix=[[0, 1, 2]])
     assert info.value.errno == errno.ENOSPC and "nothing was written" in str(info.value)
@@ -434,7 +434,7 @@ def test_failure_while_replacing_keeps_the_old_bundle(tmp_path, monkeypatch):
     def broken(path, data):
         raise OSError(errno.EIO, "Input/output error")
 
-    monkeypatch.setattr(engine.export, "_write_bytes", broken)
+    monkeypatch.setattr(engine.export.folder, "_write_bytes", broken)
     with pytest.raises(ExportError, match="Input/output error"):
         export_bundle(out, name="a", tiles=make_tiles(2, rng=2), overwrite=True)
     assert {p.name: p.read_bytes() for p in out.iterdir()} == before

@@ -8,7 +8,7 @@ import pytest
 import tifffile
 from PIL import Image
 
-from engine.export._png import encode_png
+from engine.png import encode_png
 from engine.io import ImageError, load_image, save_image
 
 MODES = {1: "L", 2: "LA", 3: "RGB", 4: "RGBA"}

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.ndimage import distance_transform_edt
 
-from engine.export import quantize
+from engine.bitdepth import quantize
 from engine.materials import (
     apply_cut,
     blend_normals,
@@ -207,7 +207,7 @@ def test_exported_material_tiles_share_every_cut_and_keep_unit_normals(tmp_path)
     took each pixel from the same place; with the patches' cut blended it fails only inside
     their blend bands (the template is cut hard in both runs)."""
     from engine.export import export_bundle
-    from engine.export._png import decode_png
+    from engine.png import decode_png
     from engine.tiles.candidates import candidates
     from engine.tiles.seamless import make_seamless
 

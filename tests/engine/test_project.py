@@ -12,8 +12,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import engine.project as project_mod
-from engine.export._png import encode_png
+import engine.project.archive as project_mod
+from engine.png import encode_png
 from engine.project import (
     Candidate,
     Project,
@@ -136,7 +136,7 @@ def test_save_is_atomic(tmp_path, monkeypatch):
     def fail_replace(src, dst):
         raise OSError(28, "No space left on device")
 
-    monkeypatch.setattr(project_mod.os, "replace", fail_replace)
+    monkeypatch.setattr(os, "replace", fail_replace)
     with pytest.raises(ProjectError, match="cannot save") as info:
         save_project(path, make_project(8, rng=2))
     assert str(path) in str(info.value)

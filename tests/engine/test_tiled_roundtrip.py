@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from engine.export import export_bundle
-from engine.export._png import decode_png
+from engine.png import decode_png
 
 TILED = shutil.which("tiled")
 RASTERIZER = shutil.which("tmxrasterizer")  # Tiled's own map renderer, same Debian package

@@ -1,11 +1,5 @@
-"""Minimal exact PNG codec for 8/16-bit gray, gray+alpha, RGB and RGBA.
-
-Used where the bytes must round-trip exactly in memory (project files):
-Pillow drops 16-bit colour to 8 bits when reading, so 16-bit data is decoded
-here. Decoding checks the declared size against ``max_pixels`` before it
-inflates anything and caps the inflated size, so a crafted file cannot
-exhaust memory.
-"""
+"""The hand-written exact PNG codec (zlib + a numba unfilter) the engine used before
+``engine.png`` (libpng through imagecodecs): kept as the baseline of ``benchmarks/png.py``."""
 
 from __future__ import annotations
 

@@ -1,0 +1,165 @@
+"""Cross-field checks of a :class:`~engine.project.model.Project`, shared by building, saving
+and loading: names, versions, shapes of every map and tile, indices, rectangles, numbers."""
+
+from __future__ import annotations
+
+import math
+import numbers
+
+import numpy as np
+
+from engine.materials import MAP_KINDS, NORMAL_CONVENTIONS
+from engine.project.model import PROJECT_VERSION, SAFE_NAME, Candidate, Project
+
+__all__ = ["check_project", "finite_number"]
+
+
+def finite_number(v) -> bool:
+    if isinstance(v, bool) or not isinstance(v, numbers.Real):
+        return False
+    try:
+        return math.isfinite(v)
+    except OverflowError:  # an int beyond the float range
+        return False
+
+
+def check_project(p: Project, where: str) -> None:
+    """Cross-field checks shared by building, saving and loading; raises ValueError."""
+    if not isinstance(p, Project):
+        raise TypeError(f"{where} must be a Project, got {type(p).__name__}")
+    if not isinstance(p.name, str) or not SAFE_NAME.match(p.name) or len(p.name) > 100:
+        raise ValueError(
+            f"{where}: name must be a simple file-name part (letters, digits, . _ -), got "
+            f"{p.name!r}"
+        )
+    if p.version != PROJECT_VERSION:
+        raise ValueError(
+            f"{where}: version {p.version!r} is not supported (this build reads version "
+            f"{PROJECT_VERSION})"
+        )
+    if not isinstance(p.sources, dict) or not p.sources:
+        raise ValueError(f"{where}: sources must be a non-empty dict of map name -> image")
+    for m in p.sources:
+        if not isinstance(m, str) or not SAFE_NAME.match(m) or len(m) > 64:
+            raise ValueError(f"{where}: bad map name {m!r} (letters, digits, . _ - only)")
+    shapes = {m: np.shape(a) for m, a in p.sources.items()}
+    hw = shapes[p.main_map][:2]
+    for m, s in shapes.items():
+        if len(s) != 3 or s[:2] != hw:
+            raise ValueError(
+                f"{where}: source map {m!r} is shaped {s}; all maps must be (H, W, C) of the main "
+                f"map's size {hw}"
+            )
+    if p.normal_convention not in NORMAL_CONVENTIONS:
+        raise ValueError(
+            f"{where}: normal_convention must be one of {NORMAL_CONVENTIONS}, got "
+            f"{p.normal_convention!r}"
+        )
+    if p.bit_depth not in (8, 16) or isinstance(p.bit_depth, bool):
+        raise ValueError(f"{where}: bit_depth must be 8 or 16, got {p.bit_depth!r}")
+    for m, k in p.map_kinds.items():
+        if m not in p.sources or k not in MAP_KINDS:
+            raise ValueError(f"{where}: map_kinds has a bad entry {m!r}: {k!r}")
+    for m, w in p.map_weights.items():
+        if m not in p.sources or not finite_number(w) or w < 0:
+            raise ValueError(f"{where}: map_weights has a bad entry {m!r}: {w!r:.40}")
+    if p.template_rect is not None:
+        r = p.template_rect
+        if (
+            len(r) != 4
+            or any(isinstance(v, bool) or not isinstance(v, numbers.Integral) for v in r)
+            or r[2] < 1
+            or r[3] < 1
+            or r[0] < 0
+            or r[1] < 0
+        ):
+            raise ValueError(
+                f"{where}: template_rect must be 4 integers (x, y, w, h) with w, h >= 1, got {r!r}"
+            )
+    tile_shape = None
+
+    def check_tile(maps, what):
+        nonlocal tile_shape
+        if not isinstance(maps, dict) or list(maps) != list(p.sources):
+            raise ValueError(
+                f"{where}: {what} must have the maps {list(p.sources)}, got "
+                f"{list(maps) if isinstance(maps, dict) else type(maps).__name__}"
+            )
+        for m, a in maps.items():
+            s = np.shape(a)
+            if len(s) != 3 or s[2] != shapes[m][2]:
+                raise ValueError(
+                    f"{where}: {what}[{m!r}] is shaped {s}, expected (h, w, {shapes[m][2]})"
+                )
+            if tile_shape is None:
+                tile_shape = s[:2]
+            if s[:2] != tile_shape:
+                raise ValueError(
+                    f"{where}: {what}[{m!r}] is {s[1]}x{s[0]}, other tiles are "
+                    f"{tile_shape[1]}x{tile_shape[0]}"
+                )
+
+    if p.template is not None:
+        check_tile(p.template, "template")
+    for i, c in enumerate(p.candidates):
+        if not isinstance(c, Candidate):
+            raise TypeError(f"{where}: candidates[{i}] must be a Candidate")
+        check_tile(c.maps, f"candidates[{i}]")
+        if c.patch_origin is not None and (
+            len(c.patch_origin) != 2
+            or any(
+                isinstance(v, bool) or not isinstance(v, numbers.Integral) for v in c.patch_origin
+            )
+        ):
+            raise ValueError(
+                f"{where}: candidates[{i}].patch_origin must be (row, col) integers or None"
+            )
+        if c.seed is not None and (
+            isinstance(c.seed, bool)
+            or not isinstance(c.seed, numbers.Integral)
+            or not 0 <= c.seed < 2**64
+        ):
+            raise ValueError(
+                f"{where}: candidates[{i}].seed must be an integer in [0, 2**64) or None"
+            )
+        if c.score is not None and not finite_number(c.score):
+            raise ValueError(f"{where}: candidates[{i}].score must be a finite number or None")
+        if not isinstance(c.locked, bool) or not isinstance(c.params, dict):
+            raise ValueError(f"{where}: candidates[{i}].locked must be a bool and params a dict")
+    n = len(p.candidates)
+    for k in p.picks:
+        if isinstance(k, bool) or not isinstance(k, numbers.Integral) or not 0 <= k < n:
+            raise ValueError(f"{where}: picks must be candidate indices in [0, {n - 1}], got {k!r}")
+    if len(set(p.picks)) != len(p.picks):
+        raise ValueError(f"{where}: picks must not repeat a candidate")
+    if p.layout is not None:
+        lay = np.asarray(p.layout)
+        count = len(p.picks) if p.picks else n
+        if lay.ndim != 2 or lay.size == 0 or not np.issubdtype(lay.dtype, np.integer):
+            raise ValueError(
+                f"{where}: layout must be a non-empty 2-D integer matrix, got shape {lay.shape} "
+                f"{lay.dtype}"
+            )
+        if lay.min() < -1 or lay.max() >= count:
+            raise ValueError(
+                f"{where}: layout cells must be exported tile ids in [0, {count - 1}] or -1"
+            )
+    if not isinstance(p.waypoints, dict):
+        raise ValueError(f"{where}: waypoints must be a dict of seam key -> [(row, col), ...]")
+    for key, pts in p.waypoints.items():
+        for pt in pts:
+            if len(pt) != 2 or any(
+                isinstance(v, bool) or not isinstance(v, numbers.Integral) for v in pt
+            ):
+                raise ValueError(
+                    f"{where}: waypoints[{key!r}] must be (row, col) integer pairs, got {pt!r}"
+                )
+    if p.preview is not None:
+        if not isinstance(p.preview, dict) or set(p.preview) - set(p.sources):
+            raise ValueError(f"{where}: preview keys must be map names")
+        for m, a in p.preview.items():
+            if len(np.shape(a)) != 3 or np.shape(a)[2] != shapes[m][2]:
+                raise ValueError(f"{where}: preview[{m!r}] is shaped {np.shape(a)}")
+    for key in ("parameters", "seeds", "extra"):
+        if not isinstance(getattr(p, key), dict):
+            raise ValueError(f"{where}: {key} must be a dict")

@@ -1,0 +1,73 @@
+"""The project model: everything needed to reopen a tile-set session exactly, as plain data.
+
+Conventions: rectangles are ``(x, y, w, h)`` in source pixels; points are ``(row, col)``;
+``picks`` are candidate indices in export order (exported tile id ``k`` is
+``candidates[picks[k]]``); ``layout`` cells are exported tile ids, -1 = empty. Images are
+float32 (H, W, C) in [0, 1].
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = ["Candidate", "PROJECT_FORMAT", "PROJECT_SUFFIX", "PROJECT_VERSION", "Project"]
+
+PROJECT_FORMAT = "quilt-studio-project"
+PROJECT_VERSION = 1
+PROJECT_SUFFIX = ".quiltproj"
+SAFE_NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]*$")
+"""Project and map names: simple file-name parts (they name exported files)."""
+
+
+@dataclass
+class Candidate:
+    """One candidate tile: its images (one per map) and how it was made."""
+
+    maps: dict[str, np.ndarray]
+    patch_origin: tuple[int, int] | None = (
+        None  # (row, col) of the patch source in the source image
+    )
+    seed: int | None = None
+    locked: bool = False
+    score: float | None = None
+    params: dict = field(default_factory=dict)  # any JSON (patch size, seam method, waypoints ...)
+
+
+@dataclass
+class Project:
+    """Everything needed to reopen a tile-set session exactly."""
+
+    sources: dict[str, np.ndarray]  # map name -> float32 (H, W, C); the first is the main map
+    name: str = "tileset"
+    version: int = PROJECT_VERSION
+    source_paths: dict[str, str] = field(
+        default_factory=dict
+    )  # where the maps were loaded from (info)
+    map_kinds: dict[str, str] = field(default_factory=dict)
+    map_weights: dict[str, float] = field(
+        default_factory=dict
+    )  # seam-error weights; empty = main only
+    normal_convention: str = "opengl"
+    bit_depth: int = 8
+    parameters: dict = field(default_factory=dict)  # any JSON: every parameter of every step
+    seeds: dict = field(default_factory=dict)  # any JSON: named seeds
+    template_rect: tuple[int, int, int, int] | None = None  # (x, y, w, h)
+    template: dict[str, np.ndarray] | None = None  # the seamless template tile per map
+    candidates: list[Candidate] = field(default_factory=list)
+    picks: list[int] = field(default_factory=list)
+    layout: np.ndarray | None = None  # (rows, cols) exported tile ids, -1 = empty
+    waypoints: dict[str, list[tuple[int, int]]] = field(default_factory=dict)  # per seam key
+    preview: dict[str, np.ndarray] | None = None
+    extra: dict = field(default_factory=dict)  # any JSON the editor wants to keep
+
+    @property
+    def main_map(self) -> str:
+        return next(iter(self.sources))
+
+    def exported_tiles(self) -> list[dict[str, np.ndarray]]:
+        """The tiles an export writes: the picked candidates (all candidates if none picked)."""
+        order = self.picks if self.picks else range(len(self.candidates))
+        return [self.candidates[i].maps for i in order]
