@@ -57,11 +57,15 @@ def loads_bounded(raw: bytes, *, max_values: int = MAX_VALUES, max_depth: int = 
     opens = (bare == ord("[")) | (bare == ord("{"))
     count = 1 + int(np.count_nonzero(opens | (bare == ord(",")) | (bare == ord(":"))))
     if count > max_values:
-        raise JSONDataError(f"it holds about {count:,} values, over the limit of {max_values:,}; refused")
+        raise JSONDataError(
+            f"it holds about {count:,} values, over the limit of {max_values:,}; refused"
+        )
     closes = (bare == ord("]")) | (bare == ord("}"))
     depth = int(np.cumsum(opens.astype(np.int32) - closes).max(initial=0))
     if depth > max_depth:
-        raise JSONDataError(f"it is nested too deeply ({depth} levels, over the limit of {max_depth}); refused")
+        raise JSONDataError(
+            f"it is nested too deeply ({depth} levels, over the limit of {max_depth}); refused"
+        )
     try:
         return json.loads(raw.decode("utf-8"), parse_constant=_no_constant)
     except UnicodeDecodeError as exc:

@@ -286,10 +286,10 @@ def _check_out(out: Path) -> None:
 
 
 def _run(args) -> int:
-    from engine.events import Progress, drain
     from engine.bitdepth import quantize
-    from engine.png import encode_png
+    from engine.events import Progress, drain
     from engine.io import load_image
+    from engine.png import encode_png
     from engine.seams import SeamSpec
     from engine.tiles import (
         CandidateTile,

@@ -10,8 +10,8 @@ import pytest
 
 import resources
 from engine.cli import main
-from engine.png import decode_png, encode_png
 from engine.io import load_image
+from engine.png import decode_png, encode_png
 from engine.project import load_project
 from engine.tiles import assemble, candidates, make_seamless
 

@@ -8,8 +8,8 @@ import pytest
 import tifffile
 from PIL import Image
 
-from engine.png import encode_png
 from engine.io import ImageError, load_image, save_image
+from engine.png import encode_png
 
 MODES = {1: "L", 2: "LA", 3: "RGB", 4: "RGBA"}
 
