@@ -77,9 +77,9 @@ def add_parser(subparsers):
 
 
 def run(args) -> int:
+    from engine.bitdepth import quantize
     from engine.cli.synth import ProgressPrinter, check_output, drive
     from engine.errormap import colour_channels
-    from engine.export import quantize
     from engine.heal import iter_heal
     from engine.io import load_image, save_image
     from engine.seams import SeamSpec
