@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 import numbers
 
-__all__ = ["choice", "non_negative_number", "positive_int"]
+__all__ = ["as_size", "choice", "non_negative_number", "positive_int"]
 
 
 def positive_int(value, name: str, *, minimum: int = 1) -> int:
@@ -33,3 +33,20 @@ def choice(value: str, name: str, options) -> str:
     if value not in options:
         raise ValueError(f"{name} must be one of {', '.join(map(repr, options))}, got {value!r}")
     return value
+
+
+def as_size(value, name: str) -> tuple[int, int]:
+    """An int ``n`` -> (n, n); a pair ``(h, w)`` of ints -> (h, w); both >= 1."""
+    if isinstance(value, numbers.Integral) and not isinstance(value, bool):
+        pair = (int(value), int(value))
+    elif (
+        isinstance(value, (tuple, list))
+        and len(value) == 2
+        and all(isinstance(v, numbers.Integral) and not isinstance(v, bool) for v in value)
+    ):
+        pair = (int(value[0]), int(value[1]))
+    else:
+        raise TypeError(f"{name} must be an int or an (h, w) pair of ints, got {value!r}")
+    if min(pair) < 1:
+        raise ValueError(f"{name} must be >= 1, got {value!r}")
+    return pair

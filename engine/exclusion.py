@@ -10,14 +10,24 @@ one summed-area table in O(H·W).
 
 from __future__ import annotations
 
+import base64
 import numbers
+import zlib
 
 import numpy as np
 
 from engine._validate import as_image
 from engine.io import to_rgb
 
-__all__ = ["box_sums", "exclusion_mask", "valid_anchors"]
+__all__ = [
+    "MASK_KEY",
+    "box_sums",
+    "colour_range_around",
+    "exclusion_mask",
+    "mask_from_json",
+    "mask_to_json",
+    "valid_anchors",
+]
 
 
 def _bounds(value, name: str, channels: int) -> np.ndarray:
@@ -122,3 +132,51 @@ def valid_anchors(excluded, block_shape, *, extension=(0, 0)) -> np.ndarray:
         raise ValueError(f"extension must be two non-negative integers, got {extension!r}")
     box = (int(block_shape[0]) + int(extension[0]), int(block_shape[1]) + int(extension[1]))
     return box_sums(ex, box) == 0
+
+
+def colour_range_around(colour: str, tolerance: float):
+    """The (lo, hi) range of ``"#rrggbb"`` ± ``tolerance`` per channel, clipped to [0, 1]
+    (what the editor's picked colour excludes); None for no colour or a tolerance <= 0."""
+    if not colour or not tolerance or tolerance <= 0:
+        return None
+    rgb = [int(colour[i : i + 2], 16) / 255.0 for i in (1, 3, 5)]
+    return (
+        [max(0.0, v - tolerance) for v in rgb],
+        [min(1.0, v + tolerance) for v in rgb],
+    )
+
+
+#: the key of the excluded-pixel mask in a project's ``extra`` (the project has no field for it)
+MASK_KEY = "exclude_painted"
+
+
+def mask_to_json(mask) -> dict:
+    """``{MASK_KEY: ...}`` for a project's ``extra``: the (H, W) mask's shape and its
+    bit-packed, zlib-compressed bytes in base64; ``{}`` for no mask (None or all False)."""
+    if mask is None or not np.asarray(mask).any():
+        return {}
+    packed = zlib.compress(np.packbits(np.asarray(mask, bool)).tobytes(), 9)
+    return {
+        MASK_KEY: {
+            "shape": list(np.shape(mask)),
+            "packbits_zlib_base64": base64.b64encode(packed).decode("ascii"),
+        }
+    }
+
+
+def mask_from_json(extra, shape: tuple[int, int]) -> np.ndarray | None:
+    """The mask :func:`mask_to_json` stored in ``extra``; None if absent or not a mask of
+    ``shape`` (a damaged entry is dropped, the rest of the project opens)."""
+    entry = extra.get(MASK_KEY) if isinstance(extra, dict) else None
+    if not isinstance(entry, dict) or entry.get("shape") != list(shape):
+        return None
+    n = int(shape[0]) * int(shape[1])
+    try:
+        raw = base64.b64decode(entry["packbits_zlib_base64"], validate=True)
+        bits = zlib.decompressobj().decompress(raw, (n + 7) // 8 + 1)
+    except (KeyError, TypeError, ValueError, zlib.error):
+        return None
+    if len(bits) != (n + 7) // 8:
+        return None
+    mask = np.unpackbits(np.frombuffer(bits, np.uint8), count=n).astype(bool).reshape(shape)
+    return mask if mask.any() else None

@@ -8,10 +8,12 @@ engine calls. Keeping the table here means a new option is one line, not three w
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import re
 from dataclasses import dataclass
 from typing import Any
 
+from engine.exclusion import colour_range_around
 from engine.seams.spec import (
     BLEND_MODES,
     METHODS,
@@ -21,9 +23,11 @@ from engine.seams.spec import (
     OSCILLATING_VARIANTS,
     SeamSpec,
 )
+from engine.settings import TilesetSettings, settings_from_parameters
 
 SEAM_METHODS = METHODS
 BLENDS = BLEND_MODES
+SAME = "same"  # template_blend: as the patches' blending
 QUILT_SELECTIONS = ("best", "sampled", "random", "bhatia")
 QUILT_SEAMS = ("straight", *SEAM_METHODS)
 
@@ -100,6 +104,17 @@ PARAMS: tuple[Param, ...] = (
         2,
         256,
     ),
+    _P(
+        "joint_weight",
+        TilesetSettings().joint_weight,
+        "Joint weight",
+        "Weight of the tile's natural wrap joint in the template search: the tile edge falls "
+        "where the texture is calm (0 = strip mismatch only, as in the paper).",
+        "Template",
+        0.0,
+        4.0,
+        step=0.1,
+    ),
     # -- seam
     _P(
         "method",
@@ -141,6 +156,15 @@ PARAMS: tuple[Param, ...] = (
         64,
     ),
     _P("rho", 3, "rho", "Adaptive blending strength (Somol & Haindl, default 3).", "Seam", 0, 16),
+    _P(
+        "template_blend",
+        SAME,
+        "Template blending",
+        "Blending of the seamless tile's two cuts: the same as the patches' (Blending above), "
+        "or its own (quilt-studio tileset leaves the template's cuts hard by default).",
+        "Seam",
+        choices=(SAME, *BLEND_MODES),
+    ),
     # -- candidates
     _P(
         "n_candidates",
@@ -510,7 +534,8 @@ DEFAULTS: dict[str, Any] = {p.key: p.default for p in PARAMS}
 SEAM_OPTION_KEYS = frozenset(p.key for p in PARAMS if p.group == "Seam options")
 #: Parameters whose change invalidates the seamless tile (and everything after it).
 SEAMLESS_KEYS = (
-    frozenset({"overlap", "method", "metric", "blend", "width", "rho"}) | SEAM_OPTION_KEYS
+    frozenset({"overlap", "method", "metric", "blend", "width", "rho", "template_blend"})
+    | SEAM_OPTION_KEYS
 )
 PREVIEW_KEYS = frozenset({"preview_rows", "preview_cols", "no_equal_neighbours", "layout_seed"})
 #: Parameters whose change re-runs a shown quilting / transfer result (the brush only paints).
@@ -532,11 +557,7 @@ def coerce_all(values: dict) -> dict:
 def seam_option_keys(method: str) -> frozenset[str]:
     """The "Seam options" parameters that seam ``method`` uses (the others do nothing)."""
     allowed = OPTIONS.get(method, {})
-    names = {
-        "variant": "minimax_variant" if method == "minimax" else "osc_variant",
-        "init": "osc_init",
-    }
-    return frozenset(names.get(k, k) for k in allowed if names.get(k, k) in BY_KEY)
+    return frozenset(_option_key(k, method) for k in allowed if _option_key(k, method) in BY_KEY)
 
 
 def seam_spec(p: dict) -> SeamSpec:
@@ -554,13 +575,98 @@ def seam_spec(p: dict) -> SeamSpec:
 
 def seam_options(p: dict, method: str) -> dict:
     """The options seam ``method`` takes (engine.seams.OPTIONS), from the parameters."""
-    allowed = OPTIONS.get(method, {})
-    values = {
-        "o_max": p["o_max"],
-        "max_run": p["max_run"],
-        "connectivity": int(p["connectivity"]),
-        "levels": p["levels"],
-        "variant": p["minimax_variant"] if method == "minimax" else p["osc_variant"],
-        "init": p["osc_init"],
+    opts = {k: p[_option_key(k, method)] for k in OPTIONS.get(method, {})}
+    if "connectivity" in opts:
+        opts["connectivity"] = int(opts["connectivity"])  # a choice of "8" / "4" on screen
+    return opts
+
+
+# ------------------------------------------------------------------ the tile set's settings
+#: editor parameters that are a TilesetSettings field of another name
+_RENAMED = {"n_candidates": "candidates"}
+#: editor parameters that make up one settings field (or its seam)
+_COMPOSED = frozenset(
+    {"method", "metric", "blend", "width", "rho", "template_blend"}
+    | {"preview_rows", "preview_cols", "exclude_color", "exclude_tolerance"}
+)
+_FIELDS = {f.name for f in dataclasses.fields(TilesetSettings)}
+#: the parameters :func:`tileset_settings` reads (the other parameters are the editor's own)
+TILESET_KEYS = frozenset(k for k in BY_KEY if k in _FIELDS or k in _RENAMED or k in _COMPOSED) - {
+    "exclude_color",
+    "exclude_tolerance",
+}
+
+
+def tileset_settings(p: dict) -> TilesetSettings:
+    """The :class:`engine.tiles.TilesetSettings` of the editor's parameters ``p``."""
+    values = {_RENAMED.get(k, k): p[k] for k in BY_KEY if _RENAMED.get(k, k) in _FIELDS}
+    values.update(
+        tile_max=max(p["tile_min"], p["tile_max"]),
+        seam=seam_spec(p),
+        template_blend=None if p["template_blend"] == SAME else p["template_blend"],
+        patch_size=p["patch_size"] or None,
+        patch_overlap=p["patch_overlap"] if p["patch_overlap"] >= 2 else None,  # 0: auto
+        preview=(p["preview_rows"], p["preview_cols"]),
+        exclude_color=colour_range_around(p["exclude_color"], p["exclude_tolerance"]),
+    )
+    return TilesetSettings(**values)
+
+
+def settings_params(s: TilesetSettings) -> dict:
+    """The editor's parameters for settings ``s`` (values it cannot show are left out: an
+    (h, w) tile range becomes its smallest and largest side; the excluded colour range of
+    the command line arrives as excluded pixels, see :mod:`quilt_gui.project_io`)."""
+    out = {}
+    for k in BY_KEY:
+        name = _RENAMED.get(k, k)
+        if name in _FIELDS and k not in _COMPOSED:
+            value = getattr(s, name)
+            if isinstance(value, tuple):  # a size (h, w)
+                value = max(value) if k == "tile_max" else min(value)
+            if value is not None:
+                out[k] = value
+    seam = s.seam
+    out.update(
+        method=seam.method,
+        metric=seam.metric,
+        blend=seam.blend,
+        width=round(seam.width),
+        rho=seam.rho,
+        template_blend=SAME if s.template_blend is None else s.template_blend,
+        preview_rows=s.preview[0],
+        preview_cols=s.preview[1],
+        patch_overlap=s.patch_overlap or 0,
+        patch_size=min(s.patch_size) if s.patch_size else 0,
+        layout_seed=s.seed if s.layout_seed is None else s.layout_seed,
+    )
+    for option, value in seam.options.items():
+        key = _option_key(option, seam.method)
+        out[key] = str(value) if key == "connectivity" else value
+    return out
+
+
+def project_parameters(p: dict) -> dict:
+    """A project's ``parameters``: the tile set's settings and the editor's own parameters."""
+    return {
+        "tileset": tileset_settings(p).to_dict(),
+        "editor": {k: v for k, v in p.items() if k not in TILESET_KEYS},
     }
-    return {k: v for k, v in values.items() if k in allowed}
+
+
+def from_project_parameters(parameters: dict, seeds: dict | None = None) -> dict:
+    """The editor's parameters of a project: its own (``parameters["editor"]``, or the flat
+    keys of older files), then the tile set's settings (any version, the command line's too)."""
+    own = parameters.get("editor")
+    out = coerce_all(own if isinstance(own, dict) else parameters)
+    settings = settings_from_parameters(parameters, seeds or {})
+    for k, v in settings_params(settings).items():
+        with contextlib.suppress(TypeError, ValueError):
+            out[k] = BY_KEY[k].coerce(v)
+    return out
+
+
+def _option_key(option: str, method: str) -> str:
+    """The parameter of seam ``option`` of ``method`` (the two variants have their own)."""
+    if option == "variant":
+        return "minimax_variant" if method == "minimax" else "osc_variant"
+    return "osc_init" if option == "init" else option

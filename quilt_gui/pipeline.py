@@ -131,7 +131,7 @@ class Pipeline(QObject):
         if doc.source is None:
             self.message.emit("warning", "Open a source image first.")
             return None
-        p = doc.params
+        s = self.settings()
         self._template_old_rect = doc.tileset.template_rect
         self.template_searching.emit(True)
         return self.jobs.start(
@@ -140,9 +140,10 @@ class Pipeline(QObject):
             doc.source.main,
             label="Finding the best tile",
             exclusion=self.exclusion(),
-            tile_min=p["tile_min"],
-            tile_max=max(p["tile_min"], p["tile_max"]),
-            overlap=p["overlap"],
+            tile_min=s.tile_min,
+            tile_max=s.tile_max,
+            overlap=s.overlap,
+            joint_weight=s.joint_weight,
             on_event=self._on_template_event,
             on_done=self._on_template_done,
             on_error=self._on_template_error,
@@ -185,7 +186,12 @@ class Pipeline(QObject):
         if doc.source is None or doc.tileset.template_rect is None:
             return None
         wps = {k: list(v) for k, v in doc.tileset.waypoints.items() if v}
-        kwargs = dict(overlap=doc.params["overlap"], waypoints=wps or None, **self._cut_options())
+        kwargs = dict(
+            overlap=doc.params["overlap"],
+            waypoints=wps or None,
+            seam=self.seam_spec(),
+            **self._maps(),
+        )
         inputs = (
             doc.tileset.template_rect,
             tuple(sorted((k, repr(v)) for k, v in kwargs.items() if k != "maps")),
@@ -245,15 +251,17 @@ class Pipeline(QObject):
         if not isinstance(exc, Cancelled):
             self._error(exc)
 
-    def seam_spec(self):
-        """The seam of the seamless tile and the candidates, from the parameters."""
-        return params.seam_spec(self.doc.params)
+    def settings(self):
+        """The tile set's :class:`engine.tiles.TilesetSettings`, from the parameters."""
+        return params.tileset_settings(self.doc.params)
 
-    def _cut_options(self) -> dict:
-        """The seam and the material maps (with their seam-error weights) of the seamless
-        tile and the candidates."""
+    def seam_spec(self):
+        """The seamless tile's cut (the candidates' is ``settings().seam``)."""
+        return self.settings().template_seam
+
+    def _maps(self) -> dict:
+        """The material maps and their seam-error weights."""
         return dict(
-            seam=self.seam_spec(),
             maps=self.doc.source.extra_maps or None,
             weights=self.doc.tileset.engine_weights(),
         )
@@ -262,13 +270,14 @@ class Pipeline(QObject):
     def _tile_options(self) -> dict:
         """Seam and patch options of the candidate calls (from the parameters), with the
         ``exclusion`` that :func:`excluding` turns into their ``excluded`` mask."""
-        p = self.doc.params
+        s = self.settings()
         return dict(
             exclusion=self.exclusion(),
-            patch_size=p["patch_size"] or None,
-            patch_overlap=p["patch_overlap"] or None,
-            margin=p["margin"],
-            **self._cut_options(),
+            patch_size=s.patch_size,
+            patch_overlap=s.patch_overlap,
+            margin=s.margin,
+            seam=s.seam,
+            **self._maps(),
         )
 
     def _template_ready(self) -> bool:
@@ -325,7 +334,8 @@ class Pipeline(QObject):
         self.jobs.abort_matching("candidate:")
         self._gen_old = (list(doc.tileset.candidates), list(doc.tileset.picks))
         doc.tileset.apply_candidates(keep, [k for _, k in sorted(keep_picks)])
-        n = int(doc.params["n_candidates"]) - len(keep)
+        s = self.settings()
+        n = s.candidates - len(keep)
         self._gen_wanted, self._gen_next, self._gen_waiting = max(0, n), 0, {}
         if n <= 0:
             self._on_candidates_done([])
@@ -337,8 +347,8 @@ class Pipeline(QObject):
             doc.tileset.seamless,
             n,
             label=f"Generating {n} candidates",
-            rng=int(doc.params["seed"]),
-            neighbourhood=doc.params["neighbourhood"],
+            rng=s.seed,
+            neighbourhood=s.neighbourhood,
             workers=2,
             on_event=self._on_candidate_event,
             on_done=self._on_candidates_done,
@@ -391,7 +401,7 @@ class Pipeline(QObject):
         if origin is None:
             kw.update(
                 rng=int(np.random.default_rng().integers(2**31)),
-                neighbourhood=doc.params["neighbourhood"],
+                neighbourhood=self.settings().neighbourhood,
             )
             text = f"Re-roll candidate #{index + 1}"
         else:
@@ -436,7 +446,7 @@ class Pipeline(QObject):
                 doc.tileset.apply_layout(None)
                 doc.tileset.apply_preview(None, None)
             return
-        p = doc.params
+        s = self.settings()
         weights = [e.weight for e in doc.tileset.picked_entries()]
         self.jobs.start(
             "preview",
@@ -444,10 +454,10 @@ class Pipeline(QObject):
             tiles,
             doc.source.main,
             label="Preview",
-            rows=p["preview_rows"],
-            cols=p["preview_cols"],
-            seed=p["layout_seed"],
-            no_equal_neighbours=p["no_equal_neighbours"],
+            rows=s.preview[0],
+            cols=s.preview[1],
+            seed=s.layout_seed,
+            no_equal_neighbours=s.no_equal_neighbours,
             weights=weights,
             on_done=self._on_preview_done,
             on_error=self._error,
@@ -580,13 +590,6 @@ def make_preview(tiles, source, *, rows, cols, seed, no_equal_neighbours, weight
     return layout, image, score
 
 
-def parse_color(text: str) -> tuple[float, float, float] | None:
-    """ "#rrggbb" -> (r, g, b) in [0, 1]; "" -> None."""
-    if not text:
-        return None
-    return tuple(int(text[i : i + 2], 16) / 255.0 for i in (1, 3, 5))
-
-
 def quilt_options(p: dict) -> dict:
     """Keyword options of :func:`engine.quilting.iter_quilt` from the parameters."""
     return dict(
@@ -611,15 +614,9 @@ def quilt_options(p: dict) -> dict:
 
 def excluded_mask(sample: np.ndarray, color: str, tolerance: float, painted=None):
     """Sample pixels within ``tolerance`` of ``color`` (per channel) or painted; None if none."""
-    from engine.exclusion import exclusion_mask
+    from engine.exclusion import colour_range_around, exclusion_mask
 
-    rgb = parse_color(color)
-    color_range = None
-    if rgb is not None and tolerance > 0:
-        color_range = (
-            [max(0.0, v - tolerance) for v in rgb],
-            [min(1.0, v + tolerance) for v in rgb],
-        )
+    color_range = colour_range_around(color, tolerance)
     if color_range is None and (painted is None or not painted.any()):
         return None
     return exclusion_mask(sample, color_range=color_range, painted=painted)

@@ -7,11 +7,9 @@ replaces the whole document by a project (the undo history starts empty).
 
 from __future__ import annotations
 
-import base64
-import zlib
-
 import numpy as np
 
+from engine.exclusion import mask_from_json, mask_to_json
 from engine.project import Candidate, Project
 from quilt_gui import params
 from quilt_gui.model import WAYPOINT_KEYS, CandidateEntry, Source
@@ -59,7 +57,7 @@ def to_project(doc) -> Project:
         map_kinds=dict(doc.source.kinds),
         map_weights={k: v for k, v in ts.map_weights.items() if k in doc.source.maps},
         bit_depth=doc.source.bit_depth,
-        parameters=dict(doc.params),
+        parameters=params.project_parameters(doc.params),
         seeds={"candidates": doc.params["seed"], "layout": doc.params["layout_seed"]},
         template_rect=ts.template_rect,
         template=template,
@@ -68,7 +66,7 @@ def to_project(doc) -> Project:
         layout=layout,
         waypoints={k: [tuple(p) for p in v] for k, v in ts.waypoints.items()},
         preview=preview,
-        extra={"editor": "quilt-studio", **_painted_extra(doc.exclude_painted)},
+        extra={"editor": "quilt-studio", **mask_to_json(doc.exclude_painted)},
     )
 
 
@@ -81,7 +79,7 @@ def apply_project(doc, project: Project, path: str | None) -> None:
         kinds=dict(project.map_kinds),
     )
     doc.set_source(source, name=project.name)
-    doc.params = params.coerce_all(project.parameters)
+    doc.params = params.from_project_parameters(project.parameters, project.seeds)
     ts = doc.tileset
     ts.template_rect = (
         None if project.template_rect is None else tuple(int(v) for v in project.template_rect)
@@ -108,46 +106,11 @@ def apply_project(doc, project: Project, path: str | None) -> None:
     if project.preview is not None:
         ts.preview = next(iter(project.preview.values()))
     doc.project_path = path
-    doc.apply_painted(_painted_from_extra(project.extra, source.shape))
+    doc.apply_painted(mask_from_json(project.extra, source.shape))
     doc.params_changed.emit(frozenset(doc.params))
     ts.emit_all()
     doc.path_changed.emit()
     doc.mark_saved()
-
-
-PAINTED_KEY = "exclude_painted"
-
-
-def _painted_extra(mask: np.ndarray | None) -> dict:
-    """The painted exclusion as JSON for ``Project.extra`` (the project format has no field
-    for it): shape and the bit-packed, zlib-compressed mask in base64."""
-    if mask is None or not mask.any():
-        return {}
-    packed = zlib.compress(np.packbits(np.asarray(mask, bool)).tobytes(), 9)
-    return {
-        PAINTED_KEY: {
-            "shape": list(mask.shape),
-            "packbits_zlib_base64": base64.b64encode(packed).decode("ascii"),
-        }
-    }
-
-
-def _painted_from_extra(extra: dict, shape: tuple[int, int]) -> np.ndarray | None:
-    """The painted exclusion saved by :func:`_painted_extra`; None if absent or not a mask of
-    the source's ``shape`` (a damaged entry is dropped, the rest of the project opens)."""
-    entry = extra.get(PAINTED_KEY) if isinstance(extra, dict) else None
-    if not isinstance(entry, dict) or entry.get("shape") != list(shape):
-        return None
-    n = int(shape[0]) * int(shape[1])
-    try:
-        raw = base64.b64decode(entry["packbits_zlib_base64"], validate=True)
-        bits = zlib.decompressobj().decompress(raw, (n + 7) // 8 + 1)
-    except (KeyError, TypeError, ValueError, zlib.error):
-        return None
-    if len(bits) != (n + 7) // 8:
-        return None
-    mask = np.unpackbits(np.frombuffer(bits, np.uint8), count=n).astype(bool).reshape(shape)
-    return mask if mask.any() else None
 
 
 def _rect(value) -> tuple[int, int, int, int] | None:

@@ -4,8 +4,11 @@ Writes into DIR (created if needed):
 
 - ``template.png``: the seamless template tile;
 - ``tile_000.png`` ...: every candidate (``tile_000_<map>.png`` for material maps);
-- ``manifest.json``: parameters, seed, template rectangle and costs, per-tile source
-  rectangle, seed and scores, picks, layout, warnings;
+- ``manifest.json``: the settings as given (:class:`engine.tiles.TilesetSettings`;
+  ``--settings manifest.json`` runs them again) and as used (``resolved``: every value chosen
+  from the source filled in), seed,
+  template rectangle and costs, per-tile source rectangle, seed and scores, picks, layout,
+  warnings;
 - ``layout.csv`` / ``layout.json``: the preview's index matrix (cells are tile indices,
   i.e. the NNN of ``tile_NNN.png``);
 - ``preview.png``: the picked tiles assembled by that matrix.
@@ -25,8 +28,6 @@ import sys
 import time
 from pathlib import Path
 
-import numpy as np
-
 from engine._fs import write_bytes_atomically
 from engine.cli._args import (
     add_exclusion,
@@ -36,9 +37,11 @@ from engine.cli._args import (
     non_negative_float,
 )
 from engine.cli.export import add_project_option, save_project_option
+from engine.seams.spec import BLEND_MODES, METHODS, METRICS
+from engine.settings import TilesetSettings
 
 FORMAT = "quilt-studio-tileset"
-VERSION = 1
+VERSION = 2  # 2: "settings" (TilesetSettings.to_dict()) replaces "parameters"
 MAIN_MAP = "albedo"  # the source's map name in a project file
 
 
@@ -88,37 +91,39 @@ def _named(kind: str):
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
-    from engine.blend import BLEND_MODES
-    from engine.errormap import METRICS
-    from engine.seams import METHODS
-
+    d = TilesetSettings()
     p = subparsers.add_parser(
         "tileset",
         help="make a seamless template tile and N mutually connectable candidate tiles",
         description="Search the template tile in SOURCE, make it seamless, derive N candidate "
         "tiles that all connect to each other (Somol & Haindl), and write them with a "
-        "manifest, an index matrix and a synthesized preview into DIR.",
+        "manifest, an index matrix and a synthesized preview into DIR. Options not given "
+        "come from --settings (if given), else the workflow's defaults.",
     )
     p.add_argument("source", metavar="SOURCE", help="source texture (PNG, JPEG, TIFF, BMP, WebP)")
     p.add_argument("--out", required=True, metavar="DIR", help="output folder (created)")
     p.add_argument(
+        "--settings",
+        metavar="FILE",
+        default=None,
+        help="start from the settings of an earlier run: its manifest.json or a .quiltproj "
+        "project (the editor's too)",
+    )
+    p.add_argument(
         "--candidates",
         type=int_at_least(1),
-        default=30,
         metavar="N",
-        help="number of candidate tiles (default 30)",
+        help=f"number of candidate tiles (default {d.candidates})",
     )
     p.add_argument(
         "--tile-min",
         type=_size,
-        default=None,
         metavar="N|HxW",
         help="smallest tile (default: a quarter of the source's shorter side)",
     )
     p.add_argument(
         "--tile-max",
         type=_size,
-        default=None,
         metavar="N|HxW",
         help="largest tile (default: --tile-min if given, else half the source's shorter side)",
     )
@@ -131,59 +136,57 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument(
         "--joint-weight",
         type=non_negative_float,
-        default=None,
         metavar="L",
         help="weight of the tile's natural wrap joint in the template search, so the tile edge "
-        "falls where the texture is calm (default 0.5; 0 = strip mismatch only, as in the paper)",
+        f"falls where the texture is calm (default {d.joint_weight}; 0 = strip mismatch only, "
+        "as in the paper)",
     )
     p.add_argument(
         "--overlap",
         type=int_at_least(2),
-        default=None,
         metavar="N",
         help="w_T, width of the template's border regions (default: tile/10)",
     )
     p.add_argument(
         "--patch-overlap",
         type=int_at_least(2),
-        default=None,
         metavar="N",
         help="w_P, the ring the patch cut runs in (default: min(w_T, max(8, w_T // 2)) of the "
         "template overlap w_T, see engine.tiles.default_patch_overlap)",
     )
     p.add_argument(
-        "--patch-size",
-        type=_size,
-        default=None,
-        metavar="N|HxW",
-        help="patch window (default: the tile size)",
+        "--patch-size", type=_size, metavar="N|HxW", help="patch window (default: the tile size)"
     )
     p.add_argument(
         "--margin",
         type=int_at_least(0),
-        default=None,
         metavar="N",
         help="outer pixels every candidate keeps from the template (default 2, at most w_P - 1)",
     )
     p.add_argument(
         "--neighbourhood",
         type=int_at_least(0),
-        default=5,
         metavar="N",
-        help="refine each random patch position within +-N px (default 5)",
+        help=f"refine each random patch position within +-N px (default {d.neighbourhood})",
     )
-    p.add_argument("--seam", choices=METHODS, default="dp", help="seam method (default dp)")
+    p.add_argument("--seam", choices=METHODS, help=f"seam method (default {d.seam.method})")
     add_seam_options(p)
-    p.add_argument("--metric", choices=METRICS, default="euclid", help="error metric")
+    p.add_argument("--metric", choices=METRICS, help=f"error metric (default {d.seam.metric})")
     p.add_argument(
         "--blend",
         choices=BLEND_MODES,
-        default=None,
-        help="blending of every cut (default: none for the template, adaptive for the patches)",
+        help=f"blending of every cut (default: {d.template_blend} for the template, "
+        f"{d.seam.blend} for the patches)",
     )
-    p.add_argument("--rho", type=int_at_least(0), default=3, help="adaptive blending ρ")
-    p.add_argument("--width", type=int_at_least(0), default=4, help="feather width in px")
-    p.add_argument("--seed", type=int_at_least(0), default=0, help="random seed (default 0)")
+    p.add_argument(
+        "--rho", type=int_at_least(0), help=f"adaptive blending ρ (default {d.seam.rho})"
+    )
+    p.add_argument(
+        "--width",
+        type=non_negative_float,
+        help=f"feather width in px (default {d.seam.width:g})",
+    )
+    p.add_argument("--seed", type=int_at_least(0), help=f"random seed (default {d.seed})")
     p.add_argument(
         "--pick",
         type=_picks,
@@ -194,13 +197,13 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument(
         "--preview",
         type=_grid,
-        default=(8, 8),
         metavar="RxC",
-        help="preview grid in tiles (default 8x8)",
+        help="preview grid in tiles (default {}x{})".format(*d.preview),
     )
     p.add_argument(
         "--equal-neighbours",
         action="store_true",
+        default=None,
         help="allow equal neighbouring tiles in the preview's index matrix",
     )
     p.add_argument("--workers", type=int_at_least(1), default=2, help="threads (default 2)")
@@ -224,6 +227,74 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     add_project_option(p)
     p.set_defaults(func=run)
     return p
+
+
+# ---------------------------------------------------------------- settings from the flags
+#: flag -> settings field, for the flags that are one field each
+_FIELDS = {
+    "tile_min": "tile_min",
+    "tile_max": "tile_max",
+    "overlap": "overlap",
+    "joint_weight": "joint_weight",
+    "candidates": "candidates",
+    "seed": "seed",
+    "patch_size": "patch_size",
+    "patch_overlap": "patch_overlap",
+    "margin": "margin",
+    "neighbourhood": "neighbourhood",
+    "preview": "preview",
+    "exclude_color": "exclude_color",
+}
+
+
+def settings_from_args(args) -> TilesetSettings:
+    """The run's settings: ``--settings FILE`` (or the defaults) with every given flag on top.
+    A flag's bad value raises ValueError naming the flag."""
+    base = read_settings(args.settings) if args.settings else TilesetSettings()
+    changes = {f: getattr(args, a) for a, f in _FIELDS.items() if getattr(args, a) is not None}
+    if args.tile_min is not None and args.tile_max is None:
+        changes["tile_max"] = args.tile_min  # a fixed size unless a range is asked for
+    if args.equal_neighbours:
+        changes["no_equal_neighbours"] = False
+    seam = {"method": args.seam, "metric": args.metric, "width": args.width, "rho": args.rho}
+    seam = {k: v for k, v in seam.items() if v is not None}
+    if args.blend is not None:
+        seam["blend"] = args.blend
+        changes["template_blend"] = None  # --blend sets every cut
+    if args.seam_option:
+        seam["options"] = {
+            **(base.seam.options if "method" not in seam else {}),
+            **dict(args.seam_option),
+        }
+    try:
+        if seam:
+            changes["seam"] = base.seam.replace(**seam)
+        return base.replace(**changes)
+    except TypeError as exc:  # a bad --seam-option, named by the settings
+        raise ValueError(str(exc)) from None
+
+
+def read_settings(path) -> TilesetSettings:
+    """The settings of a manifest.json (``settings``), a .quiltproj project or a JSON file of
+    settings."""
+    from engine.settings import settings_from_parameters
+
+    p = Path(path)
+    if p.suffix.lower() == ".quiltproj":
+        from engine.project import load_project
+
+        project = load_project(p)
+        return settings_from_parameters(project.parameters, project.seeds)
+    try:
+        data = json.loads(p.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise ValueError(f"--settings {p}: cannot be read ({exc})") from None
+    if isinstance(data, dict) and isinstance(data.get("settings"), dict):
+        data = data["settings"]
+    try:
+        return TilesetSettings.from_dict(data)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"--settings {p}: {exc}") from None
 
 
 # ---------------------------------------------------------------- running
@@ -251,18 +322,18 @@ def run(args) -> int:
     """Run the command; engine warnings become ``warning:`` lines on stderr (and the manifest)."""
     import warnings
 
-    if args.pick is not None and max(args.pick) >= args.candidates:
-        bad = [k for k in args.pick if k >= args.candidates]
-        raise ValueError(f"--pick {bad} out of range: --candidates is {args.candidates}")
+    settings = settings_from_args(args)
+    if args.pick is not None and max(args.pick) >= settings.candidates:
+        bad = [k for k in args.pick if k >= settings.candidates]
+        raise ValueError(f"--pick {bad} out of range: --candidates is {settings.candidates}")
+    rect = _parse_rect(args.rect) if args.rect else None
     out = Path(args.out)
     created = not out.exists()
     _check_out(out)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
-            code = _run(args)
-        except TypeError as exc:  # a bad --seam-option, named by the engine
-            raise ValueError(str(exc)) from None
+            code = _run(args, settings, rect)
         finally:
             if created and out.is_dir() and not any(out.iterdir()):
                 out.rmdir()  # nothing written: leave no empty folder behind
@@ -285,23 +356,32 @@ def _check_out(out: Path) -> None:
         raise ValueError(f"--out {out}: cannot write there ({write_problem(out, exc)})") from None
 
 
-def _run(args) -> int:
-    from engine.bitdepth import quantize
-    from engine.events import Progress, drain
+def _events(say, n: int):
+    """The progress line of each event worth one."""
+    from engine.events import Progress
+    from engine.tiles import CandidateTile, TemplateUpdate
+
+    done = [0]
+
+    def on_event(ev):
+        if isinstance(ev, TemplateUpdate):
+            say(f"template: {ev.phase} rect {ev.rect} cost {ev.cost:.4f}")
+        elif isinstance(ev, CandidateTile):
+            done[0] += 1
+            say(
+                f"candidate {ev.index:3d} ({done[0]}/{n}): patch {ev.patch_rect}, criterion "
+                f"{ev.scores['criterion']:.2f}, changed {ev.scores['changed']:.0%}"
+            )
+        elif isinstance(ev, Progress) and ev.message.endswith("cancelled"):
+            say(ev.message)
+
+    return on_event
+
+
+def _run(args, settings: TilesetSettings, rect) -> int:
+    from engine.events import drain
     from engine.io import load_image
-    from engine.png import encode_png
-    from engine.seams import SeamSpec
-    from engine.tiles import (
-        CandidateTile,
-        TemplateUpdate,
-        default_patch_overlap,
-        iter_candidates,
-        iter_find_template,
-        iter_make_seamless,
-        random_layout,
-        template_cost,
-    )
-    from engine.tiles.template import JOINT_WEIGHT
+    from engine.tiles.pipeline import iter_tileset
 
     say = _Reporter()
     loaded = load_image(args.source)
@@ -314,7 +394,8 @@ def _run(args) -> int:
             raise ValueError(f"--map {name}: duplicate or reserved map name")
         maps[name] = load_image(path).pixels
     weights = dict(args.weight) or None
-    excluded = excluded_pixels(args, S, "source")
+    given = argparse.Namespace(exclude_color=settings.exclude_color, exclude_mask=args.exclude_mask)
+    excluded = excluded_pixels(given, S, "source")
     if excluded is not None:
         say(f"excluded: {int(excluded.sum())} of {H * W} source pixels")
         if excluded.all():
@@ -322,123 +403,56 @@ def _run(args) -> int:
                 f"--exclude-color / --exclude-mask exclude every pixel of {args.source}: "
                 "no tile can be taken from it"
             )
-
-    tmpl_blend = args.blend or "none"
-    cand_blend = args.blend or "adaptive"
-    seam = SeamSpec(
-        args.seam, dict(args.seam_option), metric=args.metric, width=args.width, rho=args.rho
-    )
-    short = min(H, W)
-    tile_min = args.tile_min if args.tile_min is not None else max(8, short // 4)
-    tile_max = args.tile_max if args.tile_max is not None else max(8, short // 2)
-    if args.tile_min is not None and args.tile_max is None:
-        tile_max = tile_min
-    warn_list: list[str] = []
-
-    # 1. template rectangle
-    joint = JOINT_WEIGHT if args.joint_weight is None else args.joint_weight
-    if args.rect:
-        rect = _parse_rect(args.rect)
-        from engine.tiles import default_overlap
-
-        overlap = args.overlap or default_overlap((rect[3], rect[2]))
-        cost = template_cost(S, rect, overlap=overlap, excluded=excluded, joint_weight=joint)[0]
-        say(f"template: fixed rectangle {rect}, overlap {overlap}")
-    else:
-
-        def on_template(ev):
-            if isinstance(ev, TemplateUpdate):
-                say(f"template: {ev.phase} rect {ev.rect} cost {ev.cost:.4f}")
-
-        tmpl = drain(
-            iter_find_template(
-                S,
-                tile_min=tile_min,
-                tile_max=tile_max,
-                overlap=args.overlap,
-                excluded=excluded,
-                joint_weight=joint,
-            ),
-            on_template,
-        )
-        rect, overlap, cost = tmpl.rect, tmpl.overlap, tmpl.cost
-        warn_list += list(tmpl.warnings)
-
-    # 2. seamless tile
-    st = drain(
-        iter_make_seamless(
+    if rect is not None:
+        say(f"template: fixed rectangle {rect}")
+    result = drain(
+        iter_tileset(
             S,
-            rect,
-            overlap=overlap,
-            seam=seam.replace(blend=tmpl_blend),
+            settings,
+            rect=rect,
             maps=maps or None,
             weights=weights,
-        )
-    )
-    warn_list += [w for w in st.warnings if w not in warn_list]
-    say(
-        f"seamless tile {rect[2]}x{rect[3]}: seam criterion h {st.criterion['horizontal']:.2f}"
-        f" v {st.criterion['vertical']:.2f}"
-    )
-
-    # 3. candidates
-    n = args.candidates
-    ring = args.patch_overlap or default_patch_overlap(overlap)
-    margin = args.margin if args.margin is not None else min(2, ring - 1)
-
-    def on_candidate(ev):
-        if isinstance(ev, CandidateTile):
-            say(
-                f"candidate {ev.index:3d} ({done[0] + 1}/{n}): patch {ev.patch_rect}, criterion "
-                f"{ev.scores['criterion']:.2f}, changed {ev.scores['changed']:.0%}"
-            )
-            done[0] += 1
-        elif isinstance(ev, Progress) and ev.message.endswith("cancelled"):
-            say(ev.message)
-
-    done = [0]
-    cands = drain(
-        iter_candidates(
-            S,
-            st,
-            n,
-            patch_size=args.patch_size,
-            patch_overlap=ring,
-            margin=margin,
-            neighbourhood=args.neighbourhood,
-            seam=seam.replace(blend=cand_blend),
             excluded=excluded,
-            maps=maps or None,
-            weights=weights,
-            rng=args.seed,
+            picks=args.pick,
             workers=args.workers,
         ),
-        on_candidate,
+        _events(say, settings.candidates),
     )
-
-    # 4. picks and preview layout
-    picks = args.pick if args.pick is not None else list(range(len(cands)))
-    bad = [k for k in picks if k >= len(cands)]
-    if bad:
-        raise ValueError(f"--pick {bad} out of range: there are {len(cands)} candidates")
-    rows, cols = args.preview
-    ids = random_layout(
-        len(picks),
-        rows,
-        cols,
-        rng=args.seed,
-        no_equal_neighbours=not args.equal_neighbours and len(picks) > 1,
+    st = result.seamless
+    say(
+        f"seamless tile {result.rect[2]}x{result.rect[3]} (overlap {result.overlap}): seam "
+        f"criterion h {st.criterion['horizontal']:.2f} v {st.criterion['vertical']:.2f}"
     )
-    cells = np.asarray(picks, dtype=np.int64)[ids]  # candidate indices
-    from engine.tiles import assemble
-
-    preview = {
-        m: assemble([cands[k] for k in picks], ids, map_name=None if m == "main" else m)
-        for m in ["main", *maps]
-    }
-
-    # 5. files (the folder was checked before the work)
     out = Path(args.out)
+    manifest = write_files(out, result, depth)
+    manifest.update(
+        settings=settings.to_dict(),
+        source={
+            "path": str(args.source),
+            "width": W,
+            "height": H,
+            "channels": int(S.shape[2]),
+            "bit_depth": depth,
+            "maps": {k: p for k, p in args.map},
+            "exclude_mask": args.exclude_mask or None,
+        },
+        workers=args.workers,
+        weights=weights,
+    )
+    _write_text(out / "manifest.json", json.dumps(manifest, indent=1) + "\n")
+    say(f"wrote template, {len(result.candidates)} tiles, manifest, layout and preview to {out}")
+    if getattr(args, "project", None):
+        save_project_option(
+            args,
+            **project_arguments(result, S, maps, depth, args, weights, excluded),
+        )
+    return 0
+
+
+def write_files(out: Path, result, depth: int) -> dict:
+    """Write the images, layout.csv and layout.json of ``result``; the manifest's content."""
+    from engine.bitdepth import quantize
+    from engine.png import encode_png
 
     def write(stem: str, images: dict) -> dict:
         files = {}
@@ -448,24 +462,26 @@ def _run(args) -> int:
             files[m] = fname
         return files
 
+    st, rect, overlap = result.seamless, result.rect, result.overlap
     template_files = write("template", {"main": st.tile, **st.maps})
     tile_entries = []
-    for c in cands:
+    for c in result.candidates:
         files = write(f"tile_{c.index:03d}", {"main": c.tile, **c.maps})
-        x, y, w, h = c.patch_rect
         tile_entries.append(
             {
                 "index": c.index,
                 "file": files["main"],
                 "maps": files,
                 "seed": c.seed,
-                "source_rect": [x, y, w, h],
+                "source_rect": list(c.patch_rect),
                 "patch_origin": list(c.patch_origin),
                 "target_rect": list(c.target_rect),
                 "scores": {k: float(v) for k, v in c.scores.items()},
             }
         )
-    preview_files = write("preview", preview)
+    preview_files = write("preview", result.preview)
+    cells = result.cells
+    rows, cols = result.settings.preview
     _write_text(out / "layout.csv", _csv(cells))
     layout_doc = {
         "tile_w": int(rect[2]),
@@ -476,89 +492,71 @@ def _run(args) -> int:
         "cells_are": "tile indices (tile_NNN.png)",
     }
     _write_text(out / "layout.json", json.dumps(layout_doc, indent=1) + "\n")
-    parameters = {
-        "tile_min": tile_min,
-        "tile_max": tile_max,
-        "joint_weight": joint,
-        "overlap": overlap,
-        "patch_overlap": ring,
-        "patch_size": args.patch_size or [int(rect[3]), int(rect[2])],
-        "margin": margin,
-        "neighbourhood": args.neighbourhood,
-        "seam": args.seam,
-        "seam_options": dict(args.seam_option),
-        "metric": args.metric,
-        "template_blend": tmpl_blend,
-        "candidate_blend": cand_blend,
-        "rho": args.rho,
-        "width": args.width,
-        "candidates": n,
-        "workers": args.workers,
-        "weights": weights,
-        "preview": [rows, cols],
-        "no_equal_neighbours": not args.equal_neighbours,
-    }
-    manifest = {
+    return {
         "format": FORMAT,
         "version": VERSION,
-        "source": {
-            "path": str(args.source),
-            "width": W,
-            "height": H,
-            "channels": int(S.shape[2]),
-            "bit_depth": depth,
-            "maps": {k: p for k, p in args.map},
-        },
-        "seed": args.seed,
-        "parameters": parameters,
+        "seed": result.settings.seed,
+        "resolved": result.settings.to_dict(),
         "template": {
             "file": template_files["main"],
             "maps": template_files,
             "rect": list(rect),
             "overlap": overlap,
             "footprint": [rect[0], rect[1], rect[2] + overlap, rect[3] + overlap],
-            "cost": cost,
+            "cost": result.cost,
             "seam_criterion": st.criterion,
             "seam_peak": st.peak,
         },
         "tiles": tile_entries,
-        "picks": picks,
+        "picks": result.picks,
         "layout": {"csv": "layout.csv", "json": "layout.json"},
         "preview": {"file": preview_files["main"], "maps": preview_files},
-        "warnings": warn_list,
+        "warnings": list(result.warnings),
     }
-    _write_text(out / "manifest.json", json.dumps(manifest, indent=1) + "\n")
-    say(f"wrote template, {len(cands)} tiles, manifest, layout and preview to {out}")
 
-    # 6. project
-    src_maps = {MAIN_MAP: S, **maps}
+
+def project_arguments(result, S, maps, depth, args, weights, excluded) -> dict:
+    """The keyword arguments of :func:`engine.project.project_from_tileset` for ``result``."""
+    import numpy as np
+
+    from engine.exclusion import mask_to_json
 
     def as_project_maps(main, extra):
         return {MAIN_MAP: np.asarray(main), **{k: np.asarray(v) for k, v in extra.items()}}
 
-    save_project_option(
-        args,
-        sources=src_maps,
+    s = result.settings
+    cands = result.candidates
+    extra_maps = {m: result.preview[m] for m in maps}
+    return dict(
+        sources={MAIN_MAP: S, **maps},
         tiles=[as_project_maps(c.tile, c.maps) for c in cands],
         name="tileset",
-        template=as_project_maps(st.tile, st.maps),
-        template_rect=rect,
+        template=as_project_maps(result.seamless.tile, result.seamless.maps),
+        template_rect=result.rect,
         patch_origins=[c.patch_origin for c in cands],
         seeds=[c.seed for c in cands],
         scores=[c.scores["criterion"] for c in cands],
-        picks=picks,
-        layout=ids,
-        parameters=parameters,
-        project_seeds={"candidates": args.seed, "layout": args.seed},
+        picks=result.picks,
+        layout=result.layout,
+        parameters={"tileset": s.to_dict()},
+        project_seeds={"candidates": s.seed, "layout": s.layout_seed},
         bit_depth=depth,
         source_paths={MAIN_MAP: str(args.source), **{k: p for k, p in args.map}},
-        map_weights={(MAIN_MAP if k == "main" else k): v for k, v in (weights or {}).items()},
-        preview=as_project_maps(preview["main"], {m: preview[m] for m in maps}),
+        map_weights=_map_weights(weights),
+        preview=as_project_maps(result.preview["main"], extra_maps),
+        extra=mask_to_json(excluded),
     )
-    return 0
 
 
-def _csv(cells: np.ndarray) -> str:
+def _map_weights(weights) -> dict:
+    """The project's seam-error weights per map name: given weights leave out a map's weight
+    as 0, the source's too (``engine.materials.material_error``), so it is written out."""
+    if not weights:
+        return {}
+    return {MAIN_MAP: weights.get("main", 0.0), **{k: v for k, v in weights.items() if k != "main"}}
+
+
+def _csv(cells) -> str:
     buf = io.StringIO()
     csv.writer(buf, lineterminator="\n").writerows(cells.tolist())
     return buf.getvalue()

@@ -6,6 +6,8 @@
    pinned cut, all keeping the template's border so every tile connects to every other;
 4. :func:`random_layout` / :func:`assemble` — index matrices and tiled synthesis.
 
+:func:`iter_tileset` runs them all with one :class:`TilesetSettings` (:mod:`engine.settings`).
+
 Each ``iter_x`` validates eagerly and returns a generator of events whose value is the
 result; ``x`` drains it.
 """
@@ -19,6 +21,7 @@ from engine.tiles.candidates import (
     make_candidate,
 )
 from engine.tiles.layout import assemble, random_layout
+from engine.tiles.pipeline import TilesetResult, TilesetSettings, iter_tileset, tileset
 from engine.tiles.seamless import (
     MAIN,
     SeamlessTile,
@@ -41,6 +44,8 @@ __all__ = [
     "SeamlessTile",
     "SeamlessUpdate",
     "Template",
+    "TilesetResult",
+    "TilesetSettings",
     "TemplateUpdate",
     "assemble",
     "candidate_seed",
@@ -51,8 +56,10 @@ __all__ = [
     "iter_candidates",
     "iter_find_template",
     "iter_make_seamless",
+    "iter_tileset",
     "make_candidate",
     "make_seamless",
     "random_layout",
     "template_cost",
+    "tileset",
 ]

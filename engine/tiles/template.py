@@ -34,6 +34,7 @@ import numpy as np
 from numba import njit
 from scipy import ndimage
 
+from engine._checks import as_size
 from engine._validate import as_image, positive_int
 from engine.cancel import Cancelled, is_cancelled
 from engine.errormap import colour_channels
@@ -104,23 +105,6 @@ class Template:
 
 
 # --------------------------------------------------------------------------- validation
-def as_size(value, name: str) -> tuple[int, int]:
-    """An int ``n`` -> (n, n); a pair ``(h, w)`` of ints -> (h, w); both >= 1."""
-    if isinstance(value, numbers.Integral) and not isinstance(value, bool):
-        pair = (int(value), int(value))
-    elif (
-        isinstance(value, (tuple, list))
-        and len(value) == 2
-        and all(isinstance(v, numbers.Integral) and not isinstance(v, bool) for v in value)
-    ):
-        pair = (int(value[0]), int(value[1]))
-    else:
-        raise TypeError(f"{name} must be an int or an (h, w) pair of ints, got {value!r}")
-    if min(pair) < 1:
-        raise ValueError(f"{name} must be >= 1, got {value!r}")
-    return pair
-
-
 def default_overlap(tile_min, tile_max=None) -> int:
     """w_T ≈ 1/10 of the expected tile size (the mean of the range), at least 2 and at most
     half the smallest tile side (a wide range such as 40..400 would otherwise get a w_T

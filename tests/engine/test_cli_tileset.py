@@ -76,8 +76,8 @@ def test_end_to_end_files_manifest_layout_and_determinism(src, tmp_path, capsys)
     assert {f"tile_{i:03d}.png" for i in range(5)} <= names
     man = json.loads((out / "manifest.json").read_text())
     assert man["seed"] == 3 and man["source"]["bit_depth"] == 8
-    p = man["parameters"]
-    assert p["tile_min"] == 48 and p["tile_max"] == 56 and p["seam"] == "dp"
+    p = man["resolved"]
+    assert p["tile_min"] == [48, 48] and p["tile_max"] == [56, 56] and p["seam"]["method"] == "dp"
     assert p["candidates"] == 5 and p["overlap"] == man["template"]["overlap"]
     assert len(man["tiles"]) == 5
     for t in man["tiles"]:
@@ -170,9 +170,9 @@ def test_picks_maps_exclusion_and_options(src, tmp_path):
     for t in man["tiles"]:
         tx, ty, tw, th = t["source_rect"]
         assert tx + tw <= 140
-    assert man["parameters"]["seam"] == "oscillating"
-    assert man["parameters"]["seam_options"] == {"o_max": 2}
-    assert man["parameters"]["template_blend"] == "feather"
+    seam = man["resolved"]["seam"]
+    assert seam["method"] == "oscillating" and seam["options"]["o_max"] == 2
+    assert man["resolved"]["template_blend"] == "feather" and seam["blend"] == "feather"
 
 
 def test_bad_input_gives_clear_errors(src, tmp_path, capsys):
@@ -233,7 +233,7 @@ def test_small_source_gets_a_margin_that_fits_its_ring(tmp_path, capsys):
     out = tmp_path / "o"
     assert main(["tileset", str(tmp_path / "s.png"), "--out", str(out), "--candidates", "2"]) == 0
     man = json.loads((out / "manifest.json").read_text())
-    assert man["parameters"]["patch_overlap"] == 2 and man["parameters"]["margin"] == 1
+    assert man["resolved"]["patch_overlap"] == 2 and man["resolved"]["margin"] == 1
     assert main(["tileset", str(tmp_path / "s.png"), "--out", str(out), "--margin", "2"]) == 1
     assert "margin must be smaller than patch_overlap" in capsys.readouterr().err
 
@@ -293,7 +293,7 @@ def test_fixed_rect_and_colour_exclusion(src, tmp_path):
         S_exact(src), (10, 12, 50, 48), overlap=6, excluded=np.all(S_exact(src) <= 0.15, axis=2)
     )[0]
     assert man["template"]["cost"] == pytest.approx(expected)  # a fixed rectangle is scored too
-    assert man["parameters"]["patch_overlap"] == 5
+    assert man["resolved"]["patch_overlap"] == 5
     assert png(out / "template.png").shape == (48, 50, 3)
     S = png(src["rgb8"]).astype(np.float32) / 255
     dark = np.all(S <= 0.15, axis=2)
@@ -315,7 +315,7 @@ def test_joint_weight_is_passed_to_the_search_and_recorded(src, tmp_path):
             == 0
         )
         man = json.loads((out / "manifest.json").read_text())
-        assert man["parameters"]["joint_weight"] == float(weight)
+        assert man["resolved"]["joint_weight"] == float(weight)
         t = find_template(S, tile_min=48, tile_max=56, joint_weight=float(weight))
         assert man["template"]["rect"] == list(t.rect)
 
@@ -330,7 +330,7 @@ def test_default_patch_ring_is_the_engines(src, tmp_path):
     argv = ["tileset", str(src["rgb8"]), "--out", str(out), "--candidates", "2", "--seed", "3"]
     assert main([*argv, "--rect", "10,12,50,48", "--overlap", "20"]) == 0
     man = json.loads((out / "manifest.json").read_text())
-    assert man["parameters"]["patch_overlap"] == default_patch_overlap(20) == 10
+    assert man["resolved"]["patch_overlap"] == default_patch_overlap(20) == 10
     S = S_exact(src)
     st = make_seamless(S, (10, 12, 50, 48), overlap=20)
     cands = candidates(S, st, 2, rng=3)

@@ -1,0 +1,194 @@
+"""The whole tile-set workflow in one call: template, seamless tile, candidates, preview layout.
+
+:func:`iter_tileset` runs the steps of Somol & Haindl's method with one
+:class:`~engine.settings.TilesetSettings` (re-exported here), streaming every step's events,
+and returns a
+:class:`TilesetResult`; ``quilt-studio tileset`` writes that result to files. (The editor runs
+the same steps one by one, as the person edits.)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from engine.events import Progress
+from engine.settings import TilesetSettings
+from engine.tiles.candidates import CandidateTile, default_patch_overlap, iter_candidates
+from engine.tiles.layout import assemble, random_layout
+from engine.tiles.seamless import MAIN, SeamlessTile, iter_make_seamless
+from engine.tiles.template import default_overlap, iter_find_template, template_cost
+
+__all__ = ["TilesetResult", "TilesetSettings", "iter_tileset", "resolve", "tileset"]
+
+
+@dataclass(frozen=True)
+class TilesetResult:
+    """Everything one run made.
+
+    ``settings`` are the run's settings with every "from the source" value filled in
+    (:func:`resolve`); ``rect``/``overlap``/``cost`` the template rectangle
+    (x, y, w, h), w_T and its search criterion; ``picks`` the candidate indices the preview
+    uses, ``layout`` its index matrix over ``picks`` (``cells``: the same over candidate
+    indices) and ``preview`` the assembled image per map (``"main"``: the source's).
+    """
+
+    settings: TilesetSettings
+    rect: tuple[int, int, int, int]
+    overlap: int
+    cost: float
+    seamless: SeamlessTile
+    candidates: list[CandidateTile]
+    picks: list[int]
+    layout: np.ndarray
+    preview: dict[str, np.ndarray]
+    warnings: tuple[str, ...] = field(default=())
+
+    @property
+    def cells(self) -> np.ndarray:
+        """The layout as candidate indices (``tile_NNN`` of the files)."""
+        return np.asarray(self.picks, dtype=np.int64)[self.layout]
+
+
+def resolve(settings: TilesetSettings, shape, *, overlap: int | None = None) -> TilesetSettings:
+    """``settings`` with every "from the source" value filled in for a source of ``shape``
+    (H, W); ``overlap`` is the template's w_T when it is known."""
+    lo, hi = settings.tile_range(shape)
+    w_t = overlap or settings.overlap or default_overlap(lo, hi)
+    ring = settings.patch_overlap or default_patch_overlap(w_t)
+    return settings.replace(
+        tile_min=lo,
+        tile_max=hi,
+        overlap=w_t,
+        patch_overlap=ring,
+        margin=min(2, ring - 1) if settings.margin is None else settings.margin,
+        layout_seed=settings.seed if settings.layout_seed is None else settings.layout_seed,
+        template_blend=settings.template_seam.blend,
+    )
+
+
+def iter_tileset(
+    source,
+    settings: TilesetSettings | None = None,
+    *,
+    rect=None,
+    maps=None,
+    weights=None,
+    excluded=None,
+    picks=None,
+    workers: int = 2,
+    cancel=None,
+):
+    """Run the workflow; a generator of the steps' events whose value is a TilesetResult.
+
+    Parameters
+    ----------
+    source : (H, W[, C]) array
+    settings : TilesetSettings, optional
+        Every option (default ``TilesetSettings()``).
+    rect : (x, y, w, h), optional
+        A fixed tile rectangle instead of the template search.
+    maps, weights
+        Material maps (they get every cut) and the seam error weights per map.
+    excluded : (H, W) bool, optional
+        Source pixels no tile or patch may contain.
+    picks : list of int, optional
+        Candidates the preview uses (default: all of them).
+    workers : int
+        Threads of the candidate run.
+    cancel : CancelToken, optional
+    """
+    s = settings if settings is not None else TilesetSettings()
+    if not isinstance(s, TilesetSettings):
+        raise TypeError(f"settings must be a TilesetSettings, got {type(s).__name__}")
+    if picks is not None and (not picks or max(picks) >= s.candidates or min(picks) < 0):
+        raise ValueError(f"picks {list(picks)} out of range: there are {s.candidates} candidates")
+    return _iter_tileset(source, s, rect, maps, weights, excluded, picks, workers, cancel)
+
+
+def _iter_tileset(source, s, rect, maps, weights, excluded, picks, workers, cancel):
+    H, W = np.shape(source)[:2]
+    notes: list[str] = []
+    if rect is not None:
+        overlap = s.overlap or default_overlap((rect[3], rect[2]))
+        cost = template_cost(
+            source, rect, overlap=overlap, excluded=excluded, joint_weight=s.joint_weight
+        )[0]
+    else:
+        lo, hi = s.tile_range((H, W))
+        found = yield from iter_find_template(
+            source,
+            tile_min=lo,
+            tile_max=hi,
+            overlap=s.overlap,
+            excluded=excluded,
+            joint_weight=s.joint_weight,
+            cancel=cancel,
+        )
+        rect, overlap, cost = found.rect, found.overlap, found.cost
+        notes += list(found.warnings)
+    resolved = resolve(s, (H, W), overlap=overlap)
+    seamless = yield from iter_make_seamless(
+        source,
+        rect,
+        overlap=overlap,
+        seam=resolved.template_seam,
+        maps=maps,
+        weights=weights,
+        cancel=cancel,
+    )
+    notes += [w for w in seamless.warnings if w not in notes]
+    cands = yield from iter_candidates(
+        source,
+        seamless,
+        resolved.candidates,
+        patch_size=resolved.patch_size,
+        patch_overlap=resolved.patch_overlap,
+        margin=resolved.margin,
+        neighbourhood=resolved.neighbourhood,
+        seam=resolved.seam,
+        excluded=excluded,
+        maps=maps,
+        weights=weights,
+        rng=resolved.seed,
+        workers=workers,
+        cancel=cancel,
+    )
+    chosen = list(picks) if picks is not None else [c.index for c in cands]
+    made = {c.index for c in cands}
+    missing = [k for k in chosen if k not in made]
+    if missing:  # cancelled before they were made
+        raise ValueError(f"picks {missing} were not made: {len(cands)} candidates finished")
+    by_index = {c.index: c for c in cands}
+    rows, cols = resolved.preview
+    ids = random_layout(
+        len(chosen),
+        rows,
+        cols,
+        rng=resolved.layout_seed,
+        no_equal_neighbours=resolved.no_equal_neighbours and len(chosen) > 1,
+    )
+    tiles = [by_index[k] for k in chosen]
+    names = [MAIN, *seamless.maps]
+    preview = {m: assemble(tiles, ids, map_name=None if m == MAIN else m) for m in names}
+    yield Progress(1, 1, "tile set: done")
+    return TilesetResult(
+        settings=resolved,
+        rect=tuple(int(v) for v in rect),
+        overlap=int(overlap),
+        cost=float(cost),
+        seamless=seamless,
+        candidates=cands,
+        picks=chosen,
+        layout=ids,
+        preview=preview,
+        warnings=tuple(notes),
+    )
+
+
+def tileset(source, settings: TilesetSettings | None = None, **options) -> TilesetResult:
+    """Drain :func:`iter_tileset` and return its :class:`TilesetResult`."""
+    from engine.events import drain
+
+    return drain(iter_tileset(source, settings, **options))
