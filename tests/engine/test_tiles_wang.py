@@ -1,0 +1,265 @@
+"""Wang tile sets (ALGORITHMS.md §6): edge samples, frames, interiors, streaming, seeds."""
+
+import numpy as np
+import pytest
+from scipy import ndimage
+
+from engine.cancel import CancelToken
+from engine.events import Progress
+from engine.materials import decode_normals
+from engine.seams import METHODS
+from engine.tiles.wang import (
+    WangSample,
+    WangSamples,
+    WangTile,
+    canonical_signatures,
+    choose_sample,
+    de_bruijn,
+    iter_wang_set,
+    make_wang_tile,
+    wang_set,
+)
+from engine.tiles.wang_cut import LABELS, frame_cut
+from engine.tiles.wang_layout import layout_mismatches
+from tests.engine.helpers import events_and_result, smooth_texture
+
+T = 32
+
+
+@pytest.fixture(scope="module")
+def source():
+    return smooth_texture((112, 120), 3, seed=4, sigma=1.5)
+
+
+@pytest.fixture(scope="module")
+def k2(source):
+    return wang_set(source, tile_size=T, rng=5, workers=2)
+
+
+def edge_rows(S, sample, role):
+    """The source pixels a tile edge in ``role`` must show, exactly (the oracle)."""
+    y, x = sample.offset(role, T)
+    if role == "n":
+        return S[y, x : x + T]
+    if role == "s":
+        return S[y + T - 1, x : x + T]
+    if role == "w":
+        return S[y + 1 : y + T - 1, x]
+    return S[y + 1 : y + T - 1, x + T - 1]
+
+
+def tile_edge(tile, role):
+    return {"n": tile[0], "s": tile[-1], "w": tile[1:-1, 0], "e": tile[1:-1, -1]}[role]
+
+
+@pytest.mark.parametrize("k", [1, 2, 3, 4])
+def test_de_bruijn_and_the_canonical_arrangement_is_a_complete_torus(k):
+    x = de_bruijn(k)
+    pairs = {(x[i], x[(i + 1) % len(x)]) for i in range(len(x))}
+    assert len(x) == k * k and len(pairs) == k * k
+    sigs = canonical_signatures(k)
+    assert len(set(sigs)) == k**4  # every signature once
+    grid = np.arange(k**4).reshape(k * k, k * k)
+    assert layout_mismatches(sigs, grid, wrap=True) == 0
+
+
+def test_k2_has_all_16_signatures_and_exact_edges(source, k2):
+    assert k2.complete and len(k2.tiles) == 16
+    assert sorted(t.signature for t in k2.tiles) == sorted(
+        (n, e, s, w) for n in (0, 1) for e in (0, 1) for s in (0, 1) for w in (0, 1)
+    )
+    assert [s.axis for s in k2.samples] == ["h", "h", "v", "v"]
+    for t in k2.tiles:
+        assert t.tile.shape == (T, T, 3) and t.tile.dtype == np.float32
+        for role, colour in t.wang.items():
+            sample = k2.sample("h" if role in "ns" else "v", colour)
+            np.testing.assert_array_equal(tile_edge(t.tile, role), edge_rows(source, sample, role))
+
+
+def test_matching_tiles_continue_the_source_across_every_joint(source, k2):
+    """Oracle: wherever two tiles may touch, the two pixel rows (columns) across the joint are
+    consecutive source rows (columns) of the shared sample, so the joint is the texture's own."""
+    pairs = 0
+    for a in k2.tiles:
+        for b in k2.tiles:
+            if a.signature[2] == b.signature[0]:  # b below a
+                y, x = k2.sample("h", b.signature[0]).origin
+                np.testing.assert_array_equal(a.tile[-1], source[y - 1, x : x + T])
+                np.testing.assert_array_equal(b.tile[0], source[y, x : x + T])
+                pairs += 1
+            if a.signature[1] == b.signature[3]:  # b right of a
+                y, x = k2.sample("v", b.signature[3]).origin
+                np.testing.assert_array_equal(a.tile[1:-1, -1], source[y + 1 : y + T - 1, x - 1])
+                np.testing.assert_array_equal(b.tile[1:-1, 0], source[y + 1 : y + T - 1, x])
+                pairs += 1
+    assert pairs == 2 * 16 * 8
+
+
+def test_interior_patch_is_stitched_inside_the_margin(source, k2):
+    m = k2.parameters["margin"]
+    origins = set()
+    for t in k2.tiles:
+        assert t.patch_origin is not None and "patch" in t.paths
+        assert (t.labels == 4).mean() > 0.5  # most of the tile is its own
+        assert (t.labels[:m] != 4).all() and (t.labels[:, :m] != 4).all()
+        assert (t.labels[-m:] != 4).all() and (t.labels[:, -m:] != 4).all()
+        y, x = t.patch_origin
+        # deep inside the loop, pixels are the source window's
+        deep = ndimage.binary_erosion(t.labels == 4, iterations=8)
+        np.testing.assert_array_equal(t.tile[deep], source[y : y + T, x : x + T][deep])
+        origins.add(t.patch_origin)
+    assert len(origins) == 16  # no two tiles share an interior
+
+
+def test_streams_samples_then_tiles_and_progress(source):
+    events, ws = events_and_result(iter_wang_set(source, tile_size=T, rng=2, workers=2))
+    kinds = [type(e) for e in events]
+    assert kinds.index(WangSamples) < kinds.index(WangTile)
+    assert all(k in (Progress, WangSamples, WangTile) for k in kinds)
+    assert sorted(e.index for e in events if isinstance(e, WangTile)) == list(range(16))
+    assert events[-1].done == 16
+    (samples,) = [e for e in events if isinstance(e, WangSamples)]
+    assert samples.samples == ws.samples
+
+
+def test_same_seed_same_set_on_one_or_two_workers(source):
+    a = wang_set(source, tile_size=T, rng=11, workers=1)
+    b = wang_set(source, tile_size=T, rng=11, workers=2)
+    c = wang_set(source, tile_size=T, rng=12, workers=2)
+    assert a.samples == b.samples
+    for ta, tb in zip(a.tiles, b.tiles, strict=True):
+        assert ta.signature == tb.signature and ta.patch_origin == tb.patch_origin
+        np.testing.assert_array_equal(ta.tile, tb.tile)
+    assert a.samples != c.samples
+
+
+def test_cancel_keeps_what_is_finished(source):
+    token = CancelToken()
+    gen = iter_wang_set(source, tile_size=T, rng=1, workers=2, cancel=token)
+    got = []
+    try:
+        while True:
+            ev = next(gen)
+            if isinstance(ev, WangTile):
+                got.append(ev)
+                if len(got) == 3:
+                    token.cancel()
+    except StopIteration as stop:
+        ws = stop.value
+    assert 3 <= len(ws.tiles) < 16 and not ws.complete
+    assert {t.index for t in got} == {t.index for t in ws.tiles}
+    token = CancelToken()
+    token.cancel()
+    empty = wang_set(source, tile_size=T, rng=1, cancel=token)
+    assert empty.tiles == () and not empty.complete
+
+
+def test_three_colours_make_81_tiles(source):
+    ws = wang_set(source, tile_size=24, colours=3, rng=3, workers=2, min_distance=4)
+    assert ws.complete and len(ws.tiles) == 81 and len(ws.samples) == 6
+    assert len(set(ws.signatures)) == 81
+    assert layout_mismatches(ws.signatures, ws.arrangement(), wrap=True) == 0
+
+
+def test_variants_and_diamonds(source):
+    ws = wang_set(source, tile_size=T, variants=2, rng=3, tiles=[0, 16])
+    a, b = ws.tiles
+    assert a.signature == b.signature
+    assert (a.variant, b.variant) == (0, 1) and a.patch_origin != b.patch_origin
+    d = wang_set(source, tile_size=T, interior="diamonds", rng=3, tiles=[5])
+    (t,) = d.tiles
+    assert t.patch_origin is None and "patch" not in t.paths and (t.labels < 4).all()
+    with pytest.raises(ValueError, match="variants > 1 needs interior='patch'"):
+        wang_set(source, tile_size=T, interior="diamonds", variants=2)
+
+
+@pytest.mark.parametrize("method", METHODS)
+@pytest.mark.parametrize("blend", ["none", "adaptive", "feather"])
+def test_frame_cut_keeps_every_edge_pixel_with_any_seam(method, blend):
+    rng = np.random.default_rng(0)
+    n = 40
+    errors = {name: rng.random((n, n)) for name in ("nw", "ne", "sw", "se")}
+    fr = frame_cut(errors, band=5, method=method, blend=blend, width=6)
+    w = fr.weights()
+    exact = {"n": w["n"][0], "s": w["s"][-1], "w": w["w"][1:-1, 0], "e": w["e"][1:-1, -1]}
+    for role, v in exact.items():
+        assert (v == 1).all(), role
+    total = w["n"] + w["e"] + w["s"] + w["w"]
+    np.testing.assert_allclose(total, 1, atol=1e-6)
+    lab = fr.labels
+    assert (lab[0] == LABELS["n"]).all() and (lab[-1] == LABELS["s"]).all()
+    assert (lab[1:-1, 0] == LABELS["w"]).all() and (lab[1:-1, -1] == LABELS["e"]).all()
+    jr, jc = fr.junction
+    assert abs(jr - n // 2) <= 5 and abs(jc - n // 2) <= 10
+    for name, p in fr.paths.items():
+        corner = {"nw": (1, 0), "ne": (1, n - 1), "sw": (n - 2, 0), "se": (n - 2, n - 1)}[name]
+        assert tuple(p[0]) == corner
+
+
+def test_material_maps_follow_the_cuts_and_normals_stay_unit(source):
+    normal = np.zeros(source.shape, np.float32)
+    v = np.stack([source[..., 0] - 0.5, source[..., 1] - 0.5, np.ones(source.shape[:2])], -1)
+    normal[:] = (v / np.linalg.norm(v, axis=2, keepdims=True) + 1) / 2
+    ws = wang_set(source, tile_size=T, rng=4, maps={"copy": source, "normal": normal}, tiles=[3])
+    (t,) = ws.tiles
+    np.testing.assert_allclose(t.maps["copy"], t.tile, atol=1e-6)
+    n = decode_normals(t.maps["normal"])
+    np.testing.assert_allclose(np.linalg.norm(n, axis=2), 1, atol=2e-3)
+
+
+def test_sixteen_bit_pixels_stay_exact_away_from_blends():
+    g = np.random.default_rng(1)
+    src = (smooth_texture((100, 100), 3, seed=2) * 65535).astype(np.uint16)
+    src ^= g.integers(0, 8, src.shape, dtype=np.uint16)  # low bits an 8-bit copy would lose
+    ws = wang_set(src, tile_size=T, rng=2, blend="none", tiles=[0, 7])
+    values = set(src.ravel().tolist())
+    for t in ws.tiles:
+        x = t.tile.astype(np.float64) * 65535
+        q = np.round(x)
+        assert np.abs(x - q).max() < 1e-2  # on the 16-bit grid (float32 of k / 65535)
+        assert set(q.astype(np.int64).ravel().tolist()) <= values
+
+
+def test_excluded_pixels_are_never_used(source):
+    ex = np.zeros(source.shape[:2], bool)
+    ex[:, 50:58] = True
+    ws = wang_set(source, tile_size=T, rng=6, excluded=ex, min_distance=4)
+    for s in ws.samples:
+        x, y, w, h = s.footprint(T, ws.parameters["reach"])
+        assert not ex[y : y + h, x : x + w].any()
+    for t in ws.tiles:
+        y, x = t.patch_origin
+        assert not ex[y : y + T, x : x + T].any()
+
+
+def test_rerolled_sample_and_rebuilt_tile(source, k2):
+    new = choose_sample(source, k2.samples, "v", 1, tile_size=T, rng=99)
+    assert isinstance(new, WangSample) and (new.axis, new.colour) == ("v", 1)
+    assert new.origin != k2.sample("v", 1).origin
+    t = k2.tiles[5]
+    again = make_wang_tile(source, k2.samples, 5, tile_size=T, patch_origin=t.patch_origin)
+    np.testing.assert_array_equal(again.tile, t.tile)
+    samples = list(k2.samples)
+    samples[3] = new
+    moved = make_wang_tile(source, samples, 5, tile_size=T, seed=1)
+    role = "e" if t.signature[1] == 1 else "w" if t.signature[3] == 1 else None
+    if role is not None:
+        np.testing.assert_array_equal(tile_edge(moved.tile, role), edge_rows(source, new, role))
+
+
+def test_bad_input_is_refused_with_a_clear_message(source):
+    with pytest.raises(ValueError, match="too small for 80 px Wang tiles"):
+        wang_set(source, tile_size=80)
+    with pytest.raises(ValueError, match="band 9 is too wide"):
+        wang_set(source, tile_size=T, band=9)
+    with pytest.raises(TypeError, match="unexpected option"):
+        wang_set(source, tile_size=T, o_max=3)
+    with pytest.raises(ValueError, match="margin must be smaller than patch_overlap"):
+        wang_set(source, tile_size=T, patch_overlap=3, margin=3)
+    bad = [WangSample("h", 0, (0, 0))] * 4
+    with pytest.raises(ValueError, match="must be the 'h' sample of colour 1"):
+        wang_set(source, tile_size=T, samples=bad)
+    ok = list(wang_set(source, tile_size=T, rng=1, tiles=[]).samples)
+    ok[0] = WangSample("h", 0, (2, 0))
+    with pytest.raises(ValueError, match="outside the 120x112 source"):
+        wang_set(source, tile_size=T, samples=ok)
