@@ -645,10 +645,10 @@ def lattice(
     tiles,
     source,
     *,
-    template,
+    template=None,
     margin: int,
     grid=(8, 8),
-    layouts: int = LATTICE_LAYOUTS,
+    layouts=LATTICE_LAYOUTS,
     crops: int | None = None,
     rng=0,
 ) -> Lattice:
@@ -658,26 +658,47 @@ def lattice(
     minus the same for layouts of random source crops that carry the template's outer
     ``margin`` pixels (the floor of any set that shares a border). Mean over ``layouts``
     random index matrices (uniform, equal neighbours allowed); the crops use the same
-    matrices (``crops`` of them, default as many as tiles)."""
+    matrices (``crops`` of them, default as many as tiles).
+
+    ``template=None``: every tile has its own border (a Wang set, whose edges come from its
+    edge samples): crop k carries the outer ``margin`` pixels of tile k (``crops`` must then
+    be None). ``layouts`` may also be a sequence of (R, C) index matrices to use instead of
+    random ones (e.g. valid Wang layouts; ``grid`` is then their shape)."""
     stack = _tile_stack(tiles)
     n, h, w = stack.shape
-    t = luminance(getattr(template, "tile", template))
-    if t.shape != (h, w):
-        raise ValueError(f"template is {t.shape[1]}x{t.shape[0]}, the tiles {w}x{h}")
     m = positive_int(margin, "margin", minimum=0)
-    R, C = _period(grid, "grid")
+    ring = edge_distance((h, w)) < m
+    if template is None:
+        if crops is not None:
+            raise ValueError("crops must be None when every tile carries its own border")
+        border = stack[:, ring]  # crop k carries tile k's own
+    else:
+        t = luminance(getattr(template, "tile", template))
+        if t.shape != (h, w):
+            raise ValueError(f"template is {t.shape[1]}x{t.shape[0]}, the tiles {w}x{h}")
+        border = t[ring]
+    if isinstance(layouts, numbers.Integral) and not isinstance(layouts, bool):
+        R, C = _period(grid, "grid")
+        matrices = None
+        count = positive_int(layouts, "layouts")
+    else:
+        matrices = [np.asarray(x, dtype=np.int64) for x in layouts]
+        if not matrices or any(x.ndim != 2 or x.shape != matrices[0].shape for x in matrices):
+            raise ValueError("layouts must be an int or a non-empty list of equal 2-D matrices")
+        if any(x.min() < 0 or x.max() >= n for x in matrices):
+            raise ValueError(f"layouts must hold tile indices 0..{n - 1}")
+        (R, C), count = matrices[0].shape, len(matrices)
     if R % 2 or C % 2:
         raise ValueError(f"grid must have an even number of rows and columns, got {(R, C)}")
     k = n if crops is None else positive_int(crops, "crops")
     g = as_rng(rng)
     S = luminance(source)
-    ring = edge_distance((h, w)) < m
     org = _crop_origins(S.shape, (h, w), k, g)
     ref = np.stack([S[y : y + h, x : x + w] for y, x in org])
-    ref[:, ring] = t[ring]
+    ref[:, ring] = border
     vals, floors = [], []
-    for _ in range(positive_int(layouts, "layouts")):
-        idx = g.integers(0, n, (R, C))
+    for i in range(count):
+        idx = g.integers(0, n, (R, C)) if matrices is None else matrices[i]
         hv, mv = _harmonic_spectra(stack, idx)
         hf, mf = _harmonic_spectra(ref, idx % k)
         vals.append(10 * np.log10(hv / mv))

@@ -43,18 +43,17 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from engine._validate import as_image, choice, positive_int
-from engine.blend import BLEND_MODES
 from engine.cancel import Cancelled, CancelToken, check, is_cancelled
-from engine.errormap import METRICS
 from engine.events import Item, Progress, drain, frozen_array
 from engine.exclusion import valid_anchors
 from engine.matching import ZERO_ERROR_FRACTION, SampleSpectrum, error_floor
 from engine.matching import select_within_tolerance as _select
 from engine.materials import apply_cut
-from engine.stitch import patch_cut
+from engine.seams.spec import as_seam_spec
+from engine.stitch import PATCH_SEAM, patch_cut
 from engine.tiles.candidates import _AnyCancel, _base_seed, default_patch_overlap
-from engine.tiles.seamless import MAIN, as_maps, check_seam_options, check_weights, seam_error
-from engine.tiles.template import _excluded_mask, default_overlap, flat_warning
+from engine.tiles.seamless import MAIN, as_maps, check_weights, seam_error
+from engine.tiles.template import default_overlap, excluded_mask, flat_warning
 from engine.tiles.wang_cut import CUTS, frame_cut, frame_reach, ramp_reach
 
 __all__ = [
@@ -79,7 +78,7 @@ PATCH_LABEL = 4  # label of the interior patch's pixels (0..3: N, E, S, W; wang_
 ROLE_AXIS = {"n": "h", "s": "h", "e": "v", "w": "v"}
 RING_MATCH = 1.0
 
-#: Options of :func:`iter_wang_set` and their defaults (any other keyword is a seam option).
+#: Options of :func:`iter_wang_set` and their defaults.
 WANG_DEFAULTS = {
     "colours": 2,
     "band": None,
@@ -90,11 +89,7 @@ WANG_DEFAULTS = {
     "outward": 1.0,
     "min_distance": None,
     "tolerance": 0.1,
-    "method": "dp",
-    "metric": "euclid",
-    "blend": "adaptive",
-    "width": 4,
-    "rho": 3,
+    "seam": PATCH_SEAM,
     "excluded": None,
     "maps": None,
     "weights": None,
@@ -287,10 +282,10 @@ class _Setup:
         interior, patch_overlap = opts.pop("interior"), opts.pop("patch_overlap")
         margin, outward = opts.pop("margin"), opts.pop("outward")
         min_distance, tolerance = opts.pop("min_distance"), opts.pop("tolerance")
-        method, metric, blend = opts.pop("method"), opts.pop("metric"), opts.pop("blend")
-        width, rho = opts.pop("width"), opts.pop("rho")
+        seam = opts.pop("seam")
         excluded, maps, weights = opts.pop("excluded"), opts.pop("maps"), opts.pop("weights")
-        seam_options = opts  # whatever is left: the seam method's own options
+        if opts:
+            raise TypeError(f"unexpected option(s): {', '.join(sorted(opts))}")
         self.S = as_image(source, "source")
         H, W = self.S.shape[:2]
         self.K = positive_int(colours, "colours")
@@ -307,14 +302,8 @@ class _Setup:
                 "variants > 1 needs interior='patch' (without a patch every variant of a "
                 "signature would be the same tile)"
             )
-        choice(blend, "blend", BLEND_MODES)
-        choice(metric, "metric", METRICS)
-        check_seam_options(method, seam_options)
-        self.blend = blend
-        self.width = _nonneg_float(width, "width")
-        self.rho = positive_int(rho, "rho", minimum=0)
-        self.method, self.metric, self.seam_options = method, metric, dict(seam_options)
-        self.reach = frame_reach(T, self.band, ramp_reach(blend, self.width, self.rho))
+        self.seam = as_seam_spec(seam, default=PATCH_SEAM)
+        self.reach = frame_reach(T, self.band, ramp_reach(self.seam))
         if min(H, W) < max(T, 2 * self.reach):
             need = 2 * self.reach
             raise ValueError(
@@ -341,7 +330,7 @@ class _Setup:
         extra = as_maps(maps, (H, W))
         self.weights = check_weights(weights, extra)
         self.stack = {MAIN: self.S, **extra}
-        self.excluded = _excluded_mask(excluded, (H, W))
+        self.excluded = excluded_mask(excluded, (H, W))
         self.notes = []
         flat = flat_warning(self.S)
         if flat:
@@ -533,19 +522,10 @@ class _Setup:
         for role, colour in zip("nesw", signature, strict=True):
             layers[role] = self.layer(samples[AXES.index(ROLE_AXIS[role]) * self.K + colour], role)
         errors = {
-            name: seam_error(layers[a], layers[b], self.weights, self.metric)
+            name: seam_error(layers[a], layers[b], self.weights, self.seam.metric)
             for name, (a, b, _, _) in CUTS.items()
         }
-        fr = frame_cut(
-            errors,
-            band=self.band,
-            method=self.method,
-            blend=self.blend,
-            width=self.width,
-            rho=self.rho,
-            cancel=cancel,
-            **self.seam_options,
-        )
+        fr = frame_cut(errors, band=self.band, seam=self.seam, cancel=cancel)
         return fr, fr.apply(layers)
 
     def patch_errors(self, framed: dict) -> np.ndarray:
@@ -597,20 +577,15 @@ class _Setup:
         if origin is not None:
             y, x = origin
             q = {k: v[y : y + T, x : x + T] for k, v in self.stack.items()}
-            err = seam_error(q, framed, self.weights, self.metric) * self.outward_weight
+            err = seam_error(q, framed, self.weights, self.seam.metric) * self.outward_weight
             cut = patch_cut(
                 q[MAIN],
                 framed[MAIN],
                 ring=self.ring,
                 margin=self.margin,
-                method=self.method,
-                metric=self.metric,
-                blend=self.blend,
-                width=self.width,
-                rho=self.rho,
+                seam=self.seam,
                 error=err,
                 cancel=cancel,
-                **self.seam_options,
             )
             check(cancel)
             out = apply_cut(q, framed, cut.alpha)
@@ -649,12 +624,7 @@ class _Setup:
             "outward": self.outward,
             "min_distance": self.min_distance,
             "tolerance": self.tolerance,
-            "method": self.method,
-            "metric": self.metric,
-            "blend": self.blend,
-            "width": self.width,
-            "rho": self.rho,
-            **self.seam_options,
+            "seam": self.seam.to_dict(),
         }
 
 
@@ -756,8 +726,8 @@ def iter_wang_set(
     cancel : CancelToken or None
         Stops the run; the tiles already finished are kept in the returned set.
 
-    Options (defaults in :data:`WANG_DEFAULTS`; any other keyword is a seam option)
-    -------------------------------------------------------------------------------
+    Options (defaults in :data:`WANG_DEFAULTS`)
+    -------------------------------------------
     colours : int
         K, colours per edge direction; the set has ``variants * K**4`` tiles.
     band : int or None
@@ -780,8 +750,9 @@ def iter_wang_set(
     tolerance : float
         Samples and interiors are drawn among the positions within ``(1 + tolerance)`` of
         the best match.
-    method, metric, blend, width, rho
-        Seam method, error metric, blending of every cut.
+    seam : SeamSpec
+        Seam method and options, error metric and blending of every cut (default
+        :data:`engine.stitch.PATCH_SEAM`: dp, adaptive blending).
     excluded : (H, W) bool or None
         Source pixels no sample or patch may contain.
     maps, weights

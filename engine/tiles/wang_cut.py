@@ -36,10 +36,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from engine.blend import adaptive_half_widths, blend_weights, clamped_half_widths, cut_columns
+from engine.blend import adaptive_half_widths, clamped_half_widths, cut_columns
 from engine.cancel import check
 from engine.materials import apply_cut
-from engine.seams import find_seam
+from engine.seams.spec import SeamSpec
 
 __all__ = ["CUTS", "Frame", "frame_cut", "frame_reach", "ramp_reach"]
 
@@ -54,13 +54,13 @@ ROLES = ("n", "e", "s", "w")
 LABELS = {"n": 0, "e": 1, "s": 2, "w": 3}
 
 
-def ramp_reach(blend: str, width: float, rho: int) -> int:
-    """How far (px) a blend ramp can reach past its cut."""
-    if blend == "none":
+def ramp_reach(seam: SeamSpec) -> int:
+    """How far (px) the blend ramp of ``seam`` can reach past its cut."""
+    if seam.blend == "none":
         return 0
-    if blend == "feather":
-        return math.ceil(float(width) / 2) + 1
-    return 2 * int(rho) + 1
+    if seam.blend == "feather":
+        return math.ceil(seam.width / 2) + 1
+    return 2 * seam.rho + 1
 
 
 def frame_reach(tile: int, band: int, reach: int) -> int:
@@ -163,19 +163,19 @@ def _junction(costs: dict, T: int, band: int) -> tuple[int, int]:
     return int(r.ravel()[k]), int(c.ravel()[k])
 
 
-def _cut_alpha(seam, e, inside, band: int, T: int, blend: str, width, rho) -> np.ndarray:
+def _cut_alpha(seam, e, inside, band: int, T: int, spec: SeamSpec) -> np.ndarray:
     """Weight of A over the sheared band (n_rows, 2 band + 1), 0 and 1 exactly at the tile's
     edge pixels (frame column 0 and T - 1, and within the band's own edge columns)."""
     n = e.shape[0]
     filled = np.where(inside, e, e[inside].mean() if inside.any() else 0.0)
     cols = cut_columns(seam.mask)
-    if blend == "none" or cols is None:
-        alpha = blend_weights(seam, filled, mode=blend, width=width, rho=rho)
+    if spec.blend == "none" or cols is None:
+        alpha = spec.blend_weights(seam, filled)
     else:
         b = (
-            np.full(n, float(width) / 2.0)
-            if blend == "feather"
-            else adaptive_half_widths(seam, filled, rho=rho)
+            np.full(n, spec.width / 2.0)
+            if spec.blend == "feather"
+            else adaptive_half_widths(seam, filled, rho=spec.rho)
         )
         b = clamped_half_widths(cols, b, 2 * band + 1)
         tile_col = np.arange(1, n + 1) + cols - band  # the cut's last A column in the frame
@@ -206,17 +206,7 @@ def _unshear(band_values: np.ndarray, n_rows: int, band: int, T: int, left, righ
     return out
 
 
-def frame_cut(
-    errors: dict,
-    *,
-    band: int,
-    method: str = "dp",
-    blend: str = "adaptive",
-    width: float = 4,
-    rho: int = 3,
-    cancel=None,
-    **seam_options,
-) -> Frame:
+def frame_cut(errors: dict, *, band: int, seam: SeamSpec, cancel=None) -> Frame:
     """Cut a T x T Wang tile between its four edge layers.
 
     Parameters
@@ -227,10 +217,9 @@ def frame_cut(
         around each cut's diagonal is read.
     band : int
         Half-width of the band around the diagonals in which the cuts run (>= 1).
-    method, **seam_options
-        Any seam method of :mod:`engine.seams` and its options.
-    blend, width, rho
-        Blending across each cut (:func:`engine.blend.blend_weights`).
+    seam : SeamSpec
+        Any seam method of :mod:`engine.seams` with its options, and the blending across
+        each cut (the metric is the caller's, in ``errors``).
     """
     T = next(iter(errors.values())).shape[0]
     rows_max = min(T - 2, T // 2 + band)
@@ -251,18 +240,11 @@ def frame_cut(
         n = T - 1 - jr if fr else jr
         end_col = T - 2 - jc if fc else jc
         e = np.ascontiguousarray(sheared[:n])
-        seam = find_seam(
-            e,
-            method=method,
-            start=band - 1,
-            end=end_col - n + band,
-            cancel=cancel,
-            **seam_options,
-        )
-        alpha = _cut_alpha(seam, e, inside[:n], band, T, blend, width, rho)
+        cut = seam.find(e, start=band - 1, end=end_col - n + band, cancel=cancel)
+        alpha = _cut_alpha(cut, e, inside[:n], band, T, seam)
         alphas_f[name] = _unshear(alpha, n, band, T, np.float32(1), np.float32(0))
-        masks_f[name] = _unshear(np.asarray(seam.mask), n, band, T, True, False)
-        p = np.asarray(seam.path)
+        masks_f[name] = _unshear(np.asarray(cut.mask), n, band, T, True, False)
+        p = np.asarray(cut.path)
         r = p[:, 0] + 1
         c = r + p[:, 1] - band
         if fr:
@@ -270,8 +252,8 @@ def frame_cut(
         if fc:
             c = T - 1 - c
         paths[name] = np.column_stack([r, c]).astype(np.intp)
-        crit[name] = float(seam.criterion)
-        peak[name] = float(seam.peak)
+        crit[name] = float(cut.criterion)
+        peak[name] = float(cut.peak)
 
     def tile_rows(name, values):
         """A cut's frame rows 1..n back in tile coordinates (rows and columns unflipped)."""

@@ -7,7 +7,7 @@ from scipy import ndimage
 from engine.cancel import CancelToken
 from engine.events import Progress
 from engine.materials import decode_normals
-from engine.seams import METHODS
+from engine.seams import METHODS, SeamSpec
 from engine.tiles.wang import (
     WangSample,
     WangSamples,
@@ -179,7 +179,7 @@ def test_frame_cut_keeps_every_edge_pixel_with_any_seam(method, blend):
     rng = np.random.default_rng(0)
     n = 40
     errors = {name: rng.random((n, n)) for name in ("nw", "ne", "sw", "se")}
-    fr = frame_cut(errors, band=5, method=method, blend=blend, width=6)
+    fr = frame_cut(errors, band=5, seam=SeamSpec(method, blend=blend, width=6))
     w = fr.weights()
     exact = {"n": w["n"][0], "s": w["s"][-1], "w": w["w"][1:-1, 0], "e": w["e"][1:-1, -1]}
     for role, v in exact.items():
@@ -211,7 +211,7 @@ def test_sixteen_bit_pixels_stay_exact_away_from_blends():
     g = np.random.default_rng(1)
     src = (smooth_texture((100, 100), 3, seed=2) * 65535).astype(np.uint16)
     src ^= g.integers(0, 8, src.shape, dtype=np.uint16)  # low bits an 8-bit copy would lose
-    ws = wang_set(src, tile_size=T, rng=2, blend="none", tiles=[0, 7])
+    ws = wang_set(src, tile_size=T, rng=2, seam=SeamSpec(blend="none"), tiles=[0, 7])
     values = set(src.ravel().tolist())
     for t in ws.tiles:
         x = t.tile.astype(np.float64) * 65535
@@ -254,6 +254,8 @@ def test_bad_input_is_refused_with_a_clear_message(source):
         wang_set(source, tile_size=T, band=9)
     with pytest.raises(TypeError, match="unexpected option"):
         wang_set(source, tile_size=T, o_max=3)
+    with pytest.raises(TypeError, match="seam must be an engine.seams.SeamSpec"):
+        wang_set(source, tile_size=T, seam="dp")
     with pytest.raises(ValueError, match="margin must be smaller than patch_overlap"):
         wang_set(source, tile_size=T, patch_overlap=3, margin=3)
     bad = [WangSample("h", 0, (0, 0))] * 4
@@ -263,3 +265,26 @@ def test_bad_input_is_refused_with_a_clear_message(source):
     ok[0] = WangSample("h", 0, (2, 0))
     with pytest.raises(ValueError, match="outside the 120x112 source"):
         wang_set(source, tile_size=T, samples=ok)
+
+
+def test_lattice_of_valid_layouts_against_crops_with_each_tiles_own_border(source, k2):
+    """engine.metrics.lattice for a Wang set: valid layouts, and a floor whose crop k carries
+    tile k's own margin. Crops of the source itself score about 0 above that floor; tiles that
+    repeat one diamond per colour (no interior) score far above it."""
+    from engine.metrics import lattice
+    from engine.tiles.wang_layout import wang_layout
+
+    sigs = k2.signatures
+    lays = [wang_layout(sigs, 8, 8, rng=i) for i in range(3)]
+    m = k2.parameters["margin"]
+    res = lattice(k2.tiles, source, margin=m, layouts=lays)
+    assert res.above == pytest.approx(res.value - res.floor)
+    g = np.random.default_rng(0)
+    crops = [source[y : y + T, x : x + T] for y, x in g.integers(0, 80, (16, 2))]
+    crops_above = lattice(crops, source, margin=0, layouts=lays, rng=1).above
+    assert abs(crops_above) < 3.0  # 16 crops, 3 layouts: a noisy floor
+    dia = wang_set(source, tile_size=T, rng=5, interior="diamonds")
+    dia_above = lattice(dia.tiles, source, margin=0, layouts=lays).above
+    assert dia_above > max(res.above, crops_above) + 4
+    with pytest.raises(ValueError, match="layouts must hold tile indices"):
+        lattice(k2.tiles, source, margin=m, layouts=[np.full((8, 8), 16)])
