@@ -15,6 +15,7 @@ from PySide6.QtCore import Qt, Slot
 from PySide6.QtGui import QAction, QActionGroup, QKeySequence
 from PySide6.QtWidgets import (
     QApplication,
+    QDialog,
     QDockWidget,
     QLabel,
     QMainWindow,
@@ -23,7 +24,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from quilt_gui import jobs, params, settings
+from quilt_gui import jobs, params, settings, window_geometry
 from quilt_gui.document import Document
 from quilt_gui.files import ProjectFiles
 from quilt_gui.imaging import pixel_text
@@ -32,6 +33,7 @@ from quilt_gui.theme import apply_theme
 from quilt_gui.widgets.candidate_dialog import CandidateDialog
 from quilt_gui.widgets.canvas import ImageCanvas
 from quilt_gui.widgets.gallery import CandidateView
+from quilt_gui.widgets.help import GettingStarted, ShortcutSheet
 from quilt_gui.widgets.overlap_panel import OverlapPanel
 from quilt_gui.widgets.params_panel import QUILT_GROUPS, TILESET_GROUPS, ParamsPanel
 from quilt_gui.widgets.preview import PreviewView
@@ -82,6 +84,7 @@ class MainWindow(QMainWindow):
         self.files = ProjectFiles(self.doc, self.jobs, self)
         self.messages: list[tuple[str, str]] = []  # (level, text) log, newest last
         self._dialogs: dict[int, CandidateDialog] = {}
+        self._help: dict[str, QDialog] = {}
         self._criteria: dict[str, float] = {}
         self._make_actions()
         self._make_views()
@@ -89,10 +92,8 @@ class MainWindow(QMainWindow):
         self._make_status_bar()
         self._connect()
         start_warmup(self.jobs)
-        self.resize(1500, 950)
-        geo, state = settings.get("window_geometry"), settings.get("window_state")
-        if not geo.isEmpty():
-            self.restoreGeometry(geo)
+        window_geometry.place(self, settings.get("window_geometry"))
+        state = settings.get("window_state")
         if not state.isEmpty():
             self.restoreState(state)
         self._update_title()
@@ -245,13 +246,11 @@ class MainWindow(QMainWindow):
         self.tabs.addTab(self.preview_view, "Preview")
         self.quilt_view = QuiltView(doc, (self.act_quilt, self.act_load_target, self.act_transfer))
         self.tabs.addTab(self.quilt_view, "Quilting")
-        self.message_bar = MessageBar()
         central = QWidget()
         lay = QVBoxLayout(central)
         lay.setContentsMargins(0, 0, 0, 0)
-        lay.setSpacing(0)
-        lay.addWidget(self.message_bar)
         lay.addWidget(self.tabs, 1)
+        self.message_bar = MessageBar(central)  # floats over the canvas, outside the layout
         self.setCentralWidget(central)
         self.params_panel = ParamsPanel(
             doc,
@@ -339,6 +338,7 @@ class MainWindow(QMainWindow):
         m = mb.addMenu("&Quilting")
         m.addActions([self.act_quilt, self.act_load_target, self.act_transfer])
         m = mb.addMenu("&Help")
+        m.addAction("&Getting started", self.show_getting_started)
         m.addAction("&Keyboard and mouse", self.show_help)
 
     def _make_status_bar(self) -> None:
@@ -536,23 +536,20 @@ class MainWindow(QMainWindow):
         settings.set("theme", name)
         apply_theme(QApplication.instance(), name)
 
-    def show_help(self) -> None:
-        self.show_message(
-            "info",
-            (
-                "Wheel: zoom about the cursor · drag: pan · Ctrl+0 fit · Ctrl+1 100 % · "
-                "drag the yellow rectangle or its handles, arrow keys nudge (Shift: 10 px) · "
-                "Ctrl+click an overlap (or click in the overlaps panel): waypoint, right-click "
-                "removes · Shift+drag on the source paints pixels never to use, "
-                "Shift+right-drag erases, Ctrl+Shift+click excludes a colour · "
-                "H heat overlay · 1 / 3 / 5: seamless tile 1×1 / 3×3 / 5×5 · "
-                "gallery: click picks, Shift+click picks a range, "
-                "Space, Ctrl+A all, Enter or double-click opens, L locks, R re-rolls, "
-                "right-click: preview weight · drag the orange patch rectangle to rebuild a "
-                "candidate · Ctrl+R re-rolls the layout, G its grid · Esc cancels the running "
-                "job."
-            ),
-        )
+    def show_help(self) -> ShortcutSheet:
+        """Help ▸ Keyboard and mouse: the shortcut sheet (non-modal)."""
+        return self._show_dialog("shortcuts", lambda: ShortcutSheet(self.actions(), self))
+
+    def show_getting_started(self) -> GettingStarted:
+        return self._show_dialog("getting_started", lambda: GettingStarted(self))
+
+    def _show_dialog(self, key: str, make):
+        dlg = self._help.get(key)
+        if dlg is None:
+            dlg = self._help[key] = make()
+        dlg.show()
+        dlg.raise_()
+        return dlg
 
     # ------------------------------------------------------------------ status
     def _on_hover(self, canvas: ImageCanvas, px) -> None:
@@ -619,6 +616,9 @@ class MainWindow(QMainWindow):
 
     # ------------------------------------------------------------------ closing
     def closeEvent(self, event) -> None:  # noqa: N802 - Qt API
+        if self.files.closing:  # closed before (a second close, e.g. at the end of a test)
+            event.accept()
+            return
         if not self.files.confirm_discard():
             event.ignore()
             return

@@ -17,8 +17,14 @@ SUBCOMMANDS = ("seam", "tileset", "synth", "transfer", "export", "heal")
 def build_parser(prog: str = "quilt-studio") -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog=prog,
+        usage=f"{prog} [FILE] | {prog} SUBCOMMAND [options] | {prog} -h",
         description="Quilt Studio: seamless tiles, connectable tile sets, image quilting and "
-        "texture transfer. With no sub-command, opens the editor.",
+        "texture transfer.\n\n"
+        f"  {prog}              open the editor on a bundled sample\n"
+        f"  {prog} FILE         open FILE in the editor: an image (PNG, JPEG, TIFF, BMP,\n"
+        "                            WebP) or a .quiltproj project\n"
+        f"  {prog} SUBCOMMAND   run headless (listed below; SUBCOMMAND -h for its options)",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     sub = parser.add_subparsers(dest="command", metavar="SUBCOMMAND")
     for name in SUBCOMMANDS:

@@ -136,7 +136,9 @@ class ExportDialog(QDialog):
         self.export_button = self.buttons.addButton(
             "Export", QDialogButtonBox.ButtonRole.AcceptRole
         )
-        self.buttons.addButton(QDialogButtonBox.StandardButton.Close)
+        close = self.buttons.addButton(QDialogButtonBox.StandardButton.Close)
+        close.setAutoDefault(False)  # Enter exports, also after Close was clicked once
+        self.export_button.setDefault(True)
         self.buttons.accepted.connect(self.export)
         self.buttons.rejected.connect(self.close)
         lay = QVBoxLayout(self)
@@ -170,6 +172,7 @@ class ExportDialog(QDialog):
         )
         self.normal.setEnabled("normal" in (doc.source.kinds.values() if doc.source else ()))
         self.status.setText("")
+        self.export_button.setDefault(True)
 
     def options(self) -> dict:
         """Keyword options of :func:`engine.project.export_project` from the widgets."""

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import time
 
-from PySide6.QtCore import Qt, QTimer, Slot
+from PySide6.QtCore import QEvent, Qt, QTimer, Slot
 from PySide6.QtWidgets import (
     QHBoxLayout,
     QLabel,
@@ -27,10 +27,16 @@ SHOW_AFTER = 0.3  # seconds a job runs before its progress bar appears
 
 
 class MessageBar(QWidget):
-    """A banner above the canvas: never modal; errors stay until closed, info fades."""
+    """A banner floating over the bottom of ``parent`` (the canvas area): never modal; errors
+    stay until closed, info fades. It takes no room in a layout, so nothing moves under the
+    mouse when it comes and goes."""
+
+    MARGIN = 8
 
     def __init__(self, parent=None) -> None:
         super().__init__(parent)
+        if parent is not None:
+            parent.installEventFilter(self)
         self.setObjectName("MessageBar")
         self.setAttribute(Qt.WidgetAttribute.WA_StyledBackground, True)
         lay = QHBoxLayout(self)
@@ -74,10 +80,28 @@ class MessageBar(QWidget):
             b.clicked.connect(self.dismiss)
             self._actions.addWidget(b)
         self.show()
+        self.place()
         if level == "info" and not actions:
             self._timer.start(INFO_SECONDS * 1000)
         else:
             self._timer.stop()
+
+    def place(self) -> None:
+        """Span the parent's width at its bottom, above everything in it."""
+        parent = self.parentWidget()
+        if parent is None:
+            return
+        m = self.MARGIN
+        width = max(100, parent.width() - 2 * m)
+        height = self.heightForWidth(width) if self.hasHeightForWidth() else -1
+        height = max(height, self.sizeHint().height())
+        self.setGeometry(m, max(0, parent.height() - height - m), width, height)
+        self.raise_()
+
+    def eventFilter(self, obj, event) -> bool:  # noqa: N802 - Qt API
+        if obj is self.parentWidget() and event.type() == QEvent.Type.Resize and self.isVisible():
+            self.place()
+        return False
 
     def waiting_for_answer(self) -> bool:
         """True while a message with action buttons is shown (info must not replace it)."""
@@ -89,8 +113,34 @@ class MessageBar(QWidget):
         self.hide()
 
 
+#: Jobs that run beside a long one without taking the status bar from it.
+BACKGROUND_KEYS = frozenset({"autosave", "warmup", "tile_metrics", "preview", "save"})
+
+
+def time_left(job: jobs.Job, now: float | None = None) -> float | None:
+    """Seconds the job still needs at its rate so far, None before it can be told."""
+    p = job.progress
+    if p is None or p.total <= 0 or p.done <= 0 or p.done >= p.total:
+        return None
+    elapsed = (time.perf_counter() if now is None else now) - job.started_at
+    if elapsed < 1.0:
+        return None
+    return elapsed * (p.total - p.done) / p.done
+
+
+def duration_text(seconds: float) -> str:
+    """``~12 s`` or ``~3 min``."""
+    if seconds < 90:
+        return f"~{max(1, round(seconds))} s"
+    return f"~{round(seconds / 60)} min"
+
+
 class JobStatus(QWidget):
-    """Progress of the newest running job, and a Cancel button that stops it."""
+    """The main running job (its n/N and the time left), the others named, and a Cancel
+    button that stops them.
+
+    The main job is the oldest running one with a known length, else the oldest: a
+    background save or measurement never takes the bar from a long generation."""
 
     def __init__(self, manager: jobs.JobManager, parent=None) -> None:
         super().__init__(parent)
@@ -98,6 +148,8 @@ class JobStatus(QWidget):
         lay = QHBoxLayout(self)
         lay.setContentsMargins(0, 0, 0, 0)
         self.label = QLabel()
+        self.others = QLabel()
+        self.others.setToolTip("Other jobs running at the same time")
         self.bar = QProgressBar()
         self.bar.setFixedWidth(160)
         self.bar.setTextVisible(True)
@@ -106,6 +158,7 @@ class JobStatus(QWidget):
         self.cancel_button.clicked.connect(self.cancel)
         lay.addWidget(self.label)
         lay.addWidget(self.bar)
+        lay.addWidget(self.others)
         lay.addWidget(self.cancel_button)
         self._poll = QTimer(self)
         self._poll.setInterval(100)
@@ -121,8 +174,13 @@ class JobStatus(QWidget):
         return [j for j in self.manager.running() if now - j.started_at >= SHOW_AFTER]
 
     def current(self) -> jobs.Job | None:
+        """The job the bar shows (see the class docstring)."""
         shown = self.shown_jobs()
-        return shown[-1] if shown else None
+        if not shown:
+            return None
+        foreground = [j for j in shown if j.key not in BACKGROUND_KEYS] or shown
+        measured = [j for j in foreground if j.progress is not None and j.progress.total > 0]
+        return min(measured or foreground, key=lambda j: j.started_at)
 
     @Slot()
     def cancel(self) -> None:
@@ -141,9 +199,12 @@ class JobStatus(QWidget):
             self.setVisible(False)
             return
         self.setVisible(True)
-        n = len(self.shown_jobs())
-        self.label.setText(job.label + (f" (+{n - 1})" if n > 1 else ""))
+        others = [j.label for j in self.shown_jobs() if j is not job]
+        self.others.setText(f"· also {', '.join(others)}" if others else "")
+        self.others.setVisible(bool(others))
         p = job.progress
+        left = time_left(job)
+        self.label.setText(job.label + (f" — {duration_text(left)} left" if left else ""))
         if p is None or p.total <= 0:
             self.bar.setRange(0, 0)  # busy indicator
         else:

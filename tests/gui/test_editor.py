@@ -520,7 +520,7 @@ def test_window_fits_a_1280_px_screen_whatever_the_labels_say(qtbot, win):
     generate(qtbot, win, 4)
     win.doc.tileset.set_picks([0, 1, 2])
     wait_idle(qtbot, win)
-    win.show_help()  # the longest banner
+    win.show_message("info", "A long message. " * 30)  # a long banner
     for tab in (win.source_view, win.preview_view, win.quilt_view):
         win.tabs.setCurrentWidget(tab)
         assert win.minimumSizeHint().width() <= 1100, tab

@@ -1,0 +1,49 @@
+"""Messages that move nothing, and help that stays (issue 13 item 6)."""
+
+from __future__ import annotations
+
+from PySide6.QtCore import QRect
+from PySide6.QtWidgets import QToolButton
+
+from tests.gui.helpers import make_window, open_sample
+
+
+def test_a_message_floats_over_the_canvas_and_moves_nothing(qtbot):
+    w = make_window(qtbot)
+    open_sample(qtbot, w)
+    w.message_bar.dismiss()
+    qtbot.wait(10)
+    before = (w.tabs.geometry(), w.source_view.mapTo(w, w.source_view.rect().topLeft()))
+    w.show_message("warning", "Something to read. " * 12, actions=(("OK", lambda: None),))
+    qtbot.wait(10)
+    after = (w.tabs.geometry(), w.source_view.mapTo(w, w.source_view.rect().topLeft()))
+    assert w.message_bar.isVisible() and before == after
+    bar = w.message_bar.geometry()
+    assert w.centralWidget().rect().contains(bar)
+    # it floats at the bottom: the tab bar and the Quilting tab's buttons stay clickable
+    w.tabs.setCurrentWidget(w.quilt_view)
+    tab_bar = w.tabs.tabBar().geometry()
+    assert not bar.intersects(tab_bar)
+    synth = next(b for b in w.quilt_view.findChildren(QToolButton) if "Synthesize" in b.text())
+    top_left = synth.mapTo(w.centralWidget(), synth.rect().topLeft())
+    assert not bar.intersects(QRect(top_left, synth.size()))
+    w.message_bar.dismiss()
+    assert w.tabs.geometry() == before[0]
+
+
+def test_help_is_a_shortcut_sheet_and_a_getting_started_that_stay(qtbot):
+    w = make_window(qtbot)
+    w.message_bar.dismiss()
+    help_menu = next(a.menu() for a in w.menuBar().actions() if a.text() == "&Help")
+    entries = {a.text(): a for a in help_menu.actions()}
+    entries["&Keyboard and mouse"].trigger()
+    sheet = w._help["shortcuts"]
+    assert sheet.isVisible() and not w.message_bar.isVisible()
+    rows = sheet.rows()
+    assert ("Keyboard", "Ctrl+T", "Find best tile") in rows
+    assert any(r[1] == "Wheel" for r in rows) and len(rows) > 30
+    entries["&Getting started"].trigger()
+    guide = w._help["getting_started"]
+    assert guide.isVisible() and "Export seamless tile" in guide.text.text()
+    qtbot.wait(50)
+    assert sheet.isVisible() and guide.isVisible()  # dialogs, not a banner that fades
