@@ -98,13 +98,13 @@ def test_zoom_shortcuts_and_pixel_readout(qtbot, win):
     assert win.source_view.zoom == 1.0
     win.act_zoom_in.trigger()
     assert win.source_view.zoom == 2.0
+    pos = win.source_view.view_pos_of_pixel(10, 20)  # exact at an integer zoom
+    assert win.source_view.pixel_at(QPointF(pos)) == (10, 20)
     win.act_fit.trigger()
     assert win.source_view.zoom < 2.0
-    pos = win.source_view.view_pos_of_pixel(10, 20)
     win._on_hover(win.source_view, (10, 20))
     v = (win.doc.source.main[10, 20] * 255).round().astype(int)
     assert win.pixel_label.text() == f"x 20, y 10 = ({v[0]}, {v[1]}, {v[2]})"
-    assert win.source_view.pixel_at(QPointF(pos)) == (10, 20)
 
 
 # ---------------------------------------------------------------------- template step
