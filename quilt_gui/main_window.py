@@ -41,6 +41,7 @@ from quilt_gui.widgets.quilt_view import QuiltView
 from quilt_gui.widgets.source_view import SourceView
 from quilt_gui.widgets.status import JobStatus, MessageBar
 from quilt_gui.widgets.tile_view import REPEATS, TileView
+from quilt_gui.widgets.wrap_view import WrapView
 from resources import SAMPLE_NAMES
 
 log = logging.getLogger(__name__)
@@ -244,6 +245,11 @@ class MainWindow(QMainWindow):
         self.tabs.setDocumentMode(True)
         self.tabs.addTab(self.source_view, "Source")
         self.tabs.addTab(self.preview_view, "Preview")
+        self.wrap_view = WrapView(doc)
+        self.tabs.addTab(self.wrap_view, "Wrap-around")
+        self.tabs.setTabToolTip(
+            2, "The seamless tile (or the preview) repeated without end, to pan across its edges"
+        )
         self.quilt_view = QuiltView(doc, (self.act_quilt, self.act_load_target, self.act_transfer))
         self.tabs.addTab(self.quilt_view, "Quilting")
         central = QWidget()
@@ -377,6 +383,7 @@ class MainWindow(QMainWindow):
         self.tabs.currentChanged.connect(self._on_tab_changed)
         self.quilt_view.selection_changed.connect(self._show_criteria)
         self.tile_view.repeats_changed.connect(self._on_repeats_changed)
+        self.tile_view.wrap_requested.connect(partial(self.tabs.setCurrentWidget, self.wrap_view))
         for canvas in self.canvases():
             canvas.hovered.connect(partial(self._on_hover, canvas))
         self.source_view.set_heat_visible(self.act_heat.isChecked())
@@ -385,6 +392,7 @@ class MainWindow(QMainWindow):
         return [
             self.source_view,
             self.preview_view.canvas,
+            self.wrap_view.canvas,
             self.tile_view.canvas,
             *self.overlap_panel.views.values(),
             self.quilt_view.sample,

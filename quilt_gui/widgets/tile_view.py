@@ -72,7 +72,7 @@ class TiledImageView(QWidget):
             self.repeats = 3
         self.grid = settings.get("tile_grid_lines")
         self._lines: list[QGraphicsLineItem] = []
-        bar = QHBoxLayout()
+        bar = self.bar = QHBoxLayout()
         bar.setContentsMargins(0, 0, 0, 0)
         self.repeat_buttons = QButtonGroup(self)
         for n in REPEATS:
@@ -148,9 +148,16 @@ class TiledImageView(QWidget):
 class TileView(TiledImageView):
     """The document's seamless tile, with its wrap border ratio and detail ratio."""
 
+    wrap_requested = Signal()  # show the tile in the large wrap-around view
+
     def __init__(self, doc: Document, parent=None) -> None:
         super().__init__(parent)
         self.doc = doc
+        large = QToolButton()
+        large.setText("Wrap-around…")
+        large.setToolTip("Pan across the tile's edges at 100 % in the Wrap-around tab")
+        large.clicked.connect(self.wrap_requested)
+        self.bar.insertWidget(self.bar.count() - 1, large)
         self.metrics: dict | None = None
         self.info.setToolTip(
             "Wrap border ratio: joint across the tile's wrap vs. the texture "
