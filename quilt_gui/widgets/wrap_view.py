@@ -18,6 +18,7 @@ from PySide6.QtWidgets import (
     QHBoxLayout,
     QLabel,
     QRadioButton,
+    QSizePolicy,
     QVBoxLayout,
     QWidget,
 )
@@ -140,7 +141,7 @@ class WrapView(QWidget):
         bar = QHBoxLayout()
         bar.setContentsMargins(4, 2, 4, 2)
         bar.addWidget(QLabel("Repeat:"))
-        for i, text in enumerate(("Seamless tile", "Preview of the picked tiles")):
+        for i, text in enumerate(("Seamless tile", "Preview")):
             b = QRadioButton(text)
             b.setChecked(i == 0)
             self.choice.addButton(b, i)
@@ -151,6 +152,8 @@ class WrapView(QWidget):
         self.borders.toggled.connect(self._set_borders)
         bar.addWidget(self.borders)
         self.info = QLabel()
+        self.info.setWordWrap(True)  # long texts must not widen the window
+        self.info.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Preferred)
         bar.addWidget(self.info, 1)
         lay = QVBoxLayout(self)
         lay.setContentsMargins(0, 0, 0, 0)
