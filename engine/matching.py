@@ -38,6 +38,7 @@ __all__ = [
     "error_floor",
     "masked_ssd",
     "select_within_tolerance",
+    "smallest_indices",
     "ssd_at",
 ]
 
@@ -81,6 +82,11 @@ class SampleSpectrum:
         sq = np.stack([np.sum(chans[list(g)] ** 2, axis=0) for g in self.groups])
         self._fs = self._forward(chans)
         self._fsq = self._forward(sq)
+
+    @property
+    def nbytes(self) -> int:
+        """Memory held by the spectra (the sample itself not counted)."""
+        return self._fs.nbytes + self._fsq.nbytes
 
     def _forward(self, k: np.ndarray, workers: int | None = None) -> np.ndarray:
         """2-D real FFT of kernels (..., kh, kw) zero-padded to ``padded``; pruned row pass."""
@@ -351,7 +357,7 @@ def _rank(
     errors = np.full((n, m), np.inf)
     counts = np.zeros(n, np.int64)
     for i in range(n):
-        idx = _smallest(est[i], m)
+        idx = smallest_indices(est[i], m)
         idx = idx[np.isfinite(est[i][idx])]
         a = np.empty((idx.size, 2), np.int64)
         for r in range(idx.size):
@@ -382,7 +388,7 @@ def _matmul(a, b):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _smallest(values, m):  # pragma: no cover - compiled
+def smallest_indices(values, m):  # pragma: no cover - compiled
     """Indices of the ``m`` smallest of ``values`` (1-D), ascending; ties by index.
 
     A threshold from a strided sample keeps about 8 ``m`` candidates in one pass, then only

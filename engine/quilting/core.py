@@ -25,6 +25,7 @@ from engine.matching import (
     select_within_tolerance,
     ssd_at,
 )
+from engine.pyramid import PyramidSearch, pyramid_levels
 from engine.quilting.cut import blend_alpha, cut_overlap, straight_alpha
 from engine.quilting.layout import arms_of, canvas_index
 from engine.quilting.records import EMPTY_PATH, BlockRecord, read_only
@@ -73,15 +74,34 @@ class Quilter:
         self._valid: dict[tuple[int, int], tuple[np.ndarray | None, np.ndarray]] = {}
         self._spectrum = None
         self._pca = None
+        self._pyramid = None
+        self.pyramid_depth = 0  # pyramid reductions of the fast search (0: none)
+        self.origin = None  # (H, W, 2) int32: the sample pixel each canvas pixel came from
         self.fft_workers = 1 if threads > 1 else threads  # the pool already uses every thread
         self.stream = True  # False: no events (the benchmark's streaming-overhead reference)
 
     def prepare(self) -> None:
         """Build the structures every search shares (before any thread reads them)."""
-        if self.select == "best":
-            _ = self.spectrum
-            if self.mode == "fast":
-                self.pca()
+        if self.select != "best":
+            return
+        if self.mode == "fast" and self.pyramid_depth == 0:
+            self.pyramid_depth = pyramid_levels(self.sample.shape[:2], self.block, self.overlap)
+        if self.mode == "fast" and self.pyramid_depth:
+            self._pyramid = PyramidSearch(
+                self.match_sample, levels=self.pyramid_depth, workers=self.threads
+            )
+            self.origin = np.full((*self.out_shape, 2), -1, np.int32)
+            return
+        _ = self.spectrum
+        if self.mode == "fast":
+            self.pca()
+
+    def run_block(self, wk: BlockWork) -> list[tuple[BlockRecord, np.ndarray]]:
+        """Load, search and place one block whose predecessors are placed; its records."""
+        check(self.cancel)
+        self.load(wk)
+        self.search([wk])
+        return self.place(wk)
 
     # ---------------------------------------------------------------- sample helpers
     @property
@@ -152,6 +172,10 @@ class Quilter:
             for wk in need:
                 wk.found = self._sampled(wk)
             return
+        if self._pyramid is not None:
+            for wk in need:
+                wk.found = ("list", *self._pyramid_query(wk))
+            return
         exact = need
         if self.mode == "fast":
             exact = []
@@ -177,6 +201,29 @@ class Quilter:
                 for (wk, _), (anchors, errs) in zip(fast, res, strict=True):
                     wk.found = ("list", anchors, errs)
         self._exact(exact)
+
+    def _pyramid_query(self, wk: BlockWork):
+        v, _ = self.valid(wk.h, wk.w)
+        return self._pyramid.query(
+            wk.old, wk.filled[:, :, None], valid=v, seeds=self.seeds(wk), workers=self.fft_workers
+        )
+
+    def seeds(self, wk: BlockWork) -> np.ndarray:
+        """Anchors that continue the source windows of the content under the block's arms
+        (PatchMatch's propagation): from the middle pixel of every arm."""
+        t, left, b, r = wk.arms
+        h, w = wk.h, wk.w
+        pts = [(t // 2, w // 2)] if t else []
+        pts += [(h // 2, left // 2)] if left else []
+        pts += [(h - 1 - b // 2, w // 2)] if b else []
+        pts += [(h // 2, w - 1 - r // 2)] if r else []
+        H, W = self.out_shape
+        out = []
+        for u, v in pts:
+            oy, ox = self.origin[(wk.y + u) % H, (wk.x + v) % W]
+            if oy >= 0:
+                out.append((oy - u, ox - v))
+        return np.array(out, np.int64).reshape(-1, 2)
 
     def _exact(self, works: list[BlockWork]) -> None:
         groups: dict[tuple[int, int], list[BlockWork]] = {}
@@ -256,11 +303,7 @@ class Quilter:
                 for dx in (0, wk.w - cw):
                     child = BlockWork(wk.index, wk.y + dy, wk.x + dx, ch, cw, wk.rng, wk.depth + 1)
                     self.load(child)
-                    if child.old is not None and self.select in ("best", "sampled"):
-                        if self.select == "sampled":
-                            child.found = self._sampled(child)
-                        else:
-                            self._exact([child])
+                    self.search([child])
                     out.extend(self.place(child))
             return out
         return [self.paste(wk, anchor, e_match, e_min, n)]
@@ -307,6 +350,13 @@ class Quilter:
         ix = self.idx(wk.y, wk.x, h, w)
         self.canvas[ix] = pixels
         self.filled[ix] = True
+        if self.origin is not None:
+            org = np.empty((h, w, 2), np.int32)
+            org[:, :, 0] = np.arange(ay, ay + h)[:, None]
+            org[:, :, 1] = np.arange(ax, ax + w)[None, :]
+            if keep is not None:
+                org[keep] = self.origin[ix][keep]
+            self.origin[ix] = org
         H, W = self.out_shape
         rec = BlockRecord(
             index=-1,

@@ -11,17 +11,17 @@ exactly the canvas its predecessors left: the output is identical for any number
 
 from __future__ import annotations
 
-from concurrent.futures import ThreadPoolExecutor
+import threading
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import replace
 
 import numpy as np
 
-from engine.cancel import check
 from engine.events import Progress
 from engine.quilting.core import BlockWork, Quilter
 from engine.quilting.records import BlockPlaced, BlockRecord
 
-__all__ = ["POOL_MIN_SAMPLE_AREA", "SEARCH_CHUNK", "dependencies", "run_levels"]
+__all__ = ["POOL_MIN_SAMPLE_AREA", "dependencies", "run_levels"]
 
 
 def dependencies(rects, shape, torus: bool):
@@ -62,81 +62,91 @@ def _axis_cells(spans, n: int, torus: bool):
 
 
 POOL_MIN_SAMPLE_AREA = 200 * 200
-"""Below this sample area a block's search is so cheap (< 0.1 ms) that handing it to another
-thread costs more than it saves: such runs stay on one thread (same result either way)."""
-
-
-SEARCH_CHUNK = 4
-"""Blocks of one level searched in one batch (fixed: batches never depend on the threads)."""
+"""Below this sample area a block's search is so cheap that handing blocks to other threads
+costs more than it saves: such runs stay on one thread (same result either way)."""
 
 
 def run_levels(q: Quilter, rects, total_label: str):
     """Place ``rects`` (top-level blocks, raster order); yields events, returns the records.
 
-    Blocks are placed one by one in level order (level, then raster index) and searched in fixed
-    batches of up to :data:`SEARCH_CHUNK` consecutive blocks of one level. A batch's search needs
-    only its blocks' predecessors placed, so with ``threads > 1`` the searches run ahead on a pool
-    (FFTs and numba kernels release the GIL) while this thread places blocks. Every batch is the
-    same and sees exactly the canvas its predecessors left whatever the number of threads, and
-    every block has its own generator: the result does not depend on the number of threads.
+    Each block is loaded (the canvas under it read), searched and placed as one task, as soon as
+    its predecessors are placed; with ``threads > 1`` the tasks run on a pool (FFTs and numba
+    kernels release the GIL) and blocks of one level are placed side by side (their footprints
+    are disjoint). Records and events come out in level order (level, then raster index) whatever
+    the number of threads, and every block sees exactly the canvas its predecessors left and
+    draws from its own generator: the result does not depend on the number of threads.
     """
     q.prepare()  # shared search structures, built once before any thread reads them
     preds, levels = dependencies(rects, q.out_shape, q.tileable)
     order = sorted(range(len(rects)), key=lambda k: (levels[k], k))
-    works = [BlockWork(k, *r, rng=np.random.default_rng([q.seed, k])) for k, r in enumerate(rects)]
-    chunks: list[list[int]] = []
-    for k in order:
-        if chunks and len(chunks[-1]) < SEARCH_CHUNK and levels[chunks[-1][0]] == levels[k]:
-            chunks[-1].append(k)
-        else:
-            chunks.append([k])
-    waiting, dependents = [], [[] for _ in rects]
-    for c, members in enumerate(chunks):
-        needed = {j for k in members for j in preds[k]}
-        waiting.append(len(needed))
-        for j in needed:
-            dependents[j].append(c)
+
+    def work(k: int) -> BlockWork:
+        return BlockWork(k, *rects[k], rng=np.random.default_rng([q.seed, k]))
+
     heavy = q.sample.shape[0] * q.sample.shape[1] >= POOL_MIN_SAMPLE_AREA
-    pool = ThreadPoolExecutor(max(1, q.threads - 1)) if q.threads > 1 and heavy else None
-    futures = {}
-
-    def loaded(c):  # the batch's predecessors are placed: read what lies under it now
-        batch = [works[k] for k in chunks[c]]
-        for wk in batch:
-            q.load(wk)
-        return batch
-
+    if q.threads > 1 and heavy:
+        placed = _DependencyPool(q, work, preds, q.threads)
+        outcomes = (placed.result(k) for k in order)
+    else:
+        placed = None
+        outcomes = (q.run_block(work(k)) for k in order)
     records: list[BlockRecord] = []
     try:
-        if pool is not None:
-            futures = {
-                c: pool.submit(q.search, loaded(c)) for c in range(len(chunks)) if not waiting[c]
-            }
-        done = 0
-        for c, members in enumerate(chunks):
-            check(q.cancel)
-            if pool is None:
-                q.search(loaded(c))
-            else:
-                futures.pop(c).result()
-            for k in members:
-                for rec, pixels in q.place(works[k]):
-                    rec = replace(rec, index=len(records))
-                    records.append(rec)
-                    if q.stream:
-                        yield BlockPlaced(rec, pixels)
-                works[k] = None  # its arrays live on in the records
-                for d in dependents[k]:
-                    waiting[d] -= 1
-                    if not waiting[d] and pool is not None:
-                        futures[d] = pool.submit(q.search, loaded(d))
-            done += len(members)
-            last = c + 1 == len(chunks) or levels[chunks[c + 1][0]] != levels[members[0]]
+        for i, (k, out) in enumerate(zip(order, outcomes, strict=True)):
+            for rec, pixels in out:
+                rec = replace(rec, index=len(records))
+                records.append(rec)
+                if q.stream:
+                    yield BlockPlaced(rec, pixels)
+            last = i + 1 == len(order) or levels[order[i + 1]] != levels[k]
             if q.stream and last:
-                yield Progress(done, len(rects), total_label)
+                yield Progress(i + 1, len(rects), total_label)
     finally:
-        if pool is not None:
-            for f in futures.values():
-                f.cancel()
-            pool.shutdown(wait=True, cancel_futures=True)
+        if placed is not None:
+            placed.shutdown()
     return records
+
+
+class _DependencyPool:
+    """Runs :meth:`Quilter.run_block` for every block on ``threads`` workers, each block as soon
+    as its predecessors are placed; :meth:`result` waits for one block's records."""
+
+    def __init__(self, q: Quilter, work, preds, threads: int):
+        self.q, self.work = q, work
+        self.done = [Future() for _ in preds]
+        self.waiting = [len(p) for p in preds]
+        self.dependents = [[] for _ in preds]
+        for k, p in enumerate(preds):
+            for j in p:
+                self.dependents[j].append(k)
+        self.lock = threading.Lock()
+        self.stopped = False
+        self.pool = ThreadPoolExecutor(threads)
+        for k in [k for k, n in enumerate(self.waiting) if not n]:  # before any task runs
+            self.pool.submit(self._run, k)
+
+    def _run(self, k: int) -> None:
+        if self.stopped:
+            return
+        try:
+            self.done[k].set_result(self.q.run_block(self.work(k)))
+        except BaseException as exc:  # handed to the consumer by result()
+            self.done[k].set_exception(exc)
+            return
+        ready = []
+        with self.lock:
+            for d in self.dependents[k]:
+                self.waiting[d] -= 1
+                if not self.waiting[d]:
+                    ready.append(d)
+            for d in ready:
+                if not self.stopped:
+                    self.pool.submit(self._run, d)
+
+    def result(self, k: int):
+        return self.done[k].result()
+
+    def shutdown(self) -> None:
+        with self.lock:
+            self.stopped = True
+        self.pool.shutdown(wait=True, cancel_futures=True)
