@@ -43,6 +43,7 @@ from engine.matching import ZERO_ERROR_FRACTION, error_floor, select_within_tole
 from engine.metrics import block_grid_border_ratio  # noqa: E402
 from engine.quilting import quilt  # noqa: E402
 from engine.quilting.synthesis import quilt_unstreamed  # noqa: E402
+from engine.seams import SeamSpec  # noqa: E402
 from engine.stitch import l_cut  # noqa: E402
 from resources import SAMPLE_NAMES, sample_path  # noqa: E402
 
@@ -51,6 +52,10 @@ JOBS = {
     "B": dict(crop=256, out=(1024, 1024), block=48, overlap=8),
 }
 TARGETS = {("A", "exact"): 0.25, ("B", "exact"): 1.2, ("B", "fast"): 0.36}
+
+
+def _cut(method: str, metric: str = "ssd") -> SeamSpec:
+    return SeamSpec(method, metric=metric)
 
 
 def baseline_quilt(sample, out_shape, *, block, overlap, tolerance=0.1, rng=0):
@@ -252,12 +257,12 @@ def quality(args) -> None:
     )
     print("Grid border ratio, max over the offsets 0..overlap (mean over offsets in brackets):\n")
     variants = [
-        ("best+dp", dict(seam="dp")),
-        ("best+dp fast", dict(seam="dp", mode="fast")),
-        ("best+straight", dict(seam="straight")),
-        ("random+straight", dict(select="random", seam="straight")),
-        ("random+dp", dict(select="random", seam="dp")),
-        ("bhatia+resistance", dict(select="bhatia", seam="resistance", overlap=8)),
+        ("best+dp", dict(seam=_cut("dp"))),
+        ("best+dp fast", dict(seam=_cut("dp"), mode="fast")),
+        ("best+straight", dict(seam=_cut("straight"))),
+        ("random+straight", dict(select="random", seam=_cut("straight"))),
+        ("random+dp", dict(select="random", seam=_cut("dp"))),
+        ("bhatia+resistance", dict(select="bhatia", seam=_cut("resistance"), overlap=8)),
     ]
     rows = []
     for name in SAMPLE_NAMES:
@@ -285,7 +290,7 @@ def quality(args) -> None:
     rows = []
     for name in SAMPLE_NAMES:
         s = load_sample(name, 128)
-        kw = dict(block=32, overlap=16, metric="euclid")
+        kw = dict(block=32, overlap=16)
         peaks = {}
         for method in ("dp", "minimax"):
             peaks[method] = float(
@@ -294,7 +299,13 @@ def quality(args) -> None:
                         np.nanmean(
                             [
                                 r.peak
-                                for r in quilt(s, (256, 256), seam=method, rng=seed, **kw).blocks
+                                for r in quilt(
+                                    s,
+                                    (256, 256),
+                                    seam=_cut(method, metric="euclid"),
+                                    rng=seed,
+                                    **kw,
+                                ).blocks
                             ]
                         )
                         for seed in seeds

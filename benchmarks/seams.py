@@ -247,7 +247,14 @@ def product_overlaps(names=None, *, quilting=True) -> dict[str, list[Overlap]]:
             candidates(S, tile, 4, seam=SeamSpec("oscillating", blend="adaptive"), rng=0, workers=1)
         if quilting:
             with recording_oscillating(sets["quilting"]):
-                quilt(S, (192, 192), block=48, seam="oscillating", rng=0, threads=1)
+                quilt(
+                    S,
+                    (192, 192),
+                    block=48,
+                    seam=SeamSpec("oscillating", metric="ssd"),
+                    rng=0,
+                    threads=1,
+                )
     return {k: v for k, v in sets.items() if v}
 
 

@@ -335,8 +335,8 @@ def _cut(old, new, known, arms, strips, spec: SeamSpec, cancel):
         return np.zeros(known.shape, np.float32), np.zeros((0, 2), np.intp), 0.0
     err = error_map(old, new, metric=spec.metric)
     err[~known] = 0.0
-    cut = cut_overlap(err, arms, method=spec.method, cancel=cancel, **spec.options)
-    alpha = blend_alpha(cut, err, strips, blend=spec.blend, width=spec.width, rho=spec.rho)
+    cut = cut_overlap(err, arms, seam=spec, cancel=cancel)
+    alpha = blend_alpha(cut, err, strips, seam=spec)
     alpha[~known] = 0.0
     return alpha, cut.path, float(cut.criterion)
 

@@ -36,7 +36,7 @@ from engine.events import Progress, Snapshot, drain
 from engine.matching import ZERO_ERROR_FRACTION, SampleSpectrum, error_floor
 from engine.quilting.core import BlockWork, Quilter
 from engine.quilting.layout import grid_rects
-from engine.quilting.options import SEAMS, check_options, resolve_threads
+from engine.quilting.options import check_options, resolve_threads
 from engine.quilting.records import BlockRecord
 from engine.quilting.scheduler import run_levels
 
@@ -220,16 +220,11 @@ def iter_transfer(
     correspondence: str = "luminance",
     sigma: float = 2.0,
     tolerance: float = 0.1,
-    seam: str = "dp",
-    blend: str = "none",
-    blend_width: float = 4,
-    rho: int = 3,
-    metric: str = "ssd",
+    seam=None,
     excluded=None,
     rng=None,
     cancel=None,
     threads: int | None = None,
-    **seam_options,
 ):
     """Texture transfer of ``sample`` onto ``target``'s layout, streaming events.
 
@@ -250,8 +245,7 @@ def iter_transfer(
         Number of passes N.
     correspondence : {"luminance", "blurred"}
         Correspondence maps; ``sigma`` is the blur of ``"blurred"``.
-    tolerance, seam, blend, blend_width, rho, metric, excluded, rng, cancel, threads,
-    **seam_options
+    tolerance, seam, excluded, rng, cancel, threads
         As in :func:`engine.quilting.iter_quilt`.
 
     Returns
@@ -263,7 +257,6 @@ def iter_transfer(
     s = as_image(sample, "sample")
     t = as_image(target, "target")
     choice(correspondence, "correspondence", CORRESPONDENCES)
-    choice(seam, "seam", SEAMS)
     _check_alpha(alpha)
     if isinstance(sigma, bool) or not isinstance(sigma, numbers.Real) or not sigma > 0:
         raise ValueError(f"sigma must be a positive number, got {sigma!r}")
@@ -291,16 +284,11 @@ def iter_transfer(
                 tolerance=tolerance,
                 candidates=None,
                 seam=seam,
-                blend=blend,
-                blend_width=blend_width,
-                rho=rho,
-                metric=metric,
                 excluded=excluded,
                 tileable=False,
                 adaptive_threshold=None,
                 min_block=None,
                 mode="exact",
-                seam_options=seam_options,
             )
         )
     gen = as_rng(rng)

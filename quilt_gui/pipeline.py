@@ -17,6 +17,7 @@ import numpy as np
 from PySide6.QtCore import QObject, QTimer, Signal, Slot
 
 from engine.cancel import Cancelled
+from engine.seams import SeamSpec
 from quilt_gui import jobs, params
 from quilt_gui.document import Document
 from quilt_gui.imaging import prepare_display
@@ -598,17 +599,19 @@ def quilt_options(p: dict) -> dict:
         select=p["select"],
         tolerance=p["tolerance"],
         candidates=p["q_candidates"] or None,
-        seam=p["q_method"],
-        blend=p["q_blend"],
-        blend_width=p["q_width"],
-        rho=p["q_rho"],
-        metric=p["q_metric"],
+        seam=SeamSpec(
+            p["q_method"],
+            params.seam_options(p, p["q_method"]),
+            metric=p["q_metric"],
+            blend=p["q_blend"],
+            width=p["q_width"],
+            rho=p["q_rho"],
+        ),
         tileable=p["tileable"],
         adaptive_threshold=p["adaptive_threshold"] or None,
         min_block=p["min_block"] or None,
         mode=p["q_mode"],
         rng=p["q_seed"],
-        **(params.seam_options(p, p["q_method"]) if p["q_method"] != "straight" else {}),
     )
 
 

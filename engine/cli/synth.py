@@ -223,17 +223,21 @@ def start(iter_fn, *args, **kwargs):
 
 
 def cut_options(args) -> dict:
-    return dict(
-        seam=args.seam,
-        blend=args.blend,
-        blend_width=args.blend_width,
-        rho=args.rho,
-        metric=args.metric,
-        tolerance=args.tolerance,
-        rng=args.seed,
-        threads=args.threads,
-        **dict(args.seam_option),
-    )
+    """``seam`` (a SeamSpec: a bad ``--seam-option`` raises here), tolerance, seed, threads."""
+    from engine.seams import SeamSpec
+
+    try:
+        seam = SeamSpec(
+            args.seam,
+            dict(args.seam_option),
+            metric=args.metric,
+            blend=args.blend,
+            width=args.blend_width,
+            rho=args.rho,
+        )
+    except TypeError as exc:  # a bad --seam-option: a one-line message
+        raise ValueError(str(exc)) from None
+    return dict(seam=seam, tolerance=args.tolerance, rng=args.seed, threads=args.threads)
 
 
 def run(args) -> int:
@@ -295,7 +299,8 @@ def save_seams(path: str, res) -> None:
             "block": list(res.block),
             "overlap": res.overlap,
             "select": res.select,
-            "seam": res.seam,
+            "seam": res.seam.method,
+            "seam_spec": res.seam.to_dict(),
             "blocks": blocks,
         }
         from engine._fs import write_bytes_atomically

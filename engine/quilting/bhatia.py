@@ -21,7 +21,6 @@ from engine.events import Progress
 from engine.exclusion import valid_anchors
 from engine.quilting.core import Quilter
 from engine.quilting.records import BlockPlaced, BlockRecord, read_only
-from engine.seams import find_seam
 
 __all__ = ["bhatia_anchors", "iter_bhatia"]
 
@@ -74,7 +73,7 @@ def iter_bhatia(q: Quilter, band: int):
             (ly, lx), (_, lw) = anchors[L], sizes[L]
             ext = own.copy()
             ext[:, :kb] = Sp[ly : ly + h, lx + lw : lx + lw + kb]
-            e = error_map(ext[:, :kb], own[:, :kb], metric=q.metric)
+            e = error_map(ext[:, :kb], own[:, :kb], metric=q.seam.metric)
             seam = _bhatia_seam(q, e, own[:, :kb])
             terr[:, :kb][seam.mask] |= 1
             err[:, :kb] = e
@@ -87,7 +86,7 @@ def iter_bhatia(q: Quilter, band: int):
             (uy, ux), (uh, _) = anchors[U], sizes[U]
             ext = own.copy()
             ext[:kt] = Sp[uy + uh : uy + uh + kt, ux : ux + w]
-            e = error_map(ext[:kt], own[:kt], metric=q.metric)
+            e = error_map(ext[:kt], own[:kt], metric=q.seam.metric)
             seam = _bhatia_seam(
                 q, np.ascontiguousarray(e.T), np.ascontiguousarray(own[:kt].transpose(1, 0, 2))
             )
@@ -104,7 +103,7 @@ def iter_bhatia(q: Quilter, band: int):
             ext[:kt, :kb] = Sp[dy + dh : dy + dh + kt, dx + dw : dx + dw + kb]
             exts[2] = ext
         srcs += exts
-        pixels = _territory_composite(terr, srcs, q.blend, q.blend_width)
+        pixels = _territory_composite(terr, srcs, q.seam.blend, q.seam.width)
         path = np.concatenate(paths).astype(np.intp) if paths else np.zeros((0, 2), np.intp)
         keep = terr != 0
         rec = BlockRecord(
@@ -159,10 +158,9 @@ def bhatia_anchors(excluded: np.ndarray, block, band: int) -> np.ndarray:
 
 def _bhatia_seam(q: Quilter, e: np.ndarray, own_band: np.ndarray):
     """Corner-to-corner cut of one band (canonical: extension = R1 on the left)."""
-    opts = dict(q.seam_options)
-    if q.seam == "resistance" and "image" not in opts:
-        opts["image"] = own_band  # Bhatia's step: colour difference inside the new block
-    return find_seam(e, method=q.seam, start=0, end=0, cancel=q.cancel, **opts)
+    # Bhatia's step: the colour difference inside the new block
+    image = own_band if q.seam.method == "resistance" else None
+    return q.seam.find(e, start=0, end=0, image=image, cancel=q.cancel)
 
 
 def _territory_composite(terr, srcs, blend: str, width: float) -> np.ndarray:

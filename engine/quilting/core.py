@@ -62,8 +62,8 @@ class Quilter:
 
     def __init__(self, *, seed: int, cancel, threads: int, **options):
         # options: the validated keywords of iter_quilt, as returned by check_options (sample,
-        # out_shape, block, overlap, select, tolerance, candidates, seam, blend, blend_width, rho,
-        # metric, excluded, tileable, adaptive_threshold, min_block, mode, seam_options)
+        # out_shape, block, overlap, select, tolerance, candidates, seam (a SeamSpec), excluded,
+        # tileable, adaptive_threshold, min_block, mode)
         self.__dict__.update(options)
         self.seed, self.cancel, self.threads = seed, cancel, threads
         sample, out_shape = self.sample, self.out_shape
@@ -319,26 +319,22 @@ class Quilter:
         else:
             old_full = self.canvas[self.idx(wk.y, wk.x, h, w)]
             overlap = wk.filled
-            err = error_map(wk.old, colour_channels(new), metric=self.metric)
+            err = error_map(wk.old, colour_channels(new), metric=self.seam.metric)
             err[~overlap] = 0
-            if self.seam == "straight":
+            if not self.seam.cuts:
                 keep = np.zeros((h, w), dtype=bool)
-                alpha = straight_alpha(wk.arms, (h, w), self.blend)
+                alpha = straight_alpha(wk.arms, (h, w), self.seam.blend)
             elif not err.any():
                 # old and new agree exactly over the overlap (a continued copy of the sample):
                 # every cut gives the same pixels, so none is searched
                 keep, crit, peak, alpha = overlap.copy(), 0.0, 0.0, None
             else:
-                cut = cut_overlap(
-                    err, wk.arms, method=self.seam, cancel=self.cancel, **self.seam_options
-                )
+                cut = cut_overlap(err, wk.arms, seam=self.seam, cancel=self.cancel)
                 keep, path, crit, peak = cut.keep_old, read_only(cut.path), cut.criterion, cut.peak
                 keep &= overlap
                 alpha = None
-                if self.blend != "none":
-                    alpha = blend_alpha(
-                        cut, err, overlap, blend=self.blend, width=self.blend_width, rho=self.rho
-                    )
+                if self.seam.blend != "none":
+                    alpha = blend_alpha(cut, err, overlap, seam=self.seam)
             if alpha is None:  # hard cut: exact copies of old and new
                 pixels = new.copy()
                 np.copyto(pixels, old_full, where=keep[:, :, None])

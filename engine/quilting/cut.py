@@ -14,7 +14,7 @@ import numpy as np
 from scipy import ndimage
 
 from engine.blend import ramp_from_mask
-from engine.seams import SeamSpec, find_seam
+from engine.seams import SeamSpec
 from engine.stitch import from_canonical, l_cut, map_points, to_canonical
 
 __all__ = ["Cut", "blend_alpha", "cut_overlap", "straight_alpha"]
@@ -44,8 +44,8 @@ class Cut:
     peak: float
 
 
-def cut_overlap(err, arms, *, method: str, cancel=None, **options) -> Cut:
-    """Cut a block's overlap (arms = top, left, bottom, right widths) with a seam ``method``.
+def cut_overlap(err, arms, *, seam: SeamSpec, cancel=None) -> Cut:
+    """Cut a block's overlap (arms = top, left, bottom, right widths) with ``seam``'s method.
 
     The left and top arms are cut as one L joined in the corner (:func:`engine.stitch.l_cut`);
     wrap-around arms (bottom, right) get a seam each, oriented so the old content is R1; the old
@@ -57,8 +57,7 @@ def cut_overlap(err, arms, *, method: str, cancel=None, **options) -> Cut:
     keep = np.zeros((h, w), dtype=bool)
     paths, crit, peak = [], 0.0, 0.0
     if t or left:
-        spec = SeamSpec(method, options)
-        lc = l_cut(err, overlap_left=left, overlap_top=t, seam=spec, cancel=cancel)
+        lc = l_cut(err, overlap_left=left, overlap_top=t, seam=seam, cancel=cancel)
         keep |= np.asarray(lc.mask, dtype=bool)
         paths.append(np.asarray(lc.path, dtype=np.intp).reshape(-1, 2))
         crit, peak = float(lc.criterion), float(lc.peak)
@@ -68,17 +67,12 @@ def cut_overlap(err, arms, *, method: str, cancel=None, **options) -> Cut:
         rows, cols = _arm_window(side, k, h, w)
         orient = _ARM_ORIENTATION[side]
         strip = err[rows, cols]
-        seam = find_seam(
-            np.ascontiguousarray(to_canonical(strip, orient)),
-            method=method,
-            cancel=cancel,
-            **options,
-        )
-        keep[rows, cols] |= from_canonical(np.asarray(seam.mask), orient)
-        pts = map_points(np.asarray(seam.path), orient, strip.shape, inverse=True)
+        cut = seam.find(np.ascontiguousarray(to_canonical(strip, orient)), cancel=cancel)
+        keep[rows, cols] |= from_canonical(np.asarray(cut.mask), orient)
+        pts = map_points(np.asarray(cut.path), orient, strip.shape, inverse=True)
         paths.append(pts + (rows.start, cols.start))
-        crit += seam.criterion
-        peak = max(peak, seam.peak)
+        crit += cut.criterion
+        peak = max(peak, cut.peak)
     path = np.concatenate(paths).astype(np.intp) if paths else np.zeros((0, 2), np.intp)
     return Cut(keep, path, crit, peak)
 
@@ -115,14 +109,15 @@ def _adaptive_half_width_map(keep, path, err, overlap, rho: int) -> np.ndarray:
     return b[on[idx[0], idx[1]]]
 
 
-def blend_alpha(cut: Cut, err, overlap, *, blend: str, width: float, rho: int) -> np.ndarray:
-    """Weight of the old content for a cut: hard, feathered, or adaptive, 0 outside the overlap."""
-    if blend == "none" or len(cut.path) == 0:
+def blend_alpha(cut: Cut, err, overlap, *, seam: SeamSpec) -> np.ndarray:
+    """Weight of the old content for a cut after ``seam``'s blend (hard, feathered ``width``
+    pixels, or ρ-adaptive), 0 outside the overlap."""
+    if seam.blend == "none" or len(cut.path) == 0:
         alpha = cut.keep_old.astype(np.float32)
-    elif blend == "feather":
-        alpha = ramp_from_mask(cut.keep_old, width / 2.0)
+    elif seam.blend == "feather":
+        alpha = ramp_from_mask(cut.keep_old, seam.width / 2.0)
     else:
-        bmap = _adaptive_half_width_map(cut.keep_old, cut.path, err, overlap, rho)
+        bmap = _adaptive_half_width_map(cut.keep_old, cut.path, err, overlap, seam.rho)
         alpha = ramp_from_mask(cut.keep_old, bmap)
     alpha[~overlap] = 0
     return alpha

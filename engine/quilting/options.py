@@ -9,24 +9,27 @@ import os
 import numpy as np
 
 from engine._validate import as_image, choice, non_negative_number, positive_int
-from engine.blend import BLEND_MODES
-from engine.errormap import METRICS
 from engine.exclusion import valid_anchors
 from engine.matching import check_block
 from engine.quilting.bhatia import bhatia_anchors
 from engine.quilting.layout import check_torus_axis, torus_overlap
-from engine.seams import METHODS as SEAM_METHODS
-from engine.seams import check_option_names
+from engine.seams import SeamSpec
+from engine.seams.spec import METHODS as SEAM_METHODS
+from engine.seams.spec import STRAIGHT
 
 SELECTIONS = ("best", "random", "sampled", "bhatia")
 MODES = ("exact", "fast")
-SEAMS = ("straight", *SEAM_METHODS)
+SEAMS = (STRAIGHT, *SEAM_METHODS)
+QUILT_SEAM = SeamSpec("dp", metric="ssd")
+"""Quilting's default cut: Efros & Freeman's minimum error boundary cut on the squared error,
+no blending."""
 DEFAULT_SAMPLED = 200
 DEFAULT_RERANK = 32
 
 __all__ = [
     "DEFAULT_RERANK",
     "DEFAULT_SAMPLED",
+    "QUILT_SEAM",
     "MODES",
     "SEAMS",
     "SELECTIONS",
@@ -67,30 +70,29 @@ def check_options(
     tolerance,
     candidates,
     seam,
-    blend,
-    blend_width,
-    rho,
-    metric,
     excluded,
     tileable,
     adaptive_threshold,
     min_block,
     mode,
-    seam_options,
 ) -> dict:
     """The keywords of :func:`engine.quilting.iter_quilt` validated, defaults filled in: a dict
-    with the same names (``sample`` as float32 (H, W, C), ``excluded`` as bool or None)."""
+    with the same names (``sample`` as float32 (H, W, C), ``seam`` a :class:`SeamSpec`,
+    ``excluded`` as bool or None)."""
     s = as_image(sample, "sample")
     H, W = s.shape[:2]
     Ho, Wo = check_out_shape(out_shape)
     bh, bw = check_block(block)
     choice(select, "select", SELECTIONS)
-    choice(seam, "seam", SEAMS)
+    seam = QUILT_SEAM if seam is None else seam
+    if not isinstance(seam, SeamSpec):
+        raise TypeError(
+            "seam must be an engine.seams.SeamSpec (e.g. SeamSpec('dp', metric='ssd')), "
+            f"got {type(seam).__name__}"
+        )
     choice(mode, "mode", MODES)
-    choice(blend, "blend", BLEND_MODES)
-    choice(metric, "metric", METRICS)
     if overlap is None:
-        overlap = max(1, min(bh, bw) // (2 if seam == "minimax" else 6))
+        overlap = max(1, min(bh, bw) // (2 if seam.method == "minimax" else 6))
         if select == "bhatia":
             overlap = max(1, min(bh, bw) // 4)
         elif tileable:  # the torus spaces blocks evenly: keep them more than half a block apart
@@ -100,7 +102,7 @@ def check_options(
         raise ValueError(f"overlap must be smaller than the block ({min(bh, bw)}), got {overlap}")
     if select == "bhatia" and overlap < 1:
         raise ValueError("overlap (the cut band) must be >= 1 with select='bhatia'")
-    if select == "bhatia" and seam == "straight":
+    if select == "bhatia" and not seam.cuts:
         raise ValueError("select='bhatia' needs a cut: choose a seam method, e.g. 'resistance'")
     if bh > H or bw > W:
         raise ValueError(
@@ -117,8 +119,6 @@ def check_options(
     if candidates is None:
         candidates = DEFAULT_SAMPLED if select == "sampled" else DEFAULT_RERANK
     candidates = positive_int(candidates, "candidates")
-    blend_width = non_negative_number(blend_width, "blend_width")
-    rho = positive_int(rho, "rho", minimum=0)
     ex = None
     if excluded is not None:
         ex = np.asarray(excluded)
@@ -143,10 +143,6 @@ def check_options(
     min_block = positive_int(min_block, "min_block")
     if min_block <= overlap:
         raise ValueError(f"min_block must be larger than the overlap ({overlap}), got {min_block}")
-    if seam != "straight":
-        check_option_names(seam, seam_options, "seam")
-    elif seam_options:
-        raise TypeError(f"seam 'straight' takes no options, got {', '.join(seam_options)}")
     return dict(
         sample=s,
         out_shape=(Ho, Wo),
@@ -156,14 +152,9 @@ def check_options(
         tolerance=tolerance,
         candidates=candidates,
         seam=seam,
-        blend=blend,
-        blend_width=blend_width,
-        rho=rho,
-        metric=metric,
         excluded=ex,
         tileable=tileable,
         adaptive_threshold=adaptive_threshold,
         min_block=min_block,
         mode=mode,
-        seam_options=seam_options,
     )

@@ -8,6 +8,7 @@ import numpy as np
 
 from engine.events import Item
 from engine.quilting.layout import axis_positions
+from engine.seams import SeamSpec
 
 __all__ = ["EMPTY_PATH", "BlockPlaced", "BlockRecord", "QuiltResult", "read_only"]
 
@@ -117,7 +118,7 @@ class QuiltResult:
 
     ``step`` is the block grid's period (block - overlap; the block for Bhatia), ``band`` the
     width of the strip after each grid line in which the cuts run (the overlap, or Bhatia's
-    cut band).
+    cut band). ``seam`` is the :class:`engine.seams.SeamSpec` the cuts were made with.
     """
 
     image: np.ndarray
@@ -128,7 +129,7 @@ class QuiltResult:
     band: int
     tileable: bool
     select: str
-    seam: str
+    seam: SeamSpec
     params: dict = field(default_factory=dict)
 
     @property

@@ -25,11 +25,7 @@ def iter_quilt(
     select: str = "best",
     tolerance: float = 0.1,
     candidates: int | None = None,
-    seam: str = "dp",
-    blend: str = "none",
-    blend_width: float = 4,
-    rho: int = 3,
-    metric: str = "ssd",
+    seam=None,
     excluded=None,
     tileable: bool = False,
     adaptive_threshold: float | None = None,
@@ -38,7 +34,6 @@ def iter_quilt(
     rng=None,
     cancel=None,
     threads: int | None = None,
-    **seam_options,
 ):
     """Synthesize a texture of ``out_shape`` from ``sample`` by image quilting, streaming events.
 
@@ -52,7 +47,7 @@ def iter_quilt(
         Block size (must fit in the sample and the output).
     overlap : int, optional
         Overlap of neighbouring blocks (< block). Default: block / 6 (Efros & Freeman), block / 2
-        for ``seam="minimax"`` (Long & Mould), block / 4 as Bhatia's cut band.
+        for a ``minimax`` seam (Long & Mould), block / 4 as Bhatia's cut band.
     select : {"best", "random", "sampled", "bhatia"}
         See :mod:`engine.quilting`.
     tolerance : float
@@ -63,12 +58,11 @@ def iter_quilt(
     candidates : int, optional
         ``"sampled"``: windows drawn per block (default 200); ``mode="fast"``: windows re-ranked
         exactly (default 32).
-    seam : str
-        ``"straight"`` or a method of :data:`engine.seams.METHODS`.
-    blend : {"none", "feather", "adaptive"}
-        Softening of the cut; ``blend_width`` (feather, px) and ``rho`` (adaptive) tune it.
-    metric : {"ssd", "euclid", "lab"}
-        Error map the cut runs on (the block search always uses the SSD).
+    seam : SeamSpec, optional
+        The cut through the overlap: method (or ``"straight"``: no cut) and its options, the
+        error metric of the map it runs on (the block search always uses the SSD) and the blend
+        after it. Default :data:`engine.quilting.options.QUILT_SEAM` (dp on the squared error,
+        no blending).
     excluded : (H, W) bool array_like, optional
         Sample pixels never to copy (:func:`engine.exclusion.exclusion_mask`).
     tileable : bool
@@ -87,8 +81,6 @@ def iter_quilt(
         Checked between and inside blocks; raises :class:`engine.cancel.Cancelled`.
     threads : int, optional
         Worker threads (default: every core).
-    **seam_options
-        Passed to the seam method (e.g. ``o_max``, ``variant``, ``max_run``).
 
     Returns
     -------
@@ -106,10 +98,6 @@ def iter_quilt(
             tolerance=tolerance,
             candidates=candidates,
             seam=seam,
-            blend=blend,
-            blend_width=blend_width,
-            rho=rho,
-            metric=metric,
             excluded=excluded,
             tileable=tileable,
             adaptive_threshold=adaptive_threshold,
@@ -118,13 +106,12 @@ def iter_quilt(
             rng=rng,
             cancel=cancel,
             threads=threads,
-            seam_options=seam_options,
         )
     )
 
 
-def _build_quilter(sample, out_shape, *, rng, cancel, threads, seam_options, **options):
-    opts = check_options(sample, out_shape, seam_options=seam_options, **options)
+def _build_quilter(sample, out_shape, *, rng, cancel, threads, **options):
+    opts = check_options(sample, out_shape, **options)
     seed = int(as_rng(rng).integers(2**63))
     return Quilter(seed=seed, cancel=cancel, threads=resolve_threads(threads), **opts)
 
@@ -164,12 +151,9 @@ def _iter_quilt(q: Quilter):
         params=dict(
             tolerance=q.tolerance,
             candidates=q.candidates,
-            blend=q.blend,
-            metric=q.metric,
             mode=q.mode,
             adaptive_threshold=q.adaptive_threshold,
             min_block=q.min_block,
-            seam_options=dict(q.seam_options),
         ),
     )
 

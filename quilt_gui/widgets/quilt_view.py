@@ -204,7 +204,7 @@ class QuiltView(QWidget):
             f"{len(passes)} transfer passes, correspondence error "
             f"{passes[-1].correspondence_error:.4f}"
             if passes
-            else f"{res.select}, {res.seam} seams"
+            else f"{res.select}, {res.seam.method} seams"
         )
         self.counter.setText(f"{w}×{h} from {len(res.blocks)} blocks ({how})")
         self.select(len(self.doc.quilting.blocks) - 1 if self.doc.quilting.blocks else None)

@@ -4,6 +4,7 @@ import numpy as np
 from scipy import ndimage
 
 from engine.events import drain
+from engine.seams import SeamSpec
 
 
 def events_and_result(gen):
@@ -11,6 +12,11 @@ def events_and_result(gen):
     events = []
     result = drain(gen, events.append)
     return events, result
+
+
+def cut(method: str = "dp", **kw) -> SeamSpec:
+    """A quilting seam: ``method`` on the squared error (quilting's default metric)."""
+    return SeamSpec(method, **{"metric": "ssd", **kw})
 
 
 def smooth_texture(shape, channels=3, seed=0, sigma=2.0):

@@ -10,7 +10,7 @@ from engine.metrics import block_grid_border_ratio, wrap_border_ratio
 from engine.quilting import BlockPlaced, iter_quilt, quilt, scheduler
 from engine.quilting.synthesis import quilt_unstreamed
 from resources import SAMPLE_NAMES
-from tests.engine.helpers import events_and_result
+from tests.engine.helpers import cut, events_and_result
 
 
 @pytest.fixture(scope="module")
@@ -30,7 +30,7 @@ def wrap_write(canvas, pos, pixels):
 
 def test_events_replay_to_the_result_and_records_are_consistent(cobbles):
     events, res = events_and_result(
-        iter_quilt(cobbles, (70, 90), block=24, overlap=4, rng=3, threads=1, blend="none")
+        iter_quilt(cobbles, (70, 90), block=24, overlap=4, rng=3, threads=1)
     )
     placed = [e for e in events if isinstance(e, BlockPlaced)]
     progress = [e for e in events if isinstance(e, Progress)]
@@ -110,10 +110,10 @@ def test_best_choice_is_within_tolerance_of_brute_force(cobbles):
         {},
         {"mode": "fast"},
         {"select": "sampled", "candidates": 40},
-        {"select": "random", "seam": "minimax"},
-        {"tileable": True, "seam": "dijkstra"},
+        {"select": "random", "seam": cut("minimax")},
+        {"tileable": True, "seam": cut("dijkstra")},
         {"adaptive_threshold": 0.004, "min_block": 13},
-        {"select": "bhatia", "seam": "resistance"},
+        {"select": "bhatia", "seam": cut("resistance")},
     ],
 )
 def test_same_seed_same_output_for_any_thread_count(cobbles, kw, monkeypatch):
@@ -153,9 +153,9 @@ def test_quality_order_best_dp_straight_random(name):
             ]
         )
 
-    dp = ratio(seam="dp")
-    straight = ratio(seam="straight")
-    rnd = ratio(select="random", seam="straight")
+    dp = ratio(seam=cut("dp"))
+    straight = ratio(seam=cut("straight"))
+    rnd = ratio(select="random", seam=cut("straight"))
     assert dp <= 1.3
     assert 1.2 * dp < straight < rnd
 
@@ -165,9 +165,9 @@ def test_minimax_half_overlap_lowers_the_seam_peaks(name):
     """Long & Mould: over all seams of a run at half-block overlap, minimax's mean peak error is
     lower than dp's (the benchmark prints both figures)."""
     s = bundled(name, 96)
-    kw = dict(block=24, overlap=12, rng=0, metric="euclid")
-    dp = quilt(s, (96, 96), seam="dp", **kw)
-    mm = quilt(s, (96, 96), seam="minimax", **kw)
+    kw = dict(block=24, overlap=12, rng=0)
+    dp = quilt(s, (96, 96), seam=cut("dp", metric="euclid"), **kw)
+    mm = quilt(s, (96, 96), seam=cut("minimax", metric="euclid"), **kw)
     peak_dp = np.nanmean([r.peak for r in dp.blocks])
     peak_mm = np.nanmean([r.peak for r in mm.blocks])
     assert peak_mm < 0.95 * peak_dp
@@ -180,7 +180,7 @@ def test_minimax_half_overlap_lowers_the_seam_peaks(name):
         {"mode": "fast"},
         {"select": "random"},
         {"select": "sampled", "candidates": 20},
-        {"select": "bhatia", "seam": "resistance", "overlap": 6},
+        {"select": "bhatia", "seam": cut("resistance"), "overlap": 6},
         {"tileable": True},
     ],
 )
@@ -191,9 +191,7 @@ def test_excluded_colour_never_reaches_the_output(kw):
     sample[:, 30:34] = (1.0, 0.0, 0.0)
     ex = exclusion_mask(sample, color_range=((0.9, 0, 0), (1, 0.1, 0.1)))
     assert ex[:, 30:34].all() and ex.sum() == 64 * 4
-    res = quilt(
-        sample, (100, 100), block=20, excluded=ex, rng=1, blend="none", **{"overlap": 4, **kw}
-    )
+    res = quilt(sample, (100, 100), block=20, excluded=ex, rng=1, **{"overlap": 4, **kw})
     red = (res.image[..., 0] > 0.9) & (res.image[..., 1] < 0.1)
     assert not red.any()
     for r in res.blocks:
@@ -203,7 +201,7 @@ def test_excluded_colour_never_reaches_the_output(kw):
 
 @pytest.mark.parametrize(
     "kw",
-    [{}, {"select": "sampled", "candidates": 30}, {"select": "bhatia", "seam": "resistance"}],
+    [{}, {"select": "sampled", "candidates": 30}, {"select": "bhatia", "seam": cut("resistance")}],
 )
 def test_tileable_output_wraps_seamlessly(cobbles, kw):
     """The output tiled 2 x 2 shows no joint at the wrap (engine.metrics on the tiled image),
@@ -219,7 +217,7 @@ def test_tileable_output_wraps_seamlessly(cobbles, kw):
     if kw.get("select") != "bhatia":
         assert any(r.arms[3] for r in tiled.blocks) and any(r.arms[2] for r in tiled.blocks)
         # the torus grid sees joints that are there: a straight overlap's
-        straight = quilt(cobbles, (100, 110), tileable=True, seam="straight", **kw)
+        straight = quilt(cobbles, (100, 110), tileable=True, seam=cut("straight"), **kw)
         assert block_grid_border_ratio(straight) > 1.5 * block_grid_border_ratio(tiled)
 
 
@@ -227,10 +225,10 @@ def test_tileable_minimax_default_overlap_fits_the_torus(cobbles):
     """Long & Mould's half-block overlap puts evenly spaced torus blocks half a block apart:
     the default shrinks to the largest overlap that fits, and an explicit one is refused with
     the overlap that would fit named."""
-    res = quilt(cobbles, (96, 96), block=24, seam="minimax", tileable=True, rng=0)
+    res = quilt(cobbles, (96, 96), block=24, seam=cut("minimax"), tileable=True, rng=0)
     assert res.overlap < 12 and wrap_border_ratio(res.image) < 1.5
     with pytest.raises(ValueError, match="overlap of at most 10"):
-        quilt(cobbles, (96, 96), block=24, overlap=12, seam="minimax", tileable=True, rng=0)
+        quilt(cobbles, (96, 96), block=24, overlap=12, seam=cut("minimax"), tileable=True, rng=0)
 
 
 def test_adaptive_block_size_splits_only_bad_blocks(cobbles):
@@ -254,8 +252,7 @@ def test_bhatia_territories_come_from_neighbour_extensions(cobbles):
         overlap=6,
         rng=4,
         select="bhatia",
-        seam="resistance",
-        blend="none",
+        seam=cut("resistance"),
     )
     sp = np.pad(cobbles, ((0, 6), (0, 6), (0, 0)), mode="reflect")
     grid = {r.position: r for r in res.blocks}
@@ -288,7 +285,7 @@ def test_bhatia_territories_come_from_neighbour_extensions(cobbles):
 def test_input_types_gray_uint8_and_straight_feather():
     rng = np.random.default_rng(0)
     gray = (rng.random((40, 40)) * 255).astype(np.uint8)
-    res = quilt(gray, (50, 60), block=16, overlap=4, rng=0, seam="straight", blend="feather")
+    res = quilt(gray, (50, 60), block=16, overlap=4, rng=0, seam=cut("straight", blend="feather"))
     assert res.image.shape == (50, 60, 1) and res.image.dtype == np.float32
     assert res.image.min() >= 0 and res.image.max() <= 1
     assert np.isnan(res.blocks[1].criterion)
@@ -322,7 +319,7 @@ STRIPES = np.tile(np.arange(40)[:, None] % 18 == 0, (1, 40))
         ((np.zeros((40, 40, 3)), (0, 50)), {"block": 16}, ValueError, "out_shape"),
         ((np.zeros((40, 40, 3)), (50, 50)), {"block": 0}, ValueError, "block"),
         ((np.zeros((40, 40, 3)), (50, 50)), {"block": 16, "select": "x"}, ValueError, "select"),
-        ((np.zeros((40, 40, 3)), (50, 50)), {"block": 16, "seam": "x"}, ValueError, "seam"),
+        ((np.zeros((40, 40, 3)), (50, 50)), {"block": 16, "seam": "dp"}, TypeError, "SeamSpec"),
         ((np.zeros((40, 40, 3)), (50, 50)), {"block": 16, "tolerance": -1}, ValueError, "tol"),
         ((np.zeros((40, 40, 3)), (50, 50)), {"block": 16, "o_max": 3}, TypeError, "o_max"),
         (
