@@ -82,6 +82,10 @@ def seam_spec(value, name) -> SeamSpec:
     return value
 
 
+def wang_interior(value, name):
+    return choice(value, name, ("patch", "diamonds"))
+
+
 def blend_mode(value, name):
     return choice(value, name, BLEND_MODES)
 
@@ -118,6 +122,13 @@ class TilesetSettings:
     w_P - 1), ``neighbourhood``. Preview: ``preview`` (rows, cols), ``no_equal_neighbours``,
     ``layout_seed`` (None: ``seed``). ``exclude_color``: a colour range (lo, hi) no tile or
     patch may contain.
+
+    Wang set instead (:mod:`engine.tiles.wang`, when ``wang`` = K colours per edge direction
+    is set): square tiles of ``tile_min`` = ``tile_max`` (None: a quarter of the source's
+    shorter side), ``wang_variants`` per edge signature, ``wang_interior`` ("patch" or
+    "diamonds"), ``wang_band`` (None: about a tenth of the tile), ``wang_outward``,
+    ``wang_tolerance``, ``wang_min_distance`` (None: half the tile); ``seed``, ``seam``,
+    ``patch_overlap``, ``margin`` (None: 1), the preview and the exclusion as above.
     """
 
     tile_min: tuple[int, int] | None = setting(None, optional(as_size))
@@ -136,6 +147,13 @@ class TilesetSettings:
     no_equal_neighbours: bool = setting(True, boolean)
     layout_seed: int | None = setting(None, optional(at_least(0)))
     exclude_color: tuple | None = setting(None, optional(colour_range))
+    wang: int | None = setting(None, optional(at_least(1)))
+    wang_variants: int = setting(1, at_least(1))
+    wang_interior: str = setting("patch", wang_interior)
+    wang_band: int | None = setting(None, optional(at_least(1)))
+    wang_outward: float = setting(1.0, number)
+    wang_tolerance: float = setting(0.1, number)
+    wang_min_distance: float | None = setting(None, optional(number))
 
     def __post_init__(self) -> None:
         for f in dataclasses.fields(self):

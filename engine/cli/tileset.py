@@ -225,6 +225,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     )
     add_exclusion(p, "source")
     add_project_option(p)
+    from engine.cli.tileset_wang import add_wang_options
+
+    add_wang_options(p, _size)
     p.set_defaults(func=run)
     return p
 
@@ -254,6 +257,9 @@ def settings_from_args(args) -> TilesetSettings:
     changes = {f: getattr(args, a) for a, f in _FIELDS.items() if getattr(args, a) is not None}
     if args.tile_min is not None and args.tile_max is None:
         changes["tile_max"] = args.tile_min  # a fixed size unless a range is asked for
+    from engine.cli.tileset_wang import wang_changes
+
+    changes.update(wang_changes(args))
     if args.equal_neighbours:
         changes["no_equal_neighbours"] = False
     seam = {"method": args.seam, "metric": args.metric, "width": args.width, "rho": args.rho}
@@ -323,6 +329,13 @@ def run(args) -> int:
     import warnings
 
     settings = settings_from_args(args)
+    if settings.wang is not None:
+        from engine.cli.tileset_wang import check_wang_args, run_wang
+
+        check_wang_args(args)
+        work = run_wang
+    else:
+        work = _run
     if args.pick is not None and max(args.pick) >= settings.candidates:
         bad = [k for k in args.pick if k >= settings.candidates]
         raise ValueError(f"--pick {bad} out of range: --candidates is {settings.candidates}")
@@ -333,7 +346,7 @@ def run(args) -> int:
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
-            code = _run(args, settings, rect)
+            code = work(args, settings, rect)
         finally:
             if created and out.is_dir() and not any(out.iterdir()):
                 out.rmdir()  # nothing written: leave no empty folder behind
@@ -378,12 +391,11 @@ def _events(say, n: int):
     return on_event
 
 
-def _run(args, settings: TilesetSettings, rect) -> int:
-    from engine.events import drain
+def load_inputs(args, settings: TilesetSettings, say):
+    """The source, its bit depth, the material maps, the seam weights and the excluded
+    pixels the flags name: ``(S, depth, maps, weights, excluded)``."""
     from engine.io import load_image
-    from engine.tiles.pipeline import iter_tileset
 
-    say = _Reporter()
     loaded = load_image(args.source)
     S, depth = loaded.pixels, loaded.bit_depth
     H, W = S.shape[:2]
@@ -403,6 +415,16 @@ def _run(args, settings: TilesetSettings, rect) -> int:
                 f"--exclude-color / --exclude-mask exclude every pixel of {args.source}: "
                 "no tile can be taken from it"
             )
+    return S, depth, maps, weights, excluded
+
+
+def _run(args, settings: TilesetSettings, rect) -> int:
+    from engine.events import drain
+    from engine.tiles.pipeline import iter_tileset
+
+    say = _Reporter()
+    S, depth, maps, weights, excluded = load_inputs(args, settings, say)
+    H, W = S.shape[:2]
     if rect is not None:
         say(f"template: fixed rectangle {rect}")
     result = drain(
@@ -451,16 +473,9 @@ def _run(args, settings: TilesetSettings, rect) -> int:
 
 def write_files(out: Path, result, depth: int) -> dict:
     """Write the images, layout.csv and layout.json of ``result``; the manifest's content."""
-    from engine.bitdepth import quantize
-    from engine.png import encode_png
 
     def write(stem: str, images: dict) -> dict:
-        files = {}
-        for m, img in images.items():
-            fname = f"{stem}.png" if m == "main" else f"{stem}_{m}.png"
-            write_bytes_atomically(out / fname, encode_png(quantize(img, depth, dither=False)))
-            files[m] = fname
-        return files
+        return write_images(out, stem, images, depth)
 
     st, rect, overlap = result.seamless, result.rect, result.overlap
     template_files = write("template", {"main": st.tile, **st.maps})
@@ -513,6 +528,19 @@ def write_files(out: Path, result, depth: int) -> dict:
         "preview": {"file": preview_files["main"], "maps": preview_files},
         "warnings": list(result.warnings),
     }
+
+
+def write_images(out: Path, stem: str, images: dict, depth: int) -> dict:
+    """``stem.png`` (map ``main``) and ``stem_<map>.png`` at ``depth`` bits; {map: file name}."""
+    from engine.bitdepth import quantize
+    from engine.png import encode_png
+
+    files = {}
+    for m, img in images.items():
+        fname = f"{stem}.png" if m == "main" else f"{stem}_{m}.png"
+        write_bytes_atomically(out / fname, encode_png(quantize(img, depth, dither=False)))
+        files[m] = fname
+    return files
 
 
 def project_arguments(result, S, maps, depth, args, weights, excluded) -> dict:

@@ -24,6 +24,7 @@ from engine.bitdepth import quantize
 from engine.export.atlas import AtlasLayout, atlas_layout, render_atlas
 from engine.export.engines import godot_tres, tiled_tmx, tiled_tsx
 from engine.export.folder import write_bundle
+from engine.export.wang import check_wang
 from engine.index_matrix import assemble_layout, check_index_matrix
 from engine.jsondata import json_default
 from engine.materials import NORMAL_CONVENTIONS
@@ -79,6 +80,7 @@ def export_bundle(
     tile_format: str = "png",
     overwrite: bool = False,
     inputs: Sequence = (),
+    wang: Mapping | None = None,
 ) -> dict:
     """Write the export bundle of ``tiles`` into the folder ``out_dir``; returns the manifest.
 
@@ -119,6 +121,10 @@ def export_bundle(
         folder holding nothing but earlier bundles' files (as their manifests list them).
     inputs : list of paths
         Files the export was made from (the project): a folder holding one is refused.
+    wang : dict or None
+        A Wang set: ``{"colours": K, "tiles": [{"n", "e", "s", "w"}, ...]}`` (one edge
+        signature per tile). The manifest lists each tile's ``wang``, the ``.tsx`` gets an
+        edge Wang set and the ``.tres`` a "Match sides" terrain set (:mod:`engine.export.wang`).
     """
     out = Path(os.fspath(out_dir))
     name = _check_name(name, "name")
@@ -140,6 +146,9 @@ def export_bundle(
     if preview is not None and (not isinstance(preview, Mapping) or set(preview) - set(t.maps)):
         raise ValueError(f"preview must be a dict whose keys are among the maps {t.maps}")
     extra, per_tile = _split_extra(manifest_extra, t.count)
+    if wang is not None:
+        wang = check_wang(wang, t.count)
+        per_tile["wangs"] = wang["tiles"]  # each tile entry gets its "wang"
     if godot_path_prefix is None:
         godot_path_prefix = f"res://{out.name}/" if out.name else "res://"
 
@@ -162,8 +171,12 @@ def export_bundle(
         files[previews[m]] = quantize(img, bit_depth, dither=dither, rng=gen)
     layout_files = _layout_files(files, name, mat, t, lay) if mat is not None else {}
     main_atlas = atlases[t.maps[0]]
-    files[f"{name}.tsx"] = tiled_tsx(name=name, image=main_atlas, layout=lay, weights=weights)
-    files[f"{name}.tres"] = godot_tres(image_path=godot_path_prefix + main_atlas, layout=lay)
+    files[f"{name}.tsx"] = tiled_tsx(
+        name=name, image=main_atlas, layout=lay, weights=weights, wang=wang
+    )
+    files[f"{name}.tres"] = godot_tres(
+        image_path=godot_path_prefix + main_atlas, layout=lay, wang=wang
+    )
     manifest = {
         "format": BUNDLE_FORMAT,
         "version": BUNDLE_VERSION,
@@ -197,6 +210,7 @@ def export_bundle(
         "scores": extra.pop("scores", None),
         "source_rects": extra.pop("source_rects", None),
         "extra": extra,
+        "wang": None if wang is None else {"type": "edge", "colours": wang["colours"]},
         "frames": _frames(tile_entries, t.maps[0]),
         "meta": _meta(t, lay, bit_depth, main_atlas),
     }

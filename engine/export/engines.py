@@ -10,15 +10,22 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 
 from engine.export.atlas import AtlasLayout
+from engine.export.wang import godot_terrain_lines, godot_tile_terrain, tiled_wangset_lines
 
 __all__ = ["godot_tres", "tiled_tmx", "tiled_tsx"]
 
 
 def tiled_tsx(
-    *, name: str, image: str, layout: AtlasLayout, weights: Sequence[float] | None = None
+    *,
+    name: str,
+    image: str,
+    layout: AtlasLayout,
+    weights: Sequence[float] | None = None,
+    wang: dict | None = None,
 ) -> str:
-    """Tiled tileset XML: one image (the atlas) with Tiled's margin and spacing, and the
-    tiles' probabilities if ``weights`` are given."""
+    """Tiled tileset XML: one image (the atlas) with Tiled's margin and spacing, the tiles'
+    probabilities if ``weights`` are given, and an edge Wang set for a checked ``wang``
+    (:func:`engine.export.wang.check_wang`)."""
     lines = [
         '<?xml version="1.0" encoding="UTF-8"?>',
         f'<tileset version="1.8" tiledversion="1.8.2" name={quoteattr(name)} '
@@ -31,6 +38,8 @@ def tiled_tsx(
     if weights is not None:
         for i, wgt in enumerate(weights):
             lines.append(f' <tile id="{i}" probability="{float(wgt):.6g}"/>')
+    if wang is not None:
+        lines += tiled_wangset_lines(wang, name=name)
     lines.append("</tileset>")
     return "\n".join(lines) + "\n"
 
@@ -63,8 +72,9 @@ def tiled_tmx(*, tsx: str, layout: AtlasLayout, index_matrix: np.ndarray, firstg
     )
 
 
-def godot_tres(*, image_path: str, layout: AtlasLayout) -> str:
-    """Godot 4 TileSet text resource with one TileSetAtlasSource over the atlas."""
+def godot_tres(*, image_path: str, layout: AtlasLayout, wang: dict | None = None) -> str:
+    """Godot 4 TileSet text resource with one TileSetAtlasSource over the atlas; with a
+    checked ``wang``, a "Match sides" terrain set and every tile's peering bits."""
 
     def s(v):
         return json.dumps(v)  # a double-quoted string with escapes, as Godot writes them
@@ -83,10 +93,10 @@ def godot_tres(*, image_path: str, layout: AtlasLayout) -> str:
     for i in range(layout.count):
         r, c = divmod(i, layout.columns)
         lines.append(f"{c}:{r}/0 = 0")
-    lines += [
-        "",
-        "[resource]",
-        f"tile_size = Vector2i({layout.tile_w}, {layout.tile_h})",
-        'sources/0 = SubResource("TileSetAtlasSource_1")',
-    ]
+        if wang is not None:
+            lines += godot_tile_terrain(wang["tiles"][i], f"{c}:{r}/0")
+    lines += ["", "[resource]", f"tile_size = Vector2i({layout.tile_w}, {layout.tile_h})"]
+    if wang is not None:
+        lines += godot_terrain_lines(wang)
+    lines.append('sources/0 = SubResource("TileSetAtlasSource_1")')
     return "\n".join(lines) + "\n"

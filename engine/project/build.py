@@ -38,12 +38,16 @@ def project_from_tileset(
     waypoints=None,
     preview=None,
     extra=None,
+    wang=None,
+    tile_params=None,
 ) -> Project:
     """Build a validated :class:`Project` from plain arrays (for the ``tileset`` CLI and tests).
 
     ``sources`` is an image or {map: image}; ``tiles`` a list of images or of
     {map: image} (same maps as ``sources``); ``template`` likewise.
-    ``patch_origins``, ``seeds``, ``scores``, ``locked`` are per-tile lists (or None).
+    ``patch_origins``, ``seeds``, ``scores``, ``locked``, ``tile_params`` (each tile's
+    ``Candidate.params``) are per-tile lists (or None); ``wang`` a Wang set's record
+    (:attr:`Project.wang`).
     """
 
     def as_maps(v, what):
@@ -63,11 +67,12 @@ def project_from_tileset(
             raise ValueError(f"{what} must have one entry per tile ({n}), got {len(v)}")
         return v
 
-    po, sd, sc, lk = (
+    po, sd, sc, lk, pp = (
         per_tile(patch_origins, "patch_origins"),
         per_tile(seeds, "seeds"),
         per_tile(scores, "scores"),
         per_tile(locked, "locked"),
+        per_tile(tile_params, "tile_params"),
     )
     cands = []
     for i, t in enumerate(tiles):
@@ -81,6 +86,7 @@ def project_from_tileset(
                 seed=None if sd[i] is None else int(sd[i]),
                 locked=bool(lk[i]) if lk[i] is not None else False,
                 score=None if sc[i] is None else float(sc[i]),
+                params=dict(pp[i] or {}),
             )
         )
     tmpl = None
@@ -113,6 +119,7 @@ def project_from_tileset(
         },
         preview=prev,
         extra=dict(extra or {}),
+        wang=None if wang is None else dict(wang),
     )
     check_project(p, "project")
     return p

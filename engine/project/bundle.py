@@ -42,6 +42,11 @@ def export_project(project: Project, out_dir, **options) -> dict:
         options["bit_depth"] = project.bit_depth
     if options.get("normal_convention") is None:
         options["normal_convention"] = project.normal_convention
+    if project.wang is not None:  # edge signatures for Tiled's Wang set and Godot's terrains
+        k = project.wang["colours"]
+        options.setdefault("wang", {"colours": k, "tiles": [c.params["wang"] for c in cands]})
+        if options.get("columns") is None and len(cands) % (k * k) == 0:
+            options["columns"] = k * k  # the atlas shows the set's canonical arrangement
     wts = [c.params.get("weight") for c in cands]
     if "weights" not in options and all(isinstance(w, (int, float)) for w in wts):
         options["weights"] = wts  # candidate params {"weight": w} -> Tiled tile probability

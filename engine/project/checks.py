@@ -163,3 +163,34 @@ def check_project(p: Project, where: str) -> None:
     for key in ("parameters", "seeds", "extra"):
         if not isinstance(getattr(p, key), dict):
             raise ValueError(f"{where}: {key} must be a dict")
+    if p.wang is not None:
+        check_project_wang(p, where)
+
+
+def check_project_wang(p: Project, where: str) -> None:
+    """A Wang set's record: K colours, 2 K samples, an edge signature on every candidate."""
+    from engine.export.wang import check_wang
+
+    w = p.wang
+    k = w.get("colours") if isinstance(w, dict) else None
+    samples = w.get("samples") if isinstance(w, dict) else None
+    if not isinstance(samples, list) or isinstance(k, bool) or not isinstance(k, int):
+        raise ValueError(f"{where}: wang must hold 'colours' (int) and 'samples' (list)")
+    want = [(a, c) for a in ("h", "v") for c in range(k)]
+    for i, smp in enumerate(samples):
+        ok = (
+            isinstance(smp, dict)
+            and i < len(want)
+            and (smp.get("axis"), smp.get("colour")) == want[i]
+        )
+        origin = smp.get("origin") if isinstance(smp, dict) else None
+        if not ok or not isinstance(origin, list) or len(origin) != 2:
+            raise ValueError(f"{where}: wang.samples[{i}] must be {{'axis', 'colour', 'origin'}}")
+    if len(samples) != 2 * k:
+        raise ValueError(f"{where}: wang.samples must list {2 * k} samples (h, then v colours)")
+    try:
+        check_wang(
+            {"colours": k, "tiles": [c.params.get("wang") for c in p.candidates]}, len(p.candidates)
+        )
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{where}: the candidates' Wang signatures: {exc}") from None

@@ -64,6 +64,7 @@ def to_doc(project: Project, put: Callable[[np.ndarray, str], str]) -> dict:
         if project.preview is None
         else {m: put(a, f"images/preview_{m}.png") for m, a in project.preview.items()},
         "extra": project.extra,
+        "wang": project.wang,
     }
 
 
@@ -207,4 +208,5 @@ def from_doc(doc, fail: Callable[[str], None], image: Callable[[object], object]
         waypoints=waypoints,
         preview=preview,
         extra=s.get(doc, "extra", dict, "", optional=True, default={}),
+        wang=s.get(doc, "wang", dict, "", optional=True),
     )

@@ -62,6 +62,10 @@ class Project:
     waypoints: dict[str, list[tuple[int, int]]] = field(default_factory=dict)  # per seam key
     preview: dict[str, np.ndarray] | None = None
     extra: dict = field(default_factory=dict)  # any JSON the editor wants to keep
+    # a Wang set (engine.tiles.wang): {"colours": K, "tile_size": T, "variants": V,
+    # "samples": [{"axis", "colour", "origin": [row, col], "error"}...]}; each candidate's
+    # params hold its edge signature {"wang": {"n", "e", "s", "w"}, "variant": v}
+    wang: dict | None = None
 
     @property
     def main_map(self) -> str:
