@@ -60,7 +60,7 @@ def add_wang_options(p, size) -> None:
         help="bias of the interior's cut towards the tile edge (default 1; 0 = none)",
     )
     g.add_argument(
-        "--min-distance",
+        "--wang-min-distance",
         type=non_negative_float,
         metavar="PX",
         help="least distance between edge samples and interior windows (default: tile/2)",
@@ -80,7 +80,7 @@ _FIELDS = {
     "interior": "wang_interior",
     "wang_band": "wang_band",
     "outward": "wang_outward",
-    "min_distance": "wang_min_distance",
+    "wang_min_distance": "wang_min_distance",
     "wang_tolerance": "wang_tolerance",
 }
 
