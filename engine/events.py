@@ -25,9 +25,14 @@ class Event:
 
 
 class Snapshot(Event):
-    """An intermediate state; a newer snapshot of the same type supersedes it."""
+    """An intermediate state; a newer snapshot of the same type and :attr:`slot` supersedes it."""
 
     __slots__ = ()
+
+    @property
+    def slot(self):
+        """Which of several parallel states this is (e.g. one per overlap); None: one per type."""
+        return None
 
 
 class Item(Event):

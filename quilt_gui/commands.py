@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 from PySide6.QtGui import QUndoCommand
 
 if TYPE_CHECKING:
-    from quilt_gui.model import CandidateEntry
+    from engine.candidate import CandidateTile
 
 _merge_ids = itertools.count(1)
 
@@ -153,7 +153,7 @@ class SetCandidates(QUndoCommand):
     def __init__(
         self,
         doc,
-        entries: list[CandidateEntry],
+        entries: list[CandidateTile],
         picks: list[int],
         text: str,
         *,
@@ -179,7 +179,7 @@ class SetCandidates(QUndoCommand):
 
 
 class ReplaceCandidate(QUndoCommand):
-    def __init__(self, doc, index: int, entry: CandidateEntry, text: str) -> None:
+    def __init__(self, doc, index: int, entry: CandidateTile, text: str) -> None:
         super().__init__(text)
         self.doc = doc
         self.index = index

@@ -248,7 +248,7 @@ def _pump(job: Job):
 def _snapshot_key(event) -> tuple:
     """Snapshots of one type supersede each other per ``which`` (e.g. the two overlaps of a
     seamless tile each keep their newest seam)."""
-    return type(event), getattr(event, "which", None)
+    return type(event), event.slot if isinstance(event, Snapshot) else None
 
 
 def coalesce(events: list) -> list:

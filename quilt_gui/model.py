@@ -1,6 +1,6 @@
-"""Plain data of the document (no Qt): the opened source and one candidate tile as the editor
-shows it. The document modules (:mod:`quilt_gui.document`, :mod:`quilt_gui.tileset_doc`,
-:mod:`quilt_gui.quilting_doc`) and the views share these types."""
+"""Plain data of the document (no Qt): the opened source (a candidate tile is the engine's own
+:class:`engine.candidate.CandidateTile`). The document modules (:mod:`quilt_gui.document`,
+:mod:`quilt_gui.tileset_doc`, :mod:`quilt_gui.quilting_doc`) and the views share these types."""
 
 from __future__ import annotations
 
@@ -10,32 +10,6 @@ from dataclasses import dataclass, field
 import numpy as np
 
 WAYPOINT_KEYS = ("horizontal", "vertical")
-
-
-@dataclass(frozen=True)
-class CandidateEntry:
-    """One candidate tile as the editor shows it.
-
-    ``maps`` holds the tile per material map (main map first); ``patch_rect`` is the
-    patch source in source pixels (x, y, w, h) and ``patch_origin`` its (row, col);
-    ``target_rect`` where that window lies in the tile (x, y, w, h); ``loop`` the closed
-    seam pixels (row, col) in tile coordinates.
-    """
-
-    maps: dict[str, np.ndarray]
-    patch_origin: tuple[int, int] | None = None
-    patch_rect: tuple[int, int, int, int] | None = None
-    seed: int | None = None
-    score: float | None = None
-    scores: dict = field(default_factory=dict)
-    locked: bool = False
-    weight: float = 1.0
-    loop: np.ndarray | None = None
-    target_rect: tuple[int, int, int, int] | None = None
-
-    @property
-    def tile(self) -> np.ndarray:
-        return next(iter(self.maps.values()))
 
 
 @dataclass(frozen=True)

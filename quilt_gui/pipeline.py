@@ -10,19 +10,18 @@ Messages for the user go out through :attr:`Pipeline.message` (level, text).
 from __future__ import annotations
 
 import logging
-from dataclasses import replace
 from functools import partial
 
 import numpy as np
 from PySide6.QtCore import QObject, QTimer, Signal, Slot
 
 from engine.cancel import Cancelled
+from engine.candidate import CandidateTile
 from engine.seams import SeamSpec
 from quilt_gui import jobs, params
 from quilt_gui.document import Document
 from quilt_gui.imaging import prepare_display
 from quilt_gui.jobs import error_text
-from quilt_gui.model import CandidateEntry
 
 log = logging.getLogger(__name__)
 
@@ -68,7 +67,7 @@ class Pipeline(QObject):
         self._quilt_timer = _soon(self, self._restart_quilt)
         self._gen_old = ([], [])
         self._gen_wanted, self._gen_next = 0, 0  # candidates asked for / shown in index order
-        self._gen_waiting: dict[int, CandidateEntry] = {}  # finished before their turn
+        self._gen_waiting: dict[int, CandidateTile] = {}  # finished before their turn
         self._quilt_mode = "quilt"  # what a parameter change restarts: "quilt" or "transfer"
 
     # ------------------------------------------------------------------ helpers
@@ -152,9 +151,10 @@ class Pipeline(QObject):
         )
 
     def _on_template_event(self, event) -> None:
-        rect = getattr(event, "rect", None)
-        if rect is not None:
-            self.doc.tileset.apply_template_rect(rect)
+        from engine.tiles.template import TemplateUpdate
+
+        if isinstance(event, TemplateUpdate):
+            self.doc.tileset.apply_template_rect(event.rect)
 
     def _on_template_done(self, template) -> None:
         self.doc.tileset.apply_template_rect(template.rect)
@@ -236,7 +236,9 @@ class Pipeline(QObject):
         )
 
     def _on_seamless_event(self, event) -> None:
-        if hasattr(event, "which") and hasattr(event, "path_source"):
+        from engine.tiles.seamless import SeamlessUpdate
+
+        if isinstance(event, SeamlessUpdate):
             self.seam_updated.emit(event)
 
     def _on_seamless_done(self, result) -> None:
@@ -294,20 +296,11 @@ class Pipeline(QObject):
             return False
         return True
 
-    def entry_from(self, c) -> CandidateEntry:
-        """A document entry from an engine CandidateTile (all material maps, scores)."""
-        maps = {self.doc.source.main_name: c.tile, **dict(c.maps)}
-        loop_len = max(1, len(c.loop))
-        return CandidateEntry(
-            maps=maps,
-            patch_origin=tuple(int(v) for v in c.patch_origin),
-            patch_rect=tuple(int(v) for v in c.patch_rect),
-            target_rect=tuple(int(v) for v in c.target_rect),
-            seed=c.seed,
-            score=float(c.scores["criterion"]) / loop_len,
-            scores=dict(c.scores),
-            loop=np.asarray(c.loop),
-        )
+    @staticmethod
+    def kept(c: CandidateTile) -> CandidateTile:
+        """What the document keeps of a new candidate: all of it but the tile-sized mask and
+        alpha (nothing shows them; 300 large tiles would hold gigabytes of them)."""
+        return c.replace(mask=None, alpha=None)
 
     def generate_candidates(self) -> jobs.Job | None:
         """Stream ``n_candidates`` new variants into the document (locked ones are kept)."""
@@ -361,8 +354,8 @@ class Pipeline(QObject):
         """Candidates finish in any order; they are shown in the order of their index, so
         candidate #k is the same tile for the same seed (each waits for the ones before it,
         at most a worker's head start)."""
-        if hasattr(event, "tile") and hasattr(event, "patch_rect"):
-            self._gen_waiting[int(event.index)] = self.entry_from(event)
+        if isinstance(event, CandidateTile):
+            self._gen_waiting[int(event.index)] = self.kept(event)
             while self._gen_next in self._gen_waiting:
                 self.doc.tileset.append_candidate(self._gen_waiting.pop(self._gen_next))
                 self._gen_next += 1
@@ -424,7 +417,7 @@ class Pipeline(QObject):
         index = int(c.index)
         if index >= len(self.doc.tileset.candidates):
             return
-        entry = replace(self.entry_from(c), weight=self.doc.tileset.candidates[index].weight)
+        entry = self.kept(c).replace(weight=self.doc.tileset.candidates[index].weight)
         self.doc.tileset.replace_candidate(index, entry, text=text)
 
     def _on_remake_error(self, index: int, exc) -> None:
@@ -534,20 +527,25 @@ class Pipeline(QObject):
         )
 
     def _on_quilt_event(self, event) -> None:
+        from engine.quilting import BlockPlaced
+        from engine.transfer import IterationDone
+
         if self.doc.quilting.output is None:
             return
-        if hasattr(event, "record") and hasattr(event, "pixels"):
+        if isinstance(event, BlockPlaced):
             self.doc.quilting.place_block(event.record, np.asarray(event.pixels))
-        elif hasattr(event, "iteration") and hasattr(event, "image"):
+        elif isinstance(event, IterationDone):
             self.doc.quilting.finish_iteration(event)
 
     def _on_quilt_done(self, result) -> None:
         self.doc.quilting.finish(result)
         h, w = result.image.shape[:2]
-        passes = getattr(result, "iterations", ())
-        what = (
-            f"in {len(passes)} transfer passes" if passes else f"from {len(result.blocks)} blocks"
-        )
+        from engine.transfer import TransferResult
+
+        if isinstance(result, TransferResult):
+            what = f"in {len(result.iterations)} transfer passes"
+        else:
+            what = f"from {len(result.blocks)} blocks"
         self.message.emit(
             "info",
             f"Synthesized {w}×{h} {what}. Click a block to see its overlap, error map and seam.",

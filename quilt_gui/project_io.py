@@ -10,9 +10,9 @@ from __future__ import annotations
 import numpy as np
 
 from engine.exclusion import mask_from_json, mask_to_json
-from engine.project import Candidate, Project
+from engine.project import Project
 from quilt_gui import params
-from quilt_gui.model import WAYPOINT_KEYS, CandidateEntry, Source
+from quilt_gui.model import WAYPOINT_KEYS, Source
 
 __all__ = ["apply_project", "to_project"]
 
@@ -26,23 +26,10 @@ def to_project(doc) -> Project:
     template = None
     if ts.seamless is not None:
         template = _tile_maps(ts.seamless, names)
-    cands = [
-        Candidate(
-            maps={m: e.maps[m] for m in names},
-            patch_origin=e.patch_origin,
-            seed=e.seed,
-            locked=e.locked,
-            score=e.score,
-            params={
-                "weight": e.weight,
-                "scores": dict(e.scores),
-                "patch_rect": list(e.patch_rect) if e.patch_rect else None,
-                "target_rect": list(e.target_rect) if e.target_rect else None,
-                "loop": None if e.loop is None else np.asarray(e.loop).tolist(),
-            },
-        )
+    cands = [  # the source's maps in its order; made before a map was attached: left out
+        e.replace(maps={m: e.maps[m] for m in names[1:]})
         for e in ts.candidates
-        if all(m in e.maps for m in names)
+        if all(m in e.maps for m in names[1:])
     ]
     layout = ts.layout
     if layout is not None and (not ts.picks or layout.max(initial=-1) >= len(ts.picks)):
@@ -86,21 +73,7 @@ def apply_project(doc, project: Project, path: str | None) -> None:
     )
     ts.waypoints = {k: [tuple(p) for p in project.waypoints.get(k, [])] for k in WAYPOINT_KEYS}
     ts.map_weights = {k: float(v) for k, v in project.map_weights.items()}
-    ts.candidates = [
-        CandidateEntry(
-            maps=dict(c.maps),
-            patch_origin=c.patch_origin,
-            patch_rect=_rect(c.params.get("patch_rect")),
-            target_rect=_rect(c.params.get("target_rect")),
-            loop=_points(c.params.get("loop")),
-            seed=c.seed,
-            score=c.score,
-            scores=dict(c.params.get("scores") or {}),
-            locked=c.locked,
-            weight=float(c.params.get("weight", 1.0)),
-        )
-        for c in project.candidates
-    ]
+    ts.candidates = list(project.candidates)
     ts.picks = list(project.picks)
     ts.layout = None if project.layout is None else np.asarray(project.layout)
     if project.preview is not None:
@@ -111,22 +84,6 @@ def apply_project(doc, project: Project, path: str | None) -> None:
     ts.emit_all()
     doc.path_changed.emit()
     doc.mark_saved()
-
-
-def _rect(value) -> tuple[int, int, int, int] | None:
-    """An (x, y, w, h) rectangle read from a project's JSON, None if it is not one."""
-    if isinstance(value, list) and len(value) == 4 and all(isinstance(v, int) for v in value):
-        return tuple(value)
-    return None
-
-
-def _points(value) -> np.ndarray | None:
-    """(N, 2) int (row, col) points read from a project's JSON, None if they are not."""
-    try:
-        a = np.asarray(value, dtype=np.int64)
-    except (TypeError, ValueError):
-        return None
-    return a if a.ndim == 2 and a.shape[1] == 2 and len(a) else None
 
 
 def _tile_maps(seamless, names: list[str]) -> dict[str, np.ndarray] | None:

@@ -14,8 +14,9 @@ from dataclasses import replace
 import numpy as np
 from PySide6.QtCore import QObject, Signal
 
+from engine.candidate import CandidateTile
 from quilt_gui import commands
-from quilt_gui.model import WAYPOINT_KEYS, CandidateEntry
+from quilt_gui.model import WAYPOINT_KEYS
 
 
 class TileSetDocument(QObject):
@@ -43,7 +44,7 @@ class TileSetDocument(QObject):
         self.waypoints: dict[str, list[tuple[int, int]]] = {k: [] for k in WAYPOINT_KEYS}
         self.map_weights: dict[str, float] = {}  # seam-error weight per map; {} = main only
         self.seamless = None  # engine SeamlessTile (derived)
-        self.candidates: list[CandidateEntry] = []
+        self.candidates: list[CandidateTile] = []
         self.picks: list[int] = []
         self.layout: np.ndarray | None = None
         self.preview: np.ndarray | None = None  # derived
@@ -74,10 +75,10 @@ class TileSetDocument(QObject):
             signal.emit()
 
     # ------------------------------------------------------------------ state
-    def picked_entries(self) -> list[CandidateEntry]:
+    def picked_entries(self) -> list[CandidateTile]:
         return [self.candidates[i] for i in self.picks]
 
-    def connects_to_template(self, entry: CandidateEntry) -> bool:
+    def connects_to_template(self, entry: CandidateTile) -> bool:
         """True when ``entry`` was made from the current seamless template (same size and
         outer margin), i.e. it connects to tiles made from it."""
         if self.seamless is None:
@@ -180,7 +181,7 @@ class TileSetDocument(QObject):
 
     def set_candidates(
         self,
-        entries: list[CandidateEntry],
+        entries: list[CandidateTile],
         picks: list[int],
         *,
         text: str,
@@ -195,7 +196,7 @@ class TileSetDocument(QObject):
             )
         )
 
-    def replace_candidate(self, index: int, entry: CandidateEntry, *, text: str) -> None:
+    def replace_candidate(self, index: int, entry: CandidateTile, *, text: str) -> None:
         self.undo_stack.push(commands.ReplaceCandidate(self, index, entry, text))
 
     def set_locked(self, index: int, locked: bool) -> None:
@@ -258,14 +259,14 @@ class TileSetDocument(QObject):
         self.picks_changed.emit()
 
     def apply_candidates(
-        self, entries: list[CandidateEntry], picks: list[int] | None = None
+        self, entries: list[CandidateTile], picks: list[int] | None = None
     ) -> None:
         self.candidates = list(entries)
         self.picks = [i for i in (picks if picks is not None else []) if i < len(entries)]
         self.candidates_reset.emit()
         self.picks_changed.emit()
 
-    def append_candidate(self, entry: CandidateEntry) -> int:
+    def append_candidate(self, entry: CandidateTile) -> int:
         """Add a streamed candidate (not an undo step; the finished job pushes one)."""
         self.candidates.append(entry)
         row = len(self.candidates) - 1
@@ -273,7 +274,7 @@ class TileSetDocument(QObject):
         self.root.mark_dirty()
         return row
 
-    def apply_candidate(self, index: int, entry: CandidateEntry) -> None:
+    def apply_candidate(self, index: int, entry: CandidateTile) -> None:
         self.candidates[index] = entry
         self.candidate_changed.emit(index)
 

@@ -479,21 +479,9 @@ def write_files(out: Path, result, depth: int) -> dict:
 
     st, rect, overlap = result.seamless, result.rect, result.overlap
     template_files = write("template", {"main": st.tile, **st.maps})
-    tile_entries = []
-    for c in result.candidates:
-        files = write(f"tile_{c.index:03d}", {"main": c.tile, **c.maps})
-        tile_entries.append(
-            {
-                "index": c.index,
-                "file": files["main"],
-                "maps": files,
-                "seed": c.seed,
-                "source_rect": list(c.patch_rect),
-                "patch_origin": list(c.patch_origin),
-                "target_rect": list(c.target_rect),
-                "scores": {k: float(v) for k, v in c.scores.items()},
-            }
-        )
+    tile_entries = [
+        c.manifest_entry(write(f"tile_{c.index:03d}", c.images())) for c in result.candidates
+    ]
     preview_files = write("preview", result.preview)
     cells = result.cells
     rows, cols = result.settings.preview
@@ -557,13 +545,10 @@ def project_arguments(result, S, maps, depth, args, weights, excluded) -> dict:
     extra_maps = {m: result.preview[m] for m in maps}
     return dict(
         sources={MAIN_MAP: S, **maps},
-        tiles=[as_project_maps(c.tile, c.maps) for c in cands],
+        tiles=cands,
         name="tileset",
         template=as_project_maps(result.seamless.tile, result.seamless.maps),
         template_rect=result.rect,
-        patch_origins=[c.patch_origin for c in cands],
-        seeds=[c.seed for c in cands],
-        scores=[c.scores["criterion"] for c in cands],
         picks=result.picks,
         layout=result.layout,
         parameters={"tileset": s.to_dict()},

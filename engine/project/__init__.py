@@ -1,6 +1,7 @@
 """Project files (``.quiltproj``): one zip holding ``project.json`` and PNG images.
 
-The project is plain data (:class:`Project`, :class:`Candidate`), no Qt; the editor maps its
+The project is plain data (:class:`Project` holding :class:`engine.candidate.CandidateTile`
+values, the engine's own), no Qt; the editor maps its
 document to it and the CLI writes and reads the same file. Images come back as float32
 (H, W, C) in [0, 1] at the bits they were saved with.
 
@@ -25,12 +26,10 @@ from engine.project.model import (
     PROJECT_FORMAT,
     PROJECT_SUFFIX,
     PROJECT_VERSION,
-    Candidate,
     Project,
 )
 
 __all__ = [
-    "Candidate",
     "MAX_DECODED_BYTES",
     "PROJECT_FORMAT",
     "PROJECT_SUFFIX",

@@ -303,20 +303,13 @@ class _Reader:
             self.fail(f"entry {entry!r}: {exc}")
 
 
-def _image_slots(project: Project):
-    """(dict, key) of every image reference in a project read by :func:`from_doc`."""
-    groups = [project.sources, project.template, project.preview]
-    groups += [c.maps for c in project.candidates]
-    for group in groups:
-        if group is not None:
-            for key in group:
-                yield group, key
-
-
 def _load_images(project, reader: _Reader, fail, max_pixels, max_decoded_bytes, name) -> None:
     """Replace every entry name in ``project`` by its decoded image: headers and the total
     decoded size of every reference first, then each entry inflated and decoded once."""
-    slots = list(_image_slots(project))
+    main = project.main_map
+    tiles = [c.images(main) for c in project.candidates]  # the candidates' images, by map
+    groups = [project.sources, project.template, project.preview, *tiles]
+    slots = [(g, key) for g in groups if g is not None for key in g]
     heads: dict[str, PNGHeader] = {}
     total = 0
     for group, key in slots:
@@ -346,3 +339,7 @@ def _load_images(project, reader: _Reader, fail, max_pixels, max_decoded_bytes, 
             continue
         decoded[entry] = to_float(reader.png(entry, heads[entry], max_pixels))
         group[key] = decoded[entry]
+    project.candidates = [
+        c.replace(tile=t[main], maps={m: a for m, a in t.items() if m != main})
+        for c, t in zip(project.candidates, tiles, strict=True)
+    ]

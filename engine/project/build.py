@@ -8,9 +8,10 @@ import numpy as np
 
 from engine._validate import as_image
 from engine.bitdepth import to_float
+from engine.candidate import CandidateTile
 from engine.materials import resolve_kinds
 from engine.project.checks import check_project
-from engine.project.model import Candidate, Project
+from engine.project.model import Project
 
 __all__ = ["as_float", "project_from_tileset"]
 
@@ -43,11 +44,12 @@ def project_from_tileset(
 ) -> Project:
     """Build a validated :class:`Project` from plain arrays (for the ``tileset`` CLI and tests).
 
-    ``sources`` is an image or {map: image}; ``tiles`` a list of images or of
-    {map: image} (same maps as ``sources``); ``template`` likewise.
-    ``patch_origins``, ``seeds``, ``scores``, ``locked``, ``tile_params`` (each tile's
-    ``Candidate.params``) are per-tile lists (or None); ``wang`` a Wang set's record
-    (:attr:`Project.wang`).
+    ``sources`` is an image or {map: image}; ``tiles`` a list of images, of
+    {map: image} (same maps as ``sources``) or of :class:`engine.candidate.CandidateTile`
+    (kept as they are, re-indexed; the per-tile lists below are then ignored); ``template``
+    likewise. ``patch_origins``, ``seeds``, ``scores``, ``locked``, ``tile_params`` (each
+    tile's ``CandidateTile.params``) are per-tile lists (or None); ``wang`` a Wang set's
+    record (:attr:`Project.wang`).
     """
 
     def as_maps(v, what):
@@ -76,16 +78,22 @@ def project_from_tileset(
     )
     cands = []
     for i, t in enumerate(tiles):
+        if isinstance(t, CandidateTile):
+            cands.append(t.replace(index=i, mask=None, alpha=None))
+            continue
         maps = as_maps(t, f"tiles[{i}]")
         if not isinstance(t, Mapping) and len(srcs) == 1:
             maps = {next(iter(srcs)): maps["albedo"]}
+        main = next(iter(srcs))
         cands.append(
-            Candidate(
-                maps=maps,
+            CandidateTile(
+                index=i,
+                tile=maps.get(main),
+                maps={m: a for m, a in maps.items() if m != main},
                 patch_origin=None if po[i] is None else (int(po[i][0]), int(po[i][1])),
                 seed=None if sd[i] is None else int(sd[i]),
                 locked=bool(lk[i]) if lk[i] is not None else False,
-                score=None if sc[i] is None else float(sc[i]),
+                scores={} if sc[i] is None else {"score": float(sc[i])},
                 params=dict(pp[i] or {}),
             )
         )

@@ -47,13 +47,11 @@ def export_project(project: Project, out_dir, **options) -> dict:
         options.setdefault("wang", {"colours": k, "tiles": [c.params["wang"] for c in cands]})
         if options.get("columns") is None and len(cands) % (k * k) == 0:
             options["columns"] = k * k  # the atlas shows the set's canonical arrangement
-    wts = [c.params.get("weight") for c in cands]
-    if "weights" not in options and all(isinstance(w, (int, float)) for w in wts):
-        options["weights"] = wts  # candidate params {"weight": w} -> Tiled tile probability
+    options.setdefault("weights", [c.weight for c in cands])  # -> Tiled tile probability
     return export_bundle(
         out_dir,
         name=project.name,
-        tiles=[c.maps for c in cands],
+        tiles=[c.images(project.main_map) for c in cands],
         index_matrix=project.layout,
         preview=project.preview,
         manifest_extra=extra,

@@ -8,8 +8,9 @@ import numbers
 
 import numpy as np
 
+from engine.candidate import CandidateTile
 from engine.materials import MAP_KINDS, NORMAL_CONVENTIONS
-from engine.project.model import PROJECT_VERSION, SAFE_NAME, Candidate, Project
+from engine.project.model import PROJECT_VERSION, SAFE_NAME, Project
 
 __all__ = ["check_project", "finite_number"]
 
@@ -102,9 +103,9 @@ def check_project(p: Project, where: str) -> None:
     if p.template is not None:
         check_tile(p.template, "template")
     for i, c in enumerate(p.candidates):
-        if not isinstance(c, Candidate):
-            raise TypeError(f"{where}: candidates[{i}] must be a Candidate")
-        check_tile(c.maps, f"candidates[{i}]")
+        if not isinstance(c, CandidateTile):
+            raise TypeError(f"{where}: candidates[{i}] must be a CandidateTile")
+        check_tile(c.images(p.main_map), f"candidates[{i}]")
         if c.patch_origin is not None and (
             len(c.patch_origin) != 2
             or any(
@@ -122,10 +123,12 @@ def check_project(p: Project, where: str) -> None:
             raise ValueError(
                 f"{where}: candidates[{i}].seed must be an integer in [0, 2**64) or None"
             )
-        if c.score is not None and not finite_number(c.score):
-            raise ValueError(f"{where}: candidates[{i}].score must be a finite number or None")
-        if not isinstance(c.locked, bool) or not isinstance(c.params, dict):
-            raise ValueError(f"{where}: candidates[{i}].locked must be a bool and params a dict")
+        if not all(finite_number(v) for v in c.scores.values()):
+            raise ValueError(f"{where}: candidates[{i}].scores (and score) must be finite numbers")
+        if not isinstance(c.locked, bool) or not finite_number(c.weight) or c.weight < 0:
+            raise ValueError(
+                f"{where}: candidates[{i}].locked must be a bool and weight a number >= 0"
+            )
     n = len(p.candidates)
     for k in p.picks:
         if isinstance(k, bool) or not isinstance(k, numbers.Integral) or not 0 <= k < n:

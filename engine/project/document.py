@@ -11,7 +11,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-from engine.project.model import PROJECT_FORMAT, PROJECT_VERSION, SAFE_NAME, Candidate, Project
+from engine.candidate import CandidateTile
+from engine.project.model import PROJECT_FORMAT, PROJECT_VERSION, SAFE_NAME, Project
 
 __all__ = ["from_doc", "to_doc"]
 
@@ -39,19 +40,7 @@ def to_doc(project: Project, put: Callable[[np.ndarray, str], str]) -> dict:
         if project.template is None
         else {m: put(a, f"images/template_{m}.png") for m, a in project.template.items()},
         "candidates": [
-            {
-                "images": {
-                    m: put(a, f"images/candidate_{i:04}_{m}.png") for m, a in c.maps.items()
-                },
-                "patch_origin": None
-                if c.patch_origin is None
-                else [int(v) for v in c.patch_origin],
-                "seed": None if c.seed is None else int(c.seed),
-                "locked": bool(c.locked),
-                "score": None if c.score is None else float(c.score),
-                "params": c.params,
-            }
-            for i, c in enumerate(project.candidates)
+            _candidate_doc(c, i, project.main_map, put) for i, c in enumerate(project.candidates)
         ],
         "picks": [int(k) for k in project.picks],
         "layout": None
@@ -66,6 +55,75 @@ def to_doc(project: Project, put: Callable[[np.ndarray, str], str]) -> dict:
         "extra": project.extra,
         "wang": project.wang,
     }
+
+
+def _candidate_doc(c: CandidateTile, i: int, main: str, put) -> dict:
+    """One candidate's entry (its images by map, how it was made, the user's choices)."""
+    images = {m: put(a, f"images/candidate_{i:04}_{m}.png") for m, a in c.images(main).items()}
+
+    def ints(v):
+        return None if v is None else [int(x) for x in v]
+
+    return {
+        "images": images,
+        "patch_origin": ints(c.patch_origin),
+        "seed": None if c.seed is None else int(c.seed),
+        "locked": bool(c.locked),
+        "score": c.score,
+        "params": {
+            **c.params,
+            "weight": float(c.weight),
+            "scores": {k: float(v) for k, v in c.scores.items()},
+            "patch_rect": ints(c.patch_rect),
+            "target_rect": ints(c.target_rect),
+            "loop": None if c.loop is None else np.asarray(c.loop).tolist(),
+        },
+    }
+
+
+def _candidate(i: int, c: dict, images: dict, main: str, s) -> CandidateTile:
+    """The candidate of entry ``c`` (what :func:`_candidate_doc` wrote; files of version 1
+    without ``params`` keep only their score); malformed optional details are dropped."""
+    where = f"candidates[{i}]"
+    po = s.get(c, "patch_origin", list, where, optional=True)
+    params = s.get(c, "params", dict, where, optional=True, default={})
+    scores = params.get("scores") if isinstance(params.get("scores"), dict) else {}
+    scores = {k: v for k, v in scores.items() if isinstance(v, (int, float))}
+    score = s.get(c, "score", (int, float), where, optional=True)
+    if "criterion" not in scores and score is not None:
+        scores["score"] = score
+    weight = params.get("weight", 1.0)
+    own = {"weight", "scores", "patch_rect", "target_rect", "loop"}
+    return CandidateTile(
+        index=i,
+        tile=images[main],
+        maps={m: a for m, a in images.items() if m != main},
+        patch_rect=_rect(params.get("patch_rect")),
+        patch_origin=None if po is None else tuple(_int_list(s, po, 2, f"{where}.patch_origin")),
+        target_rect=_rect(params.get("target_rect")),
+        loop=_points(params.get("loop")),
+        scores=scores,
+        seed=s.get(c, "seed", int, where, optional=True),
+        locked=s.get(c, "locked", bool, where),
+        weight=float(weight) if isinstance(weight, (int, float)) else 1.0,
+        params={k: v for k, v in params.items() if k not in own},
+    )
+
+
+def _rect(value) -> tuple[int, int, int, int] | None:
+    """An (x, y, w, h) rectangle read from JSON, None if it is not one."""
+    if isinstance(value, list) and len(value) == 4 and all(isinstance(v, int) for v in value):
+        return tuple(value)
+    return None
+
+
+def _points(value) -> np.ndarray | None:
+    """(N, 2) int (row, col) points read from JSON, None if they are not."""
+    try:
+        a = np.asarray(value, dtype=np.int64)
+    except (TypeError, ValueError, OverflowError):
+        return None
+    return a if a.ndim == 2 and a.shape[1] == 2 and len(a) else None
 
 
 class _Spec:
@@ -155,19 +213,7 @@ def from_doc(doc, fail: Callable[[str], None], image: Callable[[object], object]
     for i, c in enumerate(s.get(doc, "candidates", list, "")):
         where = f"candidates[{i}]"
         imgs = map_images(s.get(c, "images", dict, where), f"{where}.images")
-        po = s.get(c, "patch_origin", list, where, optional=True)
-        cands.append(
-            Candidate(
-                maps=imgs,
-                patch_origin=None
-                if po is None
-                else tuple(_int_list(s, po, 2, f"{where}.patch_origin")),
-                seed=s.get(c, "seed", int, where, optional=True),
-                locked=s.get(c, "locked", bool, where),
-                score=s.get(c, "score", (int, float), where, optional=True),
-                params=s.get(c, "params", dict, where, optional=True, default={}),
-            )
-        )
+        cands.append(_candidate(i, c, imgs, maps[0], s))
     rect = s.get(doc, "template_rect", list, "", optional=True)
     layout = s.get(doc, "layout", list, "", optional=True)
     if layout is not None:

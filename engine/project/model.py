@@ -13,27 +13,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["Candidate", "PROJECT_FORMAT", "PROJECT_SUFFIX", "PROJECT_VERSION", "Project"]
+from engine.candidate import CandidateTile
+
+__all__ = ["PROJECT_FORMAT", "PROJECT_SUFFIX", "PROJECT_VERSION", "Project"]
 
 PROJECT_FORMAT = "quilt-studio-project"
 PROJECT_VERSION = 1
 PROJECT_SUFFIX = ".quiltproj"
 SAFE_NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]*$")
 """Project and map names: simple file-name parts (they name exported files)."""
-
-
-@dataclass
-class Candidate:
-    """One candidate tile: its images (one per map) and how it was made."""
-
-    maps: dict[str, np.ndarray]
-    patch_origin: tuple[int, int] | None = (
-        None  # (row, col) of the patch source in the source image
-    )
-    seed: int | None = None
-    locked: bool = False
-    score: float | None = None
-    params: dict = field(default_factory=dict)  # any JSON (patch size, seam method, waypoints ...)
 
 
 @dataclass
@@ -56,7 +44,8 @@ class Project:
     seeds: dict = field(default_factory=dict)  # any JSON: named seeds
     template_rect: tuple[int, int, int, int] | None = None  # (x, y, w, h)
     template: dict[str, np.ndarray] | None = None  # the seamless template tile per map
-    candidates: list[Candidate] = field(default_factory=list)
+    # the engine's candidate type: ``tile`` is the main map's, ``maps`` the other maps'
+    candidates: list[CandidateTile] = field(default_factory=list)
     picks: list[int] = field(default_factory=list)
     layout: np.ndarray | None = None  # (rows, cols) exported tile ids, -1 = empty
     waypoints: dict[str, list[tuple[int, int]]] = field(default_factory=dict)  # per seam key
@@ -74,4 +63,4 @@ class Project:
     def exported_tiles(self) -> list[dict[str, np.ndarray]]:
         """The tiles an export writes: the picked candidates (all candidates if none picked)."""
         order = self.picks if self.picks else range(len(self.candidates))
-        return [self.candidates[i].maps for i in order]
+        return [self.candidates[i].images(self.main_map) for i in order]

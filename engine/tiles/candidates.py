@@ -24,15 +24,15 @@ import math
 import numbers
 import warnings
 from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
-from dataclasses import dataclass, field
 
 import numpy as np
 from numba import njit
 
 from engine._validate import as_image, positive_int
 from engine.cancel import Cancelled, CancelToken, check, is_cancelled
+from engine.candidate import CandidateTile
 from engine.errormap import colour_channels
-from engine.events import Item, Progress, drain, frozen_array
+from engine.events import Progress, drain, frozen_array
 from engine.exclusion import valid_anchors
 from engine.materials import apply_cut
 from engine.seams.spec import SeamSpec, as_seam_spec
@@ -69,49 +69,6 @@ def default_patch_overlap(overlap: int) -> int:
     """
     w = positive_int(overlap, "overlap")
     return min(w, max(PATCH_RING_FLOOR, w // 2))
-
-
-@dataclass(frozen=True, slots=True)
-class CandidateTile(Item):
-    """One finished candidate tile.
-
-    Attributes
-    ----------
-    index : int
-        Its slot (0 .. n-1).
-    tile : (h, w, C) float32
-        The template with the patch stitched in.
-    maps : dict
-        The same candidate for every extra material map.
-    patch_rect : (x, y, w, h)
-        Where the patch comes from in the source.
-    patch_origin : (row, col)
-        Its top-left corner (what :func:`make_candidate` takes back).
-    target_rect : (x, y, w, h)
-        Where the patch window lies in the tile.
-    loop : (N, 2) int
-        The closed cut path (row, col) in tile coordinates.
-    mask, alpha : (h, w)
-        True / weight where the tile shows the patch.
-    scores : dict
-        ``criterion`` and ``peak`` (sum and max of the error on the loop), ``band_error``
-        (mean ring error of the chosen position), ``changed`` (share of tile pixels that
-        differ from the template), ``coverage`` (share inside the loop).
-    seed : int or None
-        The candidate's own seed (``None`` for a user-placed patch).
-    """
-
-    index: int
-    tile: np.ndarray
-    maps: dict
-    patch_rect: tuple[int, int, int, int]
-    patch_origin: tuple[int, int]
-    target_rect: tuple[int, int, int, int]
-    loop: np.ndarray
-    mask: np.ndarray
-    alpha: np.ndarray
-    scores: dict = field(default_factory=dict)
-    seed: int | None = None
 
 
 # --------------------------------------------------------------------------- seeds

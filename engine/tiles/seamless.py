@@ -66,6 +66,11 @@ class SeamlessUpdate(Snapshot):
     regions: dict | None = None
     error: np.ndarray | None = None
 
+    @property
+    def slot(self) -> str:
+        """Each overlap keeps its own newest seam."""
+        return self.which
+
 
 @dataclass(frozen=True)
 class SeamlessTile:

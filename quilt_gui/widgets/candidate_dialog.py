@@ -15,8 +15,8 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from engine.candidate import CandidateTile
 from quilt_gui.document import Document
-from quilt_gui.model import CandidateEntry
 from quilt_gui.widgets.canvas import ImageCanvas, PixelSetItem
 from quilt_gui.widgets.tile_view import TiledImageView
 
@@ -32,7 +32,7 @@ SCORE_LABELS = {
 }
 
 
-def score_lines(entry: CandidateEntry) -> list[str]:
+def score_lines(entry: CandidateTile) -> list[str]:
     """The candidate's figures, one line each, in words."""
     lines = []
     if entry.score is not None:
@@ -109,7 +109,7 @@ class CandidateDialog(QDialog):
         doc.tileset.picks_changed.connect(self._refresh_buttons)
         self.set_index(index)
 
-    def entry(self) -> CandidateEntry | None:
+    def entry(self) -> CandidateTile | None:
         cands = self.doc.tileset.candidates
         return cands[self.index] if 0 <= self.index < len(cands) else None
 
@@ -129,7 +129,7 @@ class CandidateDialog(QDialog):
         self.info.setText("<br>".join(lines))
         self._refresh_buttons()
 
-    def _show_patch(self, e: CandidateEntry) -> None:
+    def _show_patch(self, e: CandidateTile) -> None:
         """The patch's source window, with the seam mapped from tile to source pixels."""
         src = self.doc.source
         if e.patch_rect is None or src is None:

@@ -22,10 +22,10 @@ from PySide6.QtCore import (
 from PySide6.QtGui import QAction, QColor, QFont, QGuiApplication, QPainter, QPen, QPixmap
 from PySide6.QtWidgets import QListView, QMenu, QStyle, QStyledItemDelegate
 
+from engine.candidate import CandidateTile
 from quilt_gui import settings
 from quilt_gui.document import Document
 from quilt_gui.imaging import to_qimage
-from quilt_gui.model import CandidateEntry
 
 PICK_ROLE = Qt.ItemDataRole.UserRole + 1  # 1-based pick order, 0 = not picked
 LOCKED_ROLE = Qt.ItemDataRole.UserRole + 2
@@ -44,7 +44,7 @@ class CandidateModel(QAbstractListModel):
         super().__init__(parent)
         self.doc = doc
         self.thumb = int(thumb or settings.get("thumbnail_size"))
-        self._rows: list[CandidateEntry] = list(doc.tileset.candidates)
+        self._rows: list[CandidateTile] = list(doc.tileset.candidates)
         self._pick_order: dict[int, int] = {}
         self._thumbs: dict[int, QPixmap] = {}  # id(entry) -> pixmap
         doc.tileset.candidate_inserted.connect(self._on_inserted)
@@ -101,7 +101,7 @@ class CandidateModel(QAbstractListModel):
             | Qt.ItemFlag.ItemNeverHasChildren
         )
 
-    def thumbnail(self, entry: CandidateEntry) -> QPixmap:
+    def thumbnail(self, entry: CandidateTile) -> QPixmap:
         key = id(entry)
         pm = self._thumbs.get(key)
         if pm is None:

@@ -199,13 +199,16 @@ class QuiltView(QWidget):
         self.block_rect.hide()
         res = self.doc.quilting.result
         h, w = out.shape[:2]
-        passes = getattr(res, "iterations", ())
-        how = (
-            f"{len(passes)} transfer passes, correspondence error "
-            f"{passes[-1].correspondence_error:.4f}"
-            if passes
-            else f"{res.select}, {res.seam.method} seams"
-        )
+        from engine.transfer import TransferResult
+
+        if isinstance(res, TransferResult) and res.iterations:
+            passes = res.iterations
+            how = (
+                f"{len(passes)} transfer passes, correspondence error "
+                f"{passes[-1].correspondence_error:.4f}"
+            )
+        else:
+            how = f"{res.select}, {res.seam.method} seams"
         self.counter.setText(f"{w}×{h} from {len(res.blocks)} blocks ({how})")
         self.select(len(self.doc.quilting.blocks) - 1 if self.doc.quilting.blocks else None)
 

@@ -121,9 +121,7 @@ def test_project_option_helpers(tmp_path):
     save_project_option(args, sources=src, tiles=[src[:8, :8], src[8:, 8:]], picks=[1])
     p = load_project(tmp_path / "p.quiltproj")
     assert len(p.candidates) == 2 and p.picks == [1]
-    assert np.array_equal(
-        p.candidates[1].maps["albedo"], np.round(src[8:, 8:] * 255) / np.float32(255)
-    )
+    assert np.array_equal(p.candidates[1].tile, np.round(src[8:, 8:] * 255) / np.float32(255))
 
 
 def test_sixteen_bit_source_to_bundle_end_to_end(tmp_path):

@@ -106,7 +106,7 @@ def test_end_to_end_files_manifest_layout_and_determinism(src, tmp_path, capsys)
     assert len(project.candidates) == 5 and project.picks == list(range(5))
     assert project.template_rect == rect
     np.testing.assert_array_equal(project.layout, cells)
-    np.testing.assert_allclose(project.candidates[2].maps["albedo"], cands[2].tile, atol=1e-6)
+    np.testing.assert_allclose(project.candidates[2].tile, cands[2].tile, atol=1e-6)
 
 
 def test_sixteen_bit_and_gray_keep_their_depth(src, tmp_path):

@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 
 import engine.project.archive as project_mod
+from engine.candidate import CandidateTile
 from engine.png import encode_png
 from engine.project import (
-    Candidate,
     Project,
     ProjectError,
     export_project,
@@ -84,13 +84,12 @@ def assert_same(a: Project, b: Project):
     assert np.array_equal(a.layout, b.layout)
     assert len(a.candidates) == len(b.candidates)
     for ca, cb in zip(a.candidates, b.candidates, strict=True):
-        assert (ca.patch_origin, ca.seed, ca.locked, ca.score, ca.params) == (
-            cb.patch_origin,
-            cb.seed,
-            cb.locked,
-            cb.score,
-            cb.params,
-        )
+        fields = ("index", "patch_origin", "patch_rect", "target_rect", "seed", "locked")
+        fields += ("weight", "scores", "score")
+        assert [getattr(ca, f) for f in fields] == [getattr(cb, f) for f in fields]
+        assert (ca.loop is None) == (cb.loop is None)
+        assert ca.loop is None or np.array_equal(ca.loop, cb.loop)
+        assert list(ca.maps) == list(cb.maps) and np.array_equal(ca.tile, cb.tile)
         for m in ca.maps:
             assert np.array_equal(ca.maps[m], cb.maps[m])
 
@@ -366,9 +365,25 @@ def test_image_of_wrong_size_or_channels_is_refused(tmp_path, good):
     expect_refused(bad, "height")
 
 
-def test_candidate_dataclass_defaults():
-    c = Candidate(maps={"albedo": np.zeros((2, 2, 3), np.float32)})
-    assert c.patch_origin is None and not c.locked and c.params == {}
+def test_candidate_defaults_and_what_a_project_keeps_of_it(tmp_path):
+    c = CandidateTile(index=0, tile=np.zeros((2, 2, 3), np.float32))
+    assert c.patch_origin is None and not c.locked and c.weight == 1.0 and c.score is None
+    p = make_project(8)
+    made = p.candidates[1].replace(
+        scores={"criterion": 6.0, "peak": 1.5},
+        loop=np.array([[0, 0], [0, 1], [1, 1]]),
+        patch_rect=(1, 2, 12, 16),
+        target_rect=(0, 0, 12, 16),
+        mask=np.ones((16, 12), bool),
+        weight=2.5,
+    )
+    assert made.score == 2.0  # mean error per loop pixel
+    p.candidates[1] = made
+    save_project(tmp_path / "c.quiltproj", p)
+    back = load_project(tmp_path / "c.quiltproj").candidates[1]
+    assert back.mask is None and back.alpha is None  # not kept
+    assert (back.score, back.weight, back.patch_rect) == (2.0, 2.5, (1, 2, 12, 16))
+    assert np.array_equal(back.loop, made.loop) and back.scores == made.scores
 
 
 def test_recovery_file(tmp_path):
@@ -387,8 +402,7 @@ def test_recovery_file(tmp_path):
 
 def test_candidate_weights_become_tile_probabilities(tmp_path):
     p = make_project(8)
-    for i, c in enumerate(p.candidates):
-        c.params["weight"] = i + 0.5
+    p.candidates = [c.replace(weight=i + 0.5) for i, c in enumerate(p.candidates)]
     man = export_project(p, tmp_path / "w")
     assert [t["weight"] for t in man["tiles"]] == [4.5, 0.5, 2.5]  # picks 4, 0, 2
     assert 'probability="4.5"' in (tmp_path / "w" / "rock.tsx").read_text()

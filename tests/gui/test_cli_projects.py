@@ -44,7 +44,7 @@ def test_cli_project_opens_in_the_editor(qtbot, tmp_path):
     assert len(d.candidates) == 4 and d.picks == cli.picks == [0, 2]
     assert d.template_rect == cli.template_rect
     assert w.gallery.model().rowCount() == 4 and d.seamless is not None
-    assert np.array_equal(d.candidates[2].tile, cli.candidates[2].maps[cli.main_map])
+    assert np.array_equal(d.candidates[2].tile, cli.candidates[2].tile)
     assert d.preview is not None
 
 

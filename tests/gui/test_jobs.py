@@ -55,6 +55,10 @@ class Side(Snapshot):
     which: str
     value: int
 
+    @property
+    def slot(self) -> str:  # like engine.tiles.SeamlessUpdate: one newest state per overlap
+        return self.which
+
 
 def test_coalesce_keeps_the_newest_snapshot_of_each_which():
     """Two overlaps stream seams: a vertical update must not drop the horizontal one."""

@@ -37,7 +37,7 @@ def test_attached_normal_map_follows_every_cut_and_exports(qtbot, tmp_path):
     w.act_generate.trigger()
     wait_idle(qtbot, w)
     for e in w.doc.tileset.candidates:
-        assert set(e.maps) == {"albedo", "normal"}
+        assert set(e.images("albedo")) == {"albedo", "normal"}
         v = decode_normals(e.maps["normal"])
         assert np.allclose(np.linalg.norm(v, axis=2), 1.0, atol=0.02)
     w.doc.tileset.set_picks([0, 2])

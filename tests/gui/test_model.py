@@ -5,10 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from engine.candidate import CandidateTile
 from quilt_gui import params, project_io, settings
 from quilt_gui.commands import new_merge_id
 from quilt_gui.document import Document
-from quilt_gui.model import CandidateEntry, Source
+from quilt_gui.model import Source
 
 
 def test_settings_typed_defaults_and_unknown_keys():
@@ -57,8 +58,8 @@ def make_doc(h=64, w=80) -> Document:
     return doc
 
 
-def entry(v: float) -> CandidateEntry:
-    return CandidateEntry(maps={"albedo": np.full((8, 8, 3), v, np.float32)}, seed=int(v * 10))
+def entry(v: float) -> CandidateTile:
+    return CandidateTile(index=0, tile=np.full((8, 8, 3), v, np.float32), seed=int(v * 10))
 
 
 def test_slider_drag_is_one_undo_step(qtbot):

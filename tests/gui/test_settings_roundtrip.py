@@ -141,7 +141,7 @@ def test_cli_project_with_every_option_reopens_in_the_editor_with_all_of_them(qt
     assert len(ts.candidates) == 4
     for mine, theirs in zip(ts.candidates, cli.candidates, strict=True):
         assert mine.patch_origin == theirs.patch_origin
-        assert np.array_equal(_q(mine.tile), _q(theirs.maps[main]))
+        assert np.array_equal(_q(mine.tile), _q(theirs.tile))
         assert np.array_equal(_q(mine.maps["height"]), _q(theirs.maps["height"]))
 
 
