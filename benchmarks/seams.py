@@ -7,6 +7,11 @@ shows the method's median time, its ratio to a straightforward row-by-row numpy 
 (sum of E on the path) relative to ``dp``'s (the optimal one-pixel-per-row cut) and, for the
 oscillating search, the time to its first path.
 
+After the timing table, a Bhatia table compares the two ``resistance`` variants (the paper's
+two lines from the corners, and the single walk, both cut corner to corner as quilting cuts its
+bands) on real overlaps: time, criterion against the DP cut with the same pinned corners, how
+far the cut reaches into the overlap and how often it touches the far column.
+
 ``--quality`` instead measures how far the oscillating search ends above ``oscillating-optimal``
 (the exact optimum of its path model) on the bundled samples' overlaps: random strip pairs and
 the overlaps the product really cuts (seamless template, candidate patch rings, best-match
@@ -54,7 +59,8 @@ VARIANTS = [
         {"o_max": 3, "variant": "faithful", "init": "argmin"},
     ),
     ("oscillating-optimal", "oscillating-optimal", {}),
-    ("resistance", "resistance", {}),
+    ("resistance published (Bhatia)", "resistance", {}),
+    ("resistance walk", "resistance", {"variant": "walk"}),
     ("dp cyclic", "dp", {"cyclic": True}),
     ("oscillating o_max=3 cyclic", "oscillating", {"cyclic": True}),
 ]
@@ -62,7 +68,8 @@ VARIANTS = [
 #: targets at 512x64 (ms)
 TARGETS = {
     "dp": 1.0,
-    "resistance": 1.0,
+    "resistance published (Bhatia)": 1.0,
+    "resistance walk": 1.0,
     "dijkstra": 15.0,
     "minimax exact": 30.0,
     "oscillating o_max=3": 40.0,
@@ -170,6 +177,43 @@ def run(sizes, sample: str, min_time: float, max_seconds: float) -> tuple[list, 
                 )
             )
     return rows, at_512
+
+
+# ----------------------------------------------------------------------------- Bhatia
+#: overlap shapes of the Bhatia table: quilting bands (block 48, overlap 12 = block / 4, the
+#: default band; block 96, overlap 24) and a wide overlap
+BHATIA_SHAPES = ((48, 12), (96, 24), (512, 64))
+
+
+def bhatia_table(sample: str, n_maps: int = 12, min_time: float = 0.05) -> str:
+    """The ``resistance`` variants corner to corner (start = end = 0) on ``n_maps`` real
+    overlaps per shape: median time, criterion / the pinned DP cut's, mean reach (R1's share of
+    the overlap) and the share of cuts that touch the overlap's far column."""
+    rows = []
+    for h, w in BHATIA_SHAPES:
+        maps = [sample_map(h, w, sample, seed=s) for s in range(n_maps)]
+        dp = [find_seam(e, method="dp", start=0, end=0).criterion for e in maps]
+        for variant in ("published", "walk"):
+            times, ratio, reach, touch = [], [], [], 0
+            for e, d in zip(maps, dp, strict=True):
+                opts = dict(method="resistance", variant=variant, start=0, end=0)
+                t, seam = median_time(lambda e=e, o=opts: find_seam(e, **o), min_time=min_time)
+                times.append(t)
+                ratio.append(seam.criterion / d)
+                reach.append(seam.mask.mean())
+                touch += int(seam.path[:, 1].max() == w - 1)
+            rows.append(
+                (
+                    f"{h}x{w}",
+                    variant,
+                    f"{1e3 * np.median(times):.3f}",
+                    f"{np.median(ratio):.2f}",
+                    f"{np.mean(reach):.2f}",
+                    f"{touch}/{n_maps}",
+                )
+            )
+    headers = ("overlap", "variant", "median ms", "criterion / dp", "R1 share", "far column")
+    return format_table(headers, rows)
 
 
 # ----------------------------------------------------------------------------- quality
@@ -476,6 +520,9 @@ def main(argv=None) -> int:
                     f"  {label:<22} {worst:8.3f} ms  (target <= {limit:g} ms: "
                     f"{'ok' if worst <= limit else 'MISSED'})"
                 )
+    print(f"\nBhatia's minimum resistance cut line, corner to corner on {args.sample} overlaps")
+    print("(criterion / the DP cut between the same corners, medians over 12 maps):")
+    print(bhatia_table(args.sample))
     return 0
 
 

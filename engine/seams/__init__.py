@@ -19,7 +19,8 @@ method                   what                                                 op
 ``oscillating``          Somol & Haindl's anytime control-point search        o_max, variant,
                                                                               init
 ``oscillating-optimal``  exact optimum of the same control-point model        —
-``resistance``           Bhatia's minimum resistance walk                     max_run
+``resistance``           Bhatia's minimum resistance cut line                 variant,
+                                                                              max_run
                                                                               (+ ``image``)
 =======================  ===================================================  ==============
 
@@ -38,6 +39,11 @@ smoothed along the rows). The paper's algorithm is ``variant="faithful", init="a
 default ``variant="resume", init="dp"`` keeps its moves but starts from the DP cut: from the
 argmin start the search ends 31-65 % above the model's optimum on real overlaps at o_max = 3,
 from the DP cut 0.7-2.3 % (see :mod:`engine.seams.oscillating`).
+
+``resistance`` options: ``variant`` (``"published"``: Bhatia's two lines from the corners that
+meet, the cut running from (0, start or 0) to (h - 1, end or 0); ``"walk"``: one greedy walk from
+the top row down) and ``max_run`` (longest straight run, 5 as in the paper's figure); the new
+block's colours as ``image`` give the paper's step cost. See :mod:`engine.seams.resistance`.
 """
 
 from __future__ import annotations

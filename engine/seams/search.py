@@ -21,6 +21,7 @@ from engine.seams.spec import (
     INITS,
     METHODS,
     MINIMAX_VARIANTS,
+    RESISTANCE_VARIANTS,
     SeamSpec,
     as_seam_spec,
 )
@@ -186,7 +187,9 @@ def _solve(e, method, pins, cyclic, opts, image, cancel) -> Seam:
         c = optimal_controls(e, *_intervals(pins, w), cyclic=cyclic, cancel=cancel)
         return controls_seam(e, c, cyclic, method, lazy=False)
     if method == "resistance":
-        path = resistance_path(e, pins, max_run=opts["max_run"], image=image)
+        path = resistance_path(
+            e, pins, max_run=opts["max_run"], image=image, variant=opts["variant"]
+        )
         return make_seam(e, path, method)
     return _graph_seam(e, pins, method, opts, cancel)
 
@@ -330,7 +333,8 @@ def warmup() -> None:
     runs += [dict(method="minimax", variant=v, connectivity=4) for v in MINIMAX_VARIANTS]
     runs += [dict(method="oscillating", variant="faithful", init=i) for i in INITS]
     runs += [dict(method="oscillating", init=i, cyclic=True) for i in INITS]
-    runs += [dict(method="resistance", image=image)]
+    runs += [dict(method="resistance", variant=v, image=image) for v in RESISTANCE_VARIANTS]
+    runs += [dict(method="resistance", variant="walk", start=1, end=1, waypoints=[(2, 2)])]
     for kw in runs:
         for update in iter_find_seam(e, **kw):
             update.seam.mask  # noqa: B018 (lazily built seams: compile their builder too)

@@ -46,6 +46,8 @@ BLEND_MODES = ("none", "feather", "adaptive")
 MINIMAX_VARIANTS = ("exact", "lm", "sorted")
 #: variants of the oscillating search (restart after an improvement, or continue)
 OSCILLATING_VARIANTS = ("resume", "faithful")
+#: variants of Bhatia's minimum resistance cut line: the paper's two lines, or one walk
+RESISTANCE_VARIANTS = ("published", "walk")
 #: starting paths of the oscillating search (:func:`engine.seams.oscillating.initial_controls`)
 INITS = ("argmin", "dp", "smoothed")
 
@@ -57,7 +59,7 @@ OPTIONS: dict[str, dict[str, object]] = {
     "minimax": {"variant": "exact", "levels": 32, "connectivity": 8},
     "oscillating": {"o_max": 3, "variant": "resume", "init": "dp"},
     "oscillating-optimal": {},
-    "resistance": {"max_run": 5},
+    "resistance": {"variant": "published", "max_run": 5},
 }
 
 __all__ = [
@@ -69,6 +71,7 @@ __all__ = [
     "MINIMAX_VARIANTS",
     "OPTIONS",
     "OSCILLATING_VARIANTS",
+    "RESISTANCE_VARIANTS",
     "STRAIGHT",
     "SeamSpec",
     "as_seam_spec",
@@ -94,13 +97,20 @@ def check_option_names(method: str, options, name: str = "method") -> None:
         )
 
 
+_VARIANTS = {
+    "minimax": MINIMAX_VARIANTS,
+    "oscillating": OSCILLATING_VARIANTS,
+    "resistance": RESISTANCE_VARIANTS,
+}
+
+
 def _check_option(method: str, key: str, value):
     if key == "connectivity":
         return check_connectivity(value)
     if key in ("levels", "o_max", "max_run"):
         return positive_int(value, key)
     if key == "variant":
-        return choice(value, key, MINIMAX_VARIANTS if method == "minimax" else OSCILLATING_VARIANTS)
+        return choice(value, key, _VARIANTS[method])
     return choice(value, key, INITS)  # "init", the only other option
 
 

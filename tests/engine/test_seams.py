@@ -591,7 +591,7 @@ def test_resistance_walk_rules():
     for seed in range(10):
         e = smooth_map((60, 12), seed, sigma=1.5)
         for max_run in (2, 5):
-            s = find_seam(e, method="resistance", max_run=max_run)
+            s = find_seam(e, method="resistance", variant="walk", max_run=max_run)
             assert_valid(s, e)
             d = np.diff(s.path, axis=0)
             assert np.all(d[:, 0] >= 0), "walked upwards"
@@ -607,7 +607,7 @@ def test_resistance_follows_the_cheapest_step():
     e[:, 2] = 0.5
     e[3:6, 2] = 2.0
     e[3:6, 3] = 0.1
-    s = find_seam(e, method="resistance", max_run=3)
+    s = find_seam(e, method="resistance", variant="walk", max_run=3)
     assert s.path.tolist() == [[0, 2], [1, 2], [2, 2], [3, 3], [4, 3], [5, 3], [6, 2], [7, 2]]
 
 
@@ -616,7 +616,7 @@ def test_resistance_image_step_cost():
     e = np.ones((10, 6))
     img = np.random.default_rng(0).random((10, 6, 3))
     img[:, 4] = 0.5
-    s = find_seam(e, method="resistance", image=img, start=4, max_run=20)
+    s = find_seam(e, method="resistance", variant="walk", image=img, start=4, max_run=20)
     assert np.all(s.path[:, 1] == 4)
     with pytest.raises(ValueError, match="image"):
         find_seam(e, method="resistance", image=img[:5])
