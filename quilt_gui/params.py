@@ -125,7 +125,7 @@ PARAMS: tuple[Param, ...] = (
         "dijkstra: shortest path, may wind\n"
         "minimax: smallest worst error, then sum (Long & Mould)\n"
         "oscillating: anytime control-point search (Somol & Haindl)\n"
-        "resistance: minimum resistance walk (Bhatia)",
+        "resistance: minimum resistance cut line (Bhatia)",
         "Seam",
         choices=SEAM_METHODS,
     ),
@@ -443,10 +443,20 @@ PARAMS: tuple[Param, ...] = (
         choices=("dp", "argmin", "smoothed"),
     ),
     _P(
+        "resistance_variant",
+        "published",
+        "Resistance variant",
+        "resistance: published (Bhatia's two lines from the overlap's corners, the second "
+        "stopping where it meets the first, as in the paper) or walk (one greedy walk from the "
+        "top row down).",
+        "Seam options",
+        choices=("published", "walk"),
+    ),
+    _P(
         "max_run",
         5,
         "Max run",
-        "resistance: longest straight run of the walk (px).",
+        "resistance: longest straight run of a cut line (px; 5 in Bhatia's figure).",
         "Seam options",
         1,
         256,
@@ -552,6 +562,14 @@ def coerce_all(values: dict) -> dict:
             with contextlib.suppress(TypeError, ValueError):
                 out[k] = BY_KEY[k].coerce(v)
     return out
+
+
+#: the parameter holding each method's ``variant`` option
+_VARIANT_KEYS = {
+    "minimax": "minimax_variant",
+    "oscillating": "osc_variant",
+    "resistance": "resistance_variant",
+}
 
 
 def seam_option_keys(method: str) -> frozenset[str]:
@@ -666,7 +684,7 @@ def from_project_parameters(parameters: dict, seeds: dict | None = None) -> dict
 
 
 def _option_key(option: str, method: str) -> str:
-    """The parameter of seam ``option`` of ``method`` (the two variants have their own)."""
+    """The parameter of seam ``option`` of ``method`` (each method's variant has its own)."""
     if option == "variant":
-        return "minimax_variant" if method == "minimax" else "osc_variant"
+        return _VARIANT_KEYS[method]
     return "osc_init" if option == "init" else option

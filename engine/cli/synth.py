@@ -38,7 +38,7 @@ def parse_wxh(text: str) -> tuple[int, int]:
     return h, w
 
 
-def add_cut_arguments(p: argparse.ArgumentParser, *, seam_default: str = "dp") -> None:
+def add_cut_arguments(p: argparse.ArgumentParser) -> None:
     """Options shared by ``synth`` and ``transfer``: the cut, blending, search, seed, threads."""
     from engine.blend import BLEND_MODES
     from engine.errormap import METRICS
@@ -47,12 +47,17 @@ def add_cut_arguments(p: argparse.ArgumentParser, *, seam_default: str = "dp") -
     p.add_argument(
         "--seam",
         choices=SEAMS,
-        default=seam_default,
-        help=f"boundary: straight overlap or a seam method (default {seam_default})",
+        default=None,
+        help="boundary: straight overlap or a seam method (default dp; resistance with "
+        "--select bhatia)",
     )
     add_seam_options(p)
     p.add_argument(
-        "--blend", choices=BLEND_MODES, default="none", help="softening of the cut (default none)"
+        "--blend",
+        choices=BLEND_MODES,
+        default=None,
+        help="softening of the cut (default none; feather with --select bhatia, whose paper "
+        "blends the pixels around its cut lines)",
     )
     p.add_argument(
         "--blend-width",
@@ -224,14 +229,16 @@ def start(iter_fn, *args, **kwargs):
 
 def cut_options(args) -> dict:
     """``seam`` (a SeamSpec: a bad ``--seam-option`` raises here), tolerance, seed, threads."""
+    from engine.quilting.options import BHATIA_SEAM, QUILT_SEAM
     from engine.seams import SeamSpec
 
+    default = BHATIA_SEAM if getattr(args, "select", None) == "bhatia" else QUILT_SEAM
     try:
         seam = SeamSpec(
-            args.seam,
+            args.seam or default.method,
             dict(args.seam_option),
             metric=args.metric,
-            blend=args.blend,
+            blend=args.blend or default.blend,
             width=args.blend_width,
             rho=args.rho,
         )

@@ -21,6 +21,7 @@ from engine.events import Progress
 from engine.exclusion import valid_anchors
 from engine.quilting.core import Quilter
 from engine.quilting.records import BlockPlaced, BlockRecord, read_only
+from engine.seams import make_seam
 
 __all__ = ["bhatia_anchors", "iter_bhatia"]
 
@@ -157,10 +158,21 @@ def bhatia_anchors(excluded: np.ndarray, block, band: int) -> np.ndarray:
 
 
 def _bhatia_seam(q: Quilter, e: np.ndarray, own_band: np.ndarray):
-    """Corner-to-corner cut of one band (canonical: extension = R1 on the left)."""
+    """Corner-to-corner cut of one band (canonical: extension = R1 on the left; row 0 is the
+    corner the block shares with the blocks placed before it).
+
+    The paper's blocks grow from the bottom-left corner and its line 1 starts at that corner;
+    ours grow from the top-left, so the published resistance cut runs on the band turned upside
+    down (its line 1 then starts at the shared corner) and is turned back."""
+    spec = q.seam
+    if spec.method != "resistance":
+        return spec.find(e, start=0, end=0, cancel=q.cancel)
     # Bhatia's step: the colour difference inside the new block
-    image = own_band if q.seam.method == "resistance" else None
-    return q.seam.find(e, start=0, end=0, image=image, cancel=q.cancel)
+    if spec.options["variant"] != "published":
+        return spec.find(e, start=0, end=0, image=own_band, cancel=q.cancel)
+    up = spec.find(e[::-1].copy(), start=0, end=0, image=own_band[::-1].copy(), cancel=q.cancel)
+    path = np.asarray(up.path)[::-1] * (-1, 1) + (e.shape[0] - 1, 0)
+    return make_seam(e, path, up.method, mask=up.mask[::-1])
 
 
 def _territory_composite(terr, srcs, blend: str, width: float) -> np.ndarray:

@@ -23,12 +23,16 @@ SEAMS = (STRAIGHT, *SEAM_METHODS)
 QUILT_SEAM = SeamSpec("dp", metric="ssd")
 """Quilting's default cut: Efros & Freeman's minimum error boundary cut on the squared error,
 no blending."""
+BHATIA_SEAM = SeamSpec("resistance", metric="ssd", blend="feather")
+"""The default cut of ``select="bhatia"``: Bhatia's minimum resistance cut line as published,
+the pixels around it blended ("the pixels around the cut line are blended", Bhatia §3)."""
 DEFAULT_SAMPLED = 200
 DEFAULT_RERANK = 32
 
 __all__ = [
     "DEFAULT_RERANK",
     "DEFAULT_SAMPLED",
+    "BHATIA_SEAM",
     "QUILT_SEAM",
     "MODES",
     "SEAMS",
@@ -84,7 +88,8 @@ def check_options(
     Ho, Wo = check_out_shape(out_shape)
     bh, bw = check_block(block)
     choice(select, "select", SELECTIONS)
-    seam = QUILT_SEAM if seam is None else seam
+    if seam is None:
+        seam = BHATIA_SEAM if select == "bhatia" else QUILT_SEAM
     if not isinstance(seam, SeamSpec):
         raise TypeError(
             "seam must be an engine.seams.SeamSpec (e.g. SeamSpec('dp', metric='ssd')), "

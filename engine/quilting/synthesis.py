@@ -62,7 +62,8 @@ def iter_quilt(
         The cut through the overlap: method (or ``"straight"``: no cut) and its options, the
         error metric of the map it runs on (the block search always uses the SSD) and the blend
         after it. Default :data:`engine.quilting.options.QUILT_SEAM` (dp on the squared error,
-        no blending).
+        no blending); for ``select="bhatia"`` :data:`~engine.quilting.options.BHATIA_SEAM`
+        (Bhatia's published minimum resistance cut, blended around the cut as in the paper).
     excluded : (H, W) bool array_like, optional
         Sample pixels never to copy (:func:`engine.exclusion.exclusion_mask`).
     tileable : bool

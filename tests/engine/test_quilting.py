@@ -201,7 +201,12 @@ def test_excluded_colour_never_reaches_the_output(kw):
 
 @pytest.mark.parametrize(
     "kw",
-    [{}, {"select": "sampled", "candidates": 30}, {"select": "bhatia", "seam": cut("resistance")}],
+    [
+        {},
+        {"select": "sampled", "candidates": 30},
+        # the bounds were set on the single walk with a hard cut (the defaults then)
+        {"select": "bhatia", "seam": cut("resistance", options={"variant": "walk"})},
+    ],
 )
 def test_tileable_output_wraps_seamlessly(cobbles, kw):
     """The output tiled 2 x 2 shows no joint at the wrap (engine.metrics on the tiled image),
