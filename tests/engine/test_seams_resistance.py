@@ -6,6 +6,7 @@ engine's numba kernel; the interpretations it shares with the engine are listed 
 :mod:`engine.seams.resistance`.
 """
 
+import json
 import math
 
 import numpy as np
@@ -233,3 +234,25 @@ def test_narrow_and_tiny_overlaps():
 def test_variant_is_checked():
     with pytest.raises(ValueError, match="variant"):
         find_seam(np.ones((4, 4)), method="resistance", variant="two-lines")
+
+
+def test_seam_cli_variants(tmp_path, capsys):
+    from engine.cli import main
+    from engine.errormap import error_map
+    from engine.io import load_image, save_image
+    from resources import sample_path
+
+    src = load_image(sample_path("cobblestones")).pixels
+    r1 = save_image(tmp_path / "r1.png", src[100:164, 40:56])
+    r2 = save_image(tmp_path / "r2.png", src[100:164, 200:216])
+    e = error_map(load_image(r1).pixels, load_image(r2).pixels)
+    paths = {}
+    for extra in ([], ["--seam-option", "variant=walk"], ["--seam-option", "variant=published"]):
+        assert main(["seam", str(r1), str(r2), "--method", "resistance", "--json", *extra]) == 0
+        paths[tuple(extra)] = json.loads(capsys.readouterr().out)["path"]
+    assert paths[()] == find_seam(e, method="resistance").path.tolist()
+    assert paths[()] == paths[("--seam-option", "variant=published")]
+    assert paths[("--seam-option", "variant=walk")] == (
+        find_seam(e, method="resistance", variant="walk").path.tolist()
+    )
+    assert paths[()] != paths[("--seam-option", "variant=walk")]
