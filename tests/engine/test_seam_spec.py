@@ -17,6 +17,7 @@ from engine.seams.spec import (
     METRICS,
     MINIMAX_VARIANTS,
     OSCILLATING_VARIANTS,
+    RESISTANCE_VARIANTS,
     as_seam_spec,
 )
 
@@ -37,7 +38,9 @@ def specs(draw):
         if not draw(st.booleans()):
             continue  # left at its default
         if key == "variant":
-            pool = MINIMAX_VARIANTS if method == "minimax" else OSCILLATING_VARIANTS
+            pool = {"minimax": MINIMAX_VARIANTS, "resistance": RESISTANCE_VARIANTS}.get(
+                method, OSCILLATING_VARIANTS
+            )
             options[key] = draw(st.sampled_from(pool))
         else:
             options[key] = draw(_OPTION_VALUES[key])
