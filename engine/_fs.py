@@ -34,6 +34,7 @@ __all__ = [
     "InputError",
     "OutputError",
     "atomic_path",
+    "check_folder",
     "check_writable",
     "clean_stale",
     "open_input",
@@ -150,16 +151,18 @@ def write_problem(folder: Path, exc: OSError) -> str:
     return reason(exc)
 
 
-def check_writable(folder) -> None:
+def check_writable(folder, *, name: str | None = None) -> None:
     """Make sure a file can be created in ``folder`` (made if missing), before any long work.
-    Raises :class:`OutputError` naming the folder; leaves nothing behind but the folder."""
-    p = Path(os.fspath(folder))
+    Raises :class:`OutputError` "{name}: cannot write there (why)" (``name`` defaults to the
+    folder); leaves nothing behind but the folder."""
+    p = Path(os.fspath(folder)) if os.fspath(folder) else Path(".")
     try:
         p.mkdir(parents=True, exist_ok=True)
         with tempfile.TemporaryFile(dir=p):
             pass
     except OSError as exc:
-        raise OutputError(exc.errno, f"{p}: cannot write there ({write_problem(p, exc)})") from None
+        why = write_problem(p, exc)
+        raise OutputError(exc.errno, f"{name or p}: cannot write there ({why})") from None
 
 
 # ---------------------------------------------------------------- stale temporaries
@@ -254,24 +257,16 @@ def _holds(folder: Path, path: Path) -> bool:
     return folder == path or folder in path.parents
 
 
-def replace_folder(
+def check_folder(
     out,
-    fill: Callable[[Path], None],
     *,
     owned: Callable[[Path], Iterable[str]] = lambda folder: (),
     inputs: Iterable = (),
     overwrite: bool = True,
     action: str = "export to",
-) -> None:
-    """Create or replace the folder ``out`` as a whole with what ``fill(tmp)`` writes into an
-    empty temporary folder.
-
-    An existing non-empty ``out`` is replaced only with ``overwrite`` and only if every entry in
-    it is named by ``owned(out)`` (the files an earlier run wrote, from its manifest); a folder
-    holding one of the ``inputs``, the current folder and any folder holding another file are
-    refused before ``fill`` runs. Every failure raises :class:`OutputError` ("cannot
-    {action} {out}: why"), after which ``out`` is as it was and no temporary is left.
-    """
+) -> list[str]:
+    """Refuse, before any work, an ``out`` that :func:`replace_folder` would refuse; returns the
+    names in it (empty if it does not exist). Also removes stale temporaries of ``out``."""
     shown = os.fspath(out)
     out = Path(os.path.abspath(shown))
 
@@ -294,8 +289,7 @@ def replace_folder(
             )
     if out.exists() and not out.is_dir():
         fail(errno.EEXIST, "it exists and is not a folder")
-    parent = out.parent
-    clean_stale(parent, out.name)
+    clean_stale(out.parent, out.name)
     existing = sorted(e.name for e in os.scandir(out)) if out.is_dir() else []
     if existing and not overwrite:
         fail(
@@ -312,6 +306,36 @@ def replace_folder(
                 f"it holds {', '.join(unknown[:3])}{more}, not written by Quilt "
                 "Studio, which are never replaced or deleted; choose a new or empty folder",
             )
+    return existing
+
+
+def replace_folder(
+    out,
+    fill: Callable[[Path], None],
+    *,
+    owned: Callable[[Path], Iterable[str]] = lambda folder: (),
+    inputs: Iterable = (),
+    overwrite: bool = True,
+    action: str = "export to",
+) -> None:
+    """Create or replace the folder ``out`` as a whole with what ``fill(tmp)`` writes into an
+    empty temporary folder.
+
+    An existing non-empty ``out`` is replaced only with ``overwrite`` and only if every entry in
+    it is named by ``owned(out)`` (the files an earlier run wrote, from its manifest); a folder
+    holding one of the ``inputs``, the current folder and any folder holding another file are
+    refused before ``fill`` runs (:func:`check_folder`). Every failure raises
+    :class:`OutputError` ("cannot {action} {out}: why"), after which ``out`` is as it was and
+    no temporary is left.
+    """
+    existing = check_folder(out, owned=owned, inputs=inputs, overwrite=overwrite, action=action)
+    shown = os.fspath(out)
+    out = Path(os.path.abspath(shown))
+    parent = out.parent
+
+    def fail(code: int, why: str):
+        raise OutputError(code, f"cannot {action} {shown}: {why}")
+
     try:
         parent.mkdir(parents=True, exist_ok=True)
         tmp = Path(tempfile.mkdtemp(dir=parent, prefix=f".{out.name}.tmp-{os.getpid()}-"))

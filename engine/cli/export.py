@@ -110,13 +110,14 @@ def add_project_option(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def save_project_option(args, **project_kwargs) -> None:
+def save_project_option(args, *, into=None, **project_kwargs) -> None:
     """If ``--project`` was given, build the project with
-    :func:`engine.project.project_from_tileset` (same keyword arguments) and save it."""
+    :func:`engine.project.project_from_tileset` (same keyword arguments) and save it there
+    (or ``into`` a temporary path that becomes ``--project`` later)."""
     path = getattr(args, "project", None)
     if not path:
         return
     from engine.project import project_from_tileset, save_project
 
-    save_project(path, project_from_tileset(**project_kwargs))
+    save_project(into or path, project_from_tileset(**project_kwargs))
     print(f"quilt-studio: wrote project {path}", file=sys.stderr)

@@ -1,6 +1,8 @@
 """``quilt-studio tileset SOURCE --out DIR``: template, seamless tile, candidates, preview.
 
-Writes into DIR (created if needed):
+Writes the folder DIR as a whole (built as a hidden sibling, then swapped in: a failure or a
+kill leaves the previous set or none, never a mix; a re-run replaces only a folder holding
+nothing but an earlier set's files, as its manifest lists them):
 
 - ``template.png``: the seamless template tile;
 - ``tile_000.png`` ...: every candidate (``tile_000_<map>.png`` for material maps);
@@ -23,12 +25,13 @@ import argparse
 import csv
 import io
 import json
+import os
 import re
 import sys
 import time
 from pathlib import Path
 
-from engine._fs import write_bytes_atomically
+from engine._fs import replace_folder, write_bytes_atomically
 from engine.cli._args import (
     add_exclusion,
     add_seam_options,
@@ -43,6 +46,7 @@ from engine.settings import TilesetSettings
 FORMAT = "quilt-studio-tileset"
 VERSION = 2  # 2: "settings" (TilesetSettings.to_dict()) replaces "parameters"
 MAIN_MAP = "albedo"  # the source's map name in a project file
+WRITE_ACTION = "write the tile set to"
 
 
 # ---------------------------------------------------------------- argument types
@@ -340,33 +344,76 @@ def run(args) -> int:
         bad = [k for k in args.pick if k >= settings.candidates]
         raise ValueError(f"--pick {bad} out of range: --candidates is {settings.candidates}")
     rect = _parse_rect(args.rect) if args.rect else None
-    out = Path(args.out)
-    created = not out.exists()
-    _check_out(out)
+    _check_out(args)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        try:
-            code = work(args, settings, rect)
-        finally:
-            if created and out.is_dir() and not any(out.iterdir()):
-                out.rmdir()  # nothing written: leave no empty folder behind
+        code = work(args, settings, rect)
     for text in dict.fromkeys(str(w.message) for w in caught):  # each once, in order
         print(f"quilt-studio tileset: warning: {text}", file=sys.stderr)
     return code
 
 
-def _check_out(out: Path) -> None:
-    """Create the --out folder and make sure files can be written there, before any work."""
-    import tempfile
+def _inputs(args) -> list:
+    return [args.source, *(p for _, p in args.map), args.exclude_mask]
 
-    from engine._fs import write_problem
 
+def _project_inside(args) -> str | None:
+    """The file name of ``--project`` if it goes into the ``--out`` folder, else None."""
+    project = getattr(args, "project", None)
+    if not project:
+        return None
+    out = Path(os.path.abspath(args.out))
+    p = Path(os.path.abspath(project))
+    if p.parent == out:
+        return p.name
+    if out in p.parents:
+        raise ValueError(
+            f"--project {project}: a project inside --out goes directly in that folder, not in "
+            "a subfolder of it"
+        )
+    return None
+
+
+def _check_out(args) -> None:
+    """Refuse, before any work, an --out folder the set cannot replace as a whole (holding
+    other files or an input, the current folder) or cannot be written next to."""
+    from engine._fs import OutputError, check_folder, check_writable
+
+    out = Path(args.out)
+    _project_inside(args)
     try:
-        out.mkdir(parents=True, exist_ok=True)
-        with tempfile.TemporaryFile(dir=out):
-            pass
-    except OSError as exc:
-        raise ValueError(f"--out {out}: cannot write there ({write_problem(out, exc)})") from None
+        check_folder(out, owned=tileset_files, inputs=_inputs(args), action=WRITE_ACTION)
+        check_writable(Path(os.path.abspath(out)).parent, name=f"--out {out}")
+    except OutputError as exc:
+        raise ValueError(str(exc)) from None
+
+
+def tileset_files(folder: Path) -> set[str]:
+    """The files the tile-set manifest in ``folder`` says an earlier run wrote there."""
+    path = Path(folder) / "manifest.json"
+    try:
+        if path.stat().st_size > 64 * 2**20:
+            return set()
+        doc = json.loads(path.read_text("utf-8"))
+    except (OSError, ValueError, RecursionError):
+        return set()
+    if not isinstance(doc, dict) or doc.get("format") != FORMAT:
+        return set()
+    names = ["manifest.json", *_names(doc.get("files"))]
+    names += _names(doc.get("layout"))
+    for key in ("template", "preview"):
+        names += _names(
+            (doc.get(key) or {}).get("maps") if isinstance(doc.get(key), dict) else None
+        )
+    for tile in doc.get("tiles") or []:
+        names += _names(tile.get("maps") if isinstance(tile, dict) else None)
+    return {n for n in names if re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9._-]*", n)}
+
+
+def _names(v) -> list[str]:
+    if isinstance(v, dict):
+        v = list(v.values())
+    return [n for n in v if isinstance(n, str)] if isinstance(v, list) else []
 
 
 def _events(say, n: int):
@@ -446,28 +493,39 @@ def _run(args, settings: TilesetSettings, rect) -> int:
         f"criterion h {st.criterion['horizontal']:.2f} v {st.criterion['vertical']:.2f}"
     )
     out = Path(args.out)
-    manifest = write_files(out, result, depth)
-    manifest.update(
-        settings=settings.to_dict(),
-        source={
-            "path": str(args.source),
-            "width": W,
-            "height": H,
-            "channels": int(S.shape[2]),
-            "bit_depth": depth,
-            "maps": {k: p for k, p in args.map},
-            "exclude_mask": args.exclude_mask or None,
-        },
-        workers=args.workers,
-        weights=weights,
-    )
-    _write_text(out / "manifest.json", json.dumps(manifest, indent=1) + "\n")
-    say(f"wrote template, {len(result.candidates)} tiles, manifest, layout and preview to {out}")
-    if getattr(args, "project", None):
-        save_project_option(
-            args,
-            **project_arguments(result, S, maps, depth, args, weights, excluded),
+    inside = _project_inside(args)
+
+    def fill(tmp: Path) -> None:
+        manifest = write_files(tmp, result, depth)
+        manifest.update(
+            settings=settings.to_dict(),
+            source={
+                "path": str(args.source),
+                "width": W,
+                "height": H,
+                "channels": int(S.shape[2]),
+                "bit_depth": depth,
+                "maps": {k: p for k, p in args.map},
+                "exclude_mask": args.exclude_mask or None,
+            },
+            workers=args.workers,
+            weights=weights,
         )
+        extra = ["manifest.json"] + ([inside] if inside else [])
+        manifest["files"] = sorted([*os.listdir(tmp), *extra])
+        _write_text(tmp / "manifest.json", json.dumps(manifest, indent=1) + "\n")
+        if inside:
+            save_project_option(args, into=tmp / inside, **project)
+
+    project = (
+        project_arguments(result, S, maps, depth, args, weights, excluded)
+        if getattr(args, "project", None)
+        else {}
+    )
+    replace_folder(out, fill, owned=tileset_files, inputs=_inputs(args), action=WRITE_ACTION)
+    say(f"wrote template, {len(result.candidates)} tiles, manifest, layout and preview to {out}")
+    if project and not inside:
+        save_project_option(args, **project)
     return 0
 
 
