@@ -49,9 +49,10 @@ class OutputError(OSError):
     """An output could not be written; the message names it and says why. ``errno`` holds the
     underlying error number (e.g. ``ENOSPC``) when there is one."""
 
-    def __init__(self, code: int | None, message: str):
+    def __init__(self, code: int | None, message: str, reason: str | None = None):
         super().__init__(message)
         self.errno = code
+        self.reason = reason or message
 
     def __str__(self) -> str:
         return self.args[0]
@@ -152,17 +153,34 @@ def write_problem(folder: Path, exc: OSError) -> str:
 
 
 def check_writable(folder, *, name: str | None = None) -> None:
-    """Make sure a file can be created in ``folder`` (made if missing), before any long work.
-    Raises :class:`OutputError` "{name}: cannot write there (why)" (``name`` defaults to the
-    folder); leaves nothing behind but the folder."""
-    p = Path(os.fspath(folder)) if os.fspath(folder) else Path(".")
+    """Make sure a file can be created in ``folder`` (or, if it is missing, that it can be made
+    in its nearest existing ancestor), before any long work and without leaving anything
+    behind. Raises :class:`OutputError` "{name}: cannot write there (why)"; ``name`` defaults
+    to the folder."""
+    p = Path(os.fspath(folder) or ".")
+    shown = name or str(p)
+    q = p
+    while not q.exists() and q != q.parent:
+        q = q.parent
     try:
-        p.mkdir(parents=True, exist_ok=True)
-        with tempfile.TemporaryFile(dir=p):
-            pass
+        if not q.is_dir():
+            raise NotADirectoryError(errno.ENOTDIR, "not a folder")
+        if q == p:
+            with tempfile.TemporaryFile(dir=p):
+                pass
+        elif not os.access(q, os.W_OK | os.X_OK):
+            code = errno.EROFS if _read_only(q) else errno.EACCES
+            raise OSError(code, os.strerror(code))
     except OSError as exc:
         why = write_problem(p, exc)
-        raise OutputError(exc.errno, f"{name or p}: cannot write there ({why})") from None
+        raise OutputError(exc.errno, f"{shown}: cannot write there ({why})", why) from None
+
+
+def _read_only(path: Path) -> bool:
+    try:
+        return bool(os.statvfs(path).f_flag & os.ST_RDONLY)
+    except OSError:
+        return False
 
 
 # ---------------------------------------------------------------- stale temporaries

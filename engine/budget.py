@@ -122,3 +122,57 @@ def check_memory(needed: int, *, what: str, way_out: str, limit: int | None = No
             f"{what} needs about {format_bytes(needed)} of memory, more than the "
             f"{format_bytes(limit)} available here; {way_out}"
         )
+
+
+# ---------------------------------------------------------------- estimates
+# Peak bytes of the jobs whose engine does not estimate itself (quilting and transfer do:
+# engine.quilting.estimate). Calibrated on peak RSS (benchmarks/memory.py) and rounded up.
+
+FLOAT = 4  # bytes per float32 sample
+
+
+def image_bytes(h: int, w: int, channels: int, itemsize: int = FLOAT) -> int:
+    return int(h) * int(w) * int(channels) * itemsize
+
+
+def tileset_bytes(
+    source_shape, tile_hw, *, candidates: int, preview: tuple[int, int], map_channels=()
+) -> int:
+    """The ``tileset`` workflow: the template search over the source (about 20 float copies
+    of it), every candidate per map, and the preview (float, quantized and encoded)."""
+    h, w, c = source_shape
+    th, tw = tile_hw
+    chans = c + sum(map_channels)
+    search = 20 * image_bytes(h, w, chans)
+    tiles = (candidates + 2) * image_bytes(th, tw, chans) * 2
+    rows, cols = preview
+    shown = image_bytes(rows * th, cols * tw, chans) * 2
+    return search + tiles + shown
+
+
+def export_bytes(
+    count: int, tile_hw, map_channels, *, atlas_hw, preview_hw=None, bit_depth: int = 16
+) -> int:
+    """An export bundle built in memory: the tiles quantized, one atlas per map and the
+    preview, each also as encoded PNG bytes (at most its raw size)."""
+    item = 2 if bit_depth == 16 else 1
+    th, tw = tile_hw
+    total = 0
+    for c in map_channels:
+        total += 2 * count * image_bytes(th, tw, c, item)
+        total += 2 * image_bytes(*atlas_hw, c, item)
+        if preview_hw is not None:
+            total += image_bytes(*preview_hw, c, FLOAT + 2 * item)
+    return total
+
+
+def seam_bytes(h: int, w: int, channels: int) -> int:
+    """One seam between two overlaps: both images, the error map and the solvers' float64
+    cost tables, plus the optional composite and mask."""
+    return 6 * image_bytes(h, w, channels) + 6 * image_bytes(h, w, 1, 8)
+
+
+def heal_bytes(h: int, w: int, channels: int) -> int:
+    """Healing an image: the image and its maps, and the masked search's FFT buffers (about
+    24 float planes of the image's size)."""
+    return 4 * image_bytes(h, w, channels) + 24 * image_bytes(h, w, 1, 8)

@@ -1,34 +1,51 @@
 """Image files in and out: float32 (H, W, C) in [0, 1], bit depth remembered.
 
-Reading: PNG, JPEG, TIFF, BMP, WebP (anything Pillow opens), 8 or 16 bits per channel; gray,
-gray + alpha, RGB, RGBA and palette images stay distinct (C = 1, 2, 3, 4; palette images become
-RGB or RGBA with ``mode == "P"``); the EXIF orientation is applied. 16-bit PNG and TIFF are
-decoded exactly (Pillow would reduce 16-bit colour to 8 bits): PNG by libpng
-(:mod:`engine.png`), TIFF by tifffile.
+Reading: PNG, JPEG, TIFF, BMP, WebP, GIF, 8 or 16 bits per channel; gray, gray + alpha, RGB,
+RGBA and palette images stay distinct (C = 1, 2, 3, 4; palette images become RGB or RGBA with
+``mode == "P"``); CMYK becomes RGB; the EXIF orientation is applied. 16-bit PNG and 16-bit or
+floating-point TIFF are decoded exactly (Pillow would reduce 16-bit colour to 8 bits): PNG by
+libpng (:mod:`engine.png`), TIFF by tifffile. Animated and multi-page files give their first
+frame, with an :class:`ImageWarning`.
 
 Writing: PNG and TIFF at 8 or 16 bits, JPEG / BMP / WebP at 8 bits; atomic (a temporary file
 renamed over the target).
 
 Every failure raises :class:`ImageError`, whose message names the file and the reason: no such
-file, a folder, empty, not an image, truncated or corrupt, zero-sized, over the pixel limit
-(decompression bomb), unsupported mode.
+file, a folder / FIFO / device / socket / link loop, empty, too large, not an image, truncated
+or corrupt, zero-sized, over the pixel limit (decompression bomb), over the memory available,
+unsupported mode.
 """
 
 from __future__ import annotations
 
 import io
+import logging
 import numbers
 import os
 import struct
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 from PIL import Image, ImageOps, UnidentifiedImageError
 
-from engine._fs import atomic_path, write_problem
+from engine._fs import (
+    InputError,
+    OutputError,
+    atomic_path,
+    check_writable,
+    open_input,
+    write_problem,
+)
+
+# tifffile reports odd tags on its logger; without a handler Python prints them raw on stderr.
+logging.getLogger("tifffile").addHandler(logging.NullHandler())
 
 DEFAULT_MAX_PIXELS = 100_000_000  # 10k x 10k; larger files are refused as decompression bombs
+MAX_FILE_BYTES = 2**30
+"""Largest image file read (an uncompressed 16-bit RGBA TIFF at the pixel limit is 800 MB):
+larger files are refused from their size alone, before a byte is read."""
 READ_SUFFIXES = (".png", ".jpg", ".jpeg", ".tif", ".tiff", ".bmp", ".webp")
 WRITE_SUFFIXES = (".png", ".tif", ".tiff", ".jpg", ".jpeg", ".bmp", ".webp")
 MODES = ("1", "L", "LA", "P", "PA", "RGB", "RGBA", "CMYK", "YCbCr", "LAB", "HSV")
@@ -49,7 +66,9 @@ _FLIPS = {  # EXIF orientation -> numpy transform (what ImageOps.exif_transpose 
 __all__ = [
     "DEFAULT_MAX_PIXELS",
     "ImageError",
+    "ImageWarning",
     "LoadedImage",
+    "MAX_FILE_BYTES",
     "READ_SUFFIXES",
     "WRITE_SUFFIXES",
     "check_output",
@@ -61,6 +80,10 @@ __all__ = [
 
 class ImageError(ValueError):
     """An image file could not be read or written; the message says which file and why."""
+
+
+class ImageWarning(UserWarning):
+    """An image was read with a caveat the user should hear (e.g. only its first frame)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -108,6 +131,12 @@ def to_rgb(pixels: np.ndarray) -> np.ndarray:
 def load_image(path, *, max_pixels: int = DEFAULT_MAX_PIXELS) -> LoadedImage:
     """Read an image file into float32 (H, W, C) in [0, 1] (see the module docstring).
 
+    Before a byte of pixel data is read: the path must be a regular file (not a folder, FIFO,
+    device or socket) of at most :data:`MAX_FILE_BYTES`, start with the signature of a format
+    we read, declare at most ``max_pixels`` pixels in its header and fit the memory available
+    (:mod:`engine.budget`). An animated or multi-page file gives its first frame with an
+    :class:`ImageWarning` saying so; the libraries' own warnings are not passed on.
+
     Parameters
     ----------
     path : str or PathLike
@@ -126,17 +155,6 @@ def load_image(path, *, max_pixels: int = DEFAULT_MAX_PIXELS) -> LoadedImage:
     if max_pixels < 1:
         raise ValueError(f"max_pixels must be >= 1, got {max_pixels}")
     name = os.fspath(path)
-    p = Path(name)
-    if not p.exists():
-        raise ImageError(f"{name}: no such file")
-    if p.is_dir():
-        raise ImageError(f"{name}: is a folder, not an image")
-    try:
-        data = p.read_bytes()
-    except OSError as exc:
-        raise ImageError(f"{name}: cannot be read ({exc.strerror or exc})") from None
-    if not data:
-        raise ImageError(f"{name}: the file is empty")
 
     def fail(reason: str) -> ImageError:
         return ImageError(f"{name}: {reason}")
@@ -150,14 +168,92 @@ def load_image(path, *, max_pixels: int = DEFAULT_MAX_PIXELS) -> LoadedImage:
                 "(possible decompression bomb)"
             )
 
-    if data.startswith(_PNG) and len(data) >= 33 and data[12:16] == b"IHDR":
-        w, h = struct.unpack(">II", data[16:24])
+    try:
+        f = open_input(name, max_bytes=MAX_FILE_BYTES, what="an image")
+    except InputError as exc:
+        raise fail(str(exc)) from None
+    with f, warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # Pillow's / tifffile's: our own messages say it
+        try:
+            head = f.read(64)
+            if not head.startswith(_MAGIC):
+                raise fail(
+                    "not an image file (or an unsupported format; PNG, JPEG, TIFF, BMP, WebP "
+                    "and GIF are read)"
+                )
+            w, h, frames, kind = _probe(f, head, fail, check_size)
+            f.seek(0)
+            data = f.read()
+        except OSError as exc:
+            raise fail(f"cannot be read ({exc.strerror or exc})") from None
+        loaded = _decode(data, name, fail, check_size, max_pixels)
+    if frames > 1:
+        warnings.warn(
+            ImageWarning(f"{name}: {kind} with {frames} frames; using the first frame"),
+            stacklevel=2,
+        )
+    return loaded
+
+
+def _probe(f, head: bytes, fail, check_size) -> tuple[int, int, int, str]:
+    """(width, height, frames, kind) from the file's headers, the size and the memory budget
+    checked; reads only headers (PNG: the first 33 bytes)."""
+    from engine.budget import MemoryBudgetError, check_memory
+
+    frames, kind = 1, "image"
+    if head.startswith(_PNG) and len(head) >= 33 and head[12:16] == b"IHDR":
+        w, h = struct.unpack(">II", head[16:24])
         check_size(w, h)  # before Pillow or zlib inflate anything
+    f.seek(0)
+    try:
+        with Image.open(f) as im:
+            w, h = im.size
+            check_size(w, h)
+            frames = int(getattr(im, "n_frames", 1) or 1)
+            kind = {"GIF": "animated GIF", "PNG": "animated PNG", "TIFF": "multi-page TIFF"}.get(
+                im.format or "", "image"
+            )
+    except ImageError:
+        raise
+    except Image.DecompressionBombError as exc:  # over Pillow's own (larger) hard limit
+        raise fail(f"over the pixel limit (possible decompression bomb: {exc})") from None
+    except Exception:  # noqa: BLE001 - Pillow cannot read it: _decode says why
+        if head.startswith(_TIFF):
+            w, h, frames = _tiff_probe(f, fail, check_size)
+            kind = "multi-page TIFF"
+        else:
+            return 0, 0, 1, "image"
+    try:
+        check_memory(
+            w * h * 4 * 14 + f.seek(0, os.SEEK_END),  # float32 RGBA + decoded + converted copies
+            what=f"reading this {w}x{h} image",
+            way_out="downscale it, or free memory",
+        )
+    except MemoryBudgetError as exc:
+        raise fail(str(exc)) from None
+    return w, h, frames, kind
+
+
+def _tiff_probe(f, fail, check_size) -> tuple[int, int, int]:
+    import tifffile
+
+    f.seek(0)
+    try:
+        with tifffile.TiffFile(f, name="image.tif") as tif:
+            page = tif.pages[0]
+            check_size(page.imagewidth, page.imagelength)
+            return page.imagewidth, page.imagelength, len(tif.pages)
+    except ImageError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - tifffile raises many types on damage
+        raise fail(f"the file is truncated or corrupt ({exc})") from None
+
+
+def _decode(data: bytes, name: str, fail, check_size, max_pixels: int) -> LoadedImage:
     if data.startswith(_TIFF):
-        tiff = _tiff_16bit(data, fail, check_size)
+        tiff = _tiff_exact(data, fail, check_size)
         if tiff is not None:
-            pixels, mode = _from_uint16(tiff[0])
-            return LoadedImage(_oriented(pixels, tiff[1]), 16, name, mode)
+            return LoadedImage(_oriented(tiff[0], tiff[1]), 16, name, tiff[2])
     try:
         with Image.open(io.BytesIO(data)) as im:
             check_size(*im.size)
@@ -174,10 +270,10 @@ def load_image(path, *, max_pixels: int = DEFAULT_MAX_PIXELS) -> LoadedImage:
     except UnidentifiedImageError:
         if data.startswith(_TIFF):
             raise fail(_tiff_problem(data)) from None
-        if data.startswith(_MAGIC):
-            raise fail("the file is truncated or corrupt (its header cannot be read)") from None
-        raise fail("not an image file (or an unsupported format)") from None
-    except (OSError, SyntaxError, ValueError, EOFError, struct.error, MemoryError) as exc:
+        raise fail("the file is truncated or corrupt (its header cannot be read)") from None
+    except MemoryError:
+        raise fail("there is not enough memory to decode it") from None
+    except (OSError, SyntaxError, ValueError, EOFError, struct.error) as exc:
         raise fail(f"the file is truncated or corrupt ({exc})") from None
     return LoadedImage(pixels, depth, name, mode)
 
@@ -229,26 +325,53 @@ def _from_uint16(q: np.ndarray) -> tuple[np.ndarray, str]:
     return to_float(q), ("L", "LA", "RGB", "RGBA")[q.shape[2] - 1]
 
 
-def _tiff_16bit(data: bytes, fail, check_size):
-    """(uint16 (H, W, C), EXIF orientation) of a 16-bit gray / RGB(A) TIFF, else None."""
+def _tiff_exact(data: bytes, fail, check_size):
+    """(float32 (H, W, C), EXIF orientation, mode) of a 16-bit or floating-point TIFF (gray,
+    RGB(A), white-is-zero gray, CMYK), read by tifffile at full precision; None for the 8-bit
+    ones Pillow reads."""
     import tifffile
 
     try:
         with tifffile.TiffFile(io.BytesIO(data)) as tif:
             page = tif.pages[0]
-            if page.bitspersample != 16 or page.dtype != np.uint16:
+            if page.dtype not in (np.uint16, np.float32, np.float64, np.float16):
                 return None
             check_size(page.imagewidth, page.imagelength)
             tag = page.tags.get(274)
             orientation = int(tag.value) if tag is not None else 1
+            photometric = page.photometric.name
             q = page.asarray()
+            if page.planarconfig == 2 and q.ndim == 3:  # separate planes -> samples last
+                q = np.moveaxis(q, 0, 2)
     except ImageError:
         raise
-    except Exception as exc:  # tifffile raises many types on damaged files
+    except MemoryError:
+        raise fail("there is not enough memory to decode it") from None
+    except Exception as exc:  # noqa: BLE001 - tifffile raises many types on damaged files
         raise fail(f"the file is truncated or corrupt ({exc})") from None
-    if q.ndim not in (2, 3) or (q.ndim == 3 and q.shape[2] > 4):
-        raise fail(f"unsupported image mode (uint16 samples, shape {q.shape})")
-    return (q[:, :, None] if q.ndim == 2 else q), orientation
+    q = q[:, :, None] if q.ndim == 2 else q
+    kind = f"{q.dtype} samples, photometric {photometric}"
+    if q.ndim != 3 or q.shape[2] > 5:
+        raise fail(f"unsupported image mode ({kind}, shape {q.shape})")
+    if q.dtype == np.uint16:
+        a = q.astype(np.float32) / 65535.0
+    else:
+        a = q.astype(np.float32)
+        if not np.all(np.isfinite(a)) or a.min(initial=0) < 0 or a.max(initial=0) > 1:
+            raise fail(
+                "unsupported image mode (floating-point values outside [0, 1], e.g. HDR: "
+                "tone-map it to a 16-bit TIFF or PNG first)"
+            )
+    c = a.shape[2]
+    if photometric == "SEPARATED" and c in (4, 5):  # CMYK (+ alpha)
+        k = 1.0 - a[:, :, 3:4]
+        rgb = (1.0 - a[:, :, :3]) * k
+        return np.concatenate([rgb, a[:, :, 4:]], axis=2), orientation, "CMYK"
+    if photometric == "MINISWHITE" and c in (1, 2):
+        a[:, :, 0] = 1.0 - a[:, :, 0]
+    elif photometric not in ("MINISBLACK", "RGB") or c > 4 or (photometric == "RGB" and c < 3):
+        raise fail(f"unsupported image mode ({c} samples of {kind})")
+    return a, orientation, ("L", "LA", "RGB", "RGBA")[c - 1]
 
 
 def _to_array(im: Image.Image, fail) -> tuple[np.ndarray, int, str]:
@@ -286,7 +409,9 @@ def _to_array(im: Image.Image, fail) -> tuple[np.ndarray, int, str]:
 def check_output(path, *, bit_depth: int = 8, channels: int = 3) -> Path:
     """Refuse, before any work, an output that :func:`save_image` could not write in that
     format: an unknown suffix, 16 bits in anything but PNG / TIFF, alpha (``channels`` 2 or
-    4) in JPEG / BMP. Raises :class:`ImageError` naming the file; writes nothing."""
+    4) in JPEG / BMP, a folder in the way, a folder that cannot be written (read-only,
+    permissions, a file on its path). Raises :class:`ImageError` naming the file; writes
+    nothing."""
     p = Path(os.fspath(path))
     if isinstance(bit_depth, bool) or bit_depth not in (8, 16):
         raise ValueError(f"bit_depth must be 8 or 16, got {bit_depth!r}")
@@ -300,6 +425,12 @@ def check_output(path, *, bit_depth: int = 8, channels: int = 3) -> Path:
         raise ImageError(f"{p}: 16-bit output needs .png or .tif, not {suffix}")
     if channels in (2, 4) and suffix in (".jpg", ".jpeg", ".bmp"):
         raise ImageError(f"{p}: {suffix} cannot store an alpha channel; use .png or .tif")
+    if p.is_dir():
+        raise ImageError(f"{p}: is a folder; give a file name for the output")
+    try:
+        check_writable(p.parent)
+    except OutputError as exc:
+        raise ImageError(f"{p}: cannot write ({exc.reason})") from None
     return p
 
 

@@ -10,10 +10,15 @@ Why imagecodecs rather than our own codec or Pillow: ``benchmarks/png.py`` (READ
 
 from __future__ import annotations
 
+import logging
 import struct
 from dataclasses import dataclass
 
 import numpy as np
+
+# libpng's warnings (e.g. a damaged text chunk) go to the "imagecodecs" logger; without a handler
+# Python would print them raw on stderr. The image still decodes; damage that matters raises.
+logging.getLogger("imagecodecs").addHandler(logging.NullHandler())
 
 SIGNATURE = b"\x89PNG\r\n\x1a\n"
 HEADER_BYTES = 33  # signature, IHDR length and tag, 13 bytes of IHDR, its CRC

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import argparse
 import importlib
-import sys
 
 SUBCOMMANDS = ("seam", "tileset", "synth", "transfer", "export", "heal")
 
@@ -45,13 +44,6 @@ def main(argv: list[str] | None = None) -> int:
     if args.command is None:
         parser.print_help()
         return 2
-    from engine.io import ImageError
+    from engine.cli.outcome import run_command
 
-    try:
-        return int(args.func(args) or 0)
-    except (ImageError, ValueError, TypeError, OSError) as exc:  # engine validation errors
-        print(f"quilt-studio {args.command}: error: {exc}", file=sys.stderr)
-        return 1
-    except KeyboardInterrupt:
-        print(f"quilt-studio {args.command}: interrupted", file=sys.stderr)
-        return 130
+    return run_command(args)

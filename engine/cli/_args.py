@@ -25,6 +25,18 @@ def int_at_least(minimum: int):
     return parse
 
 
+MAX_THREADS = 256
+"""Most worker threads a command takes (more only exhausts the system's threads)."""
+
+
+def thread_count(text: str) -> int:
+    """An argument type: a number of threads in 1..MAX_THREADS."""
+    v = int_at_least(1)(text)
+    if v > MAX_THREADS:
+        raise argparse.ArgumentTypeError(f"must be at most {MAX_THREADS}, got {v}")
+    return v
+
+
 def non_negative_float(text: str) -> float:
     """An argument type: a number >= 0."""
     try:

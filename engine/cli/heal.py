@@ -18,6 +18,7 @@ from engine.cli._args import (
     excluded_pixels,
     int_at_least,
     non_negative_float,
+    thread_count,
 )
 
 
@@ -70,7 +71,7 @@ def add_parser(subparsers):
     )
     add_exclusion(p, "source")
     p.add_argument("--seed", type=int_at_least(0), default=0, help="random seed (default 0)")
-    p.add_argument("--threads", type=int_at_least(1), default=None, help="FFT workers")
+    p.add_argument("--threads", type=thread_count, default=None, help="FFT workers")
     add_bit_depth(p, "source")
     p.set_defaults(func=run)
     return p
@@ -78,6 +79,7 @@ def add_parser(subparsers):
 
 def run(args) -> int:
     from engine.bitdepth import quantize
+    from engine.budget import check_memory, heal_bytes
     from engine.cli.synth import ProgressPrinter, check_output, drive
     from engine.errormap import colour_channels
     from engine.heal import iter_heal
@@ -99,6 +101,12 @@ def run(args) -> int:
         extra = load_image(src)
         check_output(out, args.bit_depth or extra.bit_depth, extra.pixels.shape[2])
         maps[str(i)] = extra
+    h, w, c = loaded.pixels.shape
+    check_memory(
+        heal_bytes(h, w, c + sum(e.pixels.shape[2] for e in maps.values())),
+        what=f"healing this {w}x{h} image",
+        way_out="heal a crop of it, or free memory",
+    )
     seam = SeamSpec(
         args.seam,
         dict(args.seam_option),

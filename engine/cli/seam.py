@@ -82,6 +82,7 @@ def run(args) -> int:
     import numpy as np
 
     from engine.blend import composite
+    from engine.budget import check_memory, seam_bytes
     from engine.errormap import error_map
     from engine.io import check_output, load_image, save_image, to_rgb
 
@@ -101,6 +102,11 @@ def run(args) -> int:
             f"R1 and R2 must have the same size: {args.r1} is {w}x{h}, {args.r2} is {w2}x{h2}"
         )
     r1, r2 = a.pixels, b.pixels
+    check_memory(
+        seam_bytes(h, w, max(r1.shape[2], r2.shape[2])),
+        what=f"a seam through this {w}x{h} overlap",
+        way_out="use smaller overlap images",
+    )
     if r1.shape[2] != r2.shape[2]:
         r1, r2 = to_rgb(r1), to_rgb(r2)
     depth = max(a.bit_depth, b.bit_depth)

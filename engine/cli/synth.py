@@ -24,7 +24,13 @@ from engine.cli._args import (
     excluded_pixels,
     int_at_least,
     non_negative_float,
+    thread_count,
 )
+
+MAX_OUTPUT_PIXELS = 2**28
+"""Largest synthesized output (16384 x 16384): 3 GiB as float32 RGB before the search's own
+memory (which the engine estimates and checks against what is available)."""
+MAX_OUTPUT_SIDE = 65535
 
 
 def parse_wxh(text: str) -> tuple[int, int]:
@@ -35,6 +41,11 @@ def parse_wxh(text: str) -> tuple[int, int]:
     w, h = int(m.group(1)), int(m.group(2))
     if w < 1 or h < 1:
         raise argparse.ArgumentTypeError(f"width and height must be >= 1, got {text!r}")
+    if w * h > MAX_OUTPUT_PIXELS or max(w, h) > MAX_OUTPUT_SIDE:
+        raise argparse.ArgumentTypeError(
+            f"{w}x{h} is over the output limit of {MAX_OUTPUT_PIXELS:,} pixels "
+            f"({MAX_OUTPUT_SIDE} px per side at most)"
+        )
     return h, w
 
 
@@ -79,7 +90,7 @@ def add_cut_arguments(p: argparse.ArgumentParser) -> None:
     add_exclusion(p, "sample")
     p.add_argument("--seed", type=int_at_least(0), default=0, help="random seed (default 0)")
     p.add_argument(
-        "--threads", type=int_at_least(1), default=None, help="worker threads (default: every core)"
+        "--threads", type=thread_count, default=None, help="worker threads (default: every core)"
     )
     add_bit_depth(p, "sample")
     p.add_argument("-o", "--output", required=True, metavar="OUT.png", help="output image")

@@ -38,6 +38,7 @@ from engine.cli._args import (
     excluded_pixels,
     int_at_least,
     non_negative_float,
+    thread_count,
 )
 from engine.cli.export import add_project_option, save_project_option
 from engine.seams.spec import BLEND_MODES, METHODS, METRICS
@@ -210,7 +211,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         default=None,
         help="allow equal neighbouring tiles in the preview's index matrix",
     )
-    p.add_argument("--workers", type=int_at_least(1), default=2, help="threads (default 2)")
+    p.add_argument("--workers", type=thread_count, default=2, help="threads (default 2)")
     p.add_argument(
         "--map",
         type=_named("file"),
@@ -416,6 +417,49 @@ def _names(v) -> list[str]:
     return [n for n in v if isinstance(n, str)] if isinstance(v, list) else []
 
 
+def _check_sizes(args, settings: TilesetSettings, S, rect, maps) -> TilesetSettings:
+    """The preview within :data:`engine.export.MAX_PREVIEW_PIXELS` (a default grid shrinks with
+    a warning, a given ``--preview`` is refused) and the whole run within the memory available,
+    before any work; the settings to run with."""
+    import warnings
+
+    from engine.budget import check_memory, tileset_bytes
+    from engine.export import MAX_PREVIEW_PIXELS
+
+    H, W = S.shape[:2]
+    th, tw = (rect[3], rect[2]) if rect else settings.tile_range((H, W))[1]
+    rows, cols = settings.preview
+    if rows * th * cols * tw > MAX_PREVIEW_PIXELS:
+        size = f"{cols * tw}x{rows * th} px, over the limit of {MAX_PREVIEW_PIXELS:,} pixels"
+        if args.preview is not None:
+            raise ValueError(
+                f"--preview {rows}x{cols}: a preview of tiles up to {tw}x{th} would be {size}; "
+                "choose a smaller grid"
+            )
+        r, c = rows, cols
+        while r * th * c * tw > MAX_PREVIEW_PIXELS and (r > 1 or c > 1):
+            r, c = max(1, r - 1), max(1, c - 1)
+        warnings.warn(
+            f"the {rows}x{cols} preview of tiles up to {tw}x{th} would be {size}; "
+            f"using {r}x{c} (--preview sets it)",
+            stacklevel=2,
+        )
+        settings = settings.replace(preview=(r, c))
+    check_memory(
+        tileset_bytes(
+            S.shape,
+            (th, tw),
+            candidates=settings.candidates,
+            preview=settings.preview,
+            map_channels=[m.shape[2] for m in maps.values()],
+        ),
+        what=f"a tile set from this {W}x{H} source",
+        way_out="use a smaller source, a smaller --tile-max, fewer --candidates or a smaller "
+        "--preview",
+    )
+    return settings
+
+
 def _events(say, n: int):
     """The progress line of each event worth one."""
     from engine.events import Progress
@@ -472,6 +516,7 @@ def _run(args, settings: TilesetSettings, rect) -> int:
     say = _Reporter()
     S, depth, maps, weights, excluded = load_inputs(args, settings, say)
     H, W = S.shape[:2]
+    settings = _check_sizes(args, settings, S, rect, maps)
     if rect is not None:
         say(f"template: fixed rectangle {rect}")
     result = drain(

@@ -21,6 +21,7 @@ import numpy as np
 
 from engine._validate import as_rng, choice
 from engine.bitdepth import quantize
+from engine.budget import check_memory, export_bytes
 from engine.export.atlas import AtlasLayout, atlas_layout, render_atlas
 from engine.export.engines import godot_tres, tiled_tmx, tiled_tsx
 from engine.export.folder import write_bundle
@@ -149,6 +150,7 @@ def export_bundle(
     if wang is not None:
         wang = check_wang(wang, t.count)
         per_tile["wangs"] = wang["tiles"]  # each tile entry gets its "wang"
+    _check_memory(t, lay, mat, preview, bit_depth)
     if godot_path_prefix is None:
         godot_path_prefix = f"res://{out.name}/" if out.name else "res://"
 
@@ -336,6 +338,30 @@ def _check_preview_size(mat: np.ndarray, t: _Tiles) -> None:
             f"over the limit of {MAX_PREVIEW_PIXELS:,} pixels: use a smaller layout or pass a "
             "preview image"
         )
+
+
+def _check_memory(t: _Tiles, lay: AtlasLayout, mat, preview, bit_depth: int) -> None:
+    """The bundle is built in memory: refuse one that does not fit before building it."""
+    if preview is not None:
+        first = next(iter(preview.values()), None)
+        preview_hw = np.shape(first)[:2] if first is not None else None
+    elif mat is not None:
+        preview_hw = (mat.shape[0] * t.tile_h, mat.shape[1] * t.tile_w)
+    else:
+        preview_hw = None
+    channels = [s[2] if len(s) == 3 else 1 for s in t.shapes.values()]
+    check_memory(
+        export_bytes(
+            t.count,
+            (t.tile_h, t.tile_w),
+            channels,
+            atlas_hw=(lay.height, lay.width),
+            preview_hw=preview_hw,
+            bit_depth=bit_depth,
+        ),
+        what=f"an export of {t.count} tiles of {t.tile_w}x{t.tile_h}",
+        way_out="export fewer tiles, at 8 bits, or with a smaller layout",
+    )
 
 
 def _check_weights(weights, n: int) -> list[float] | None:

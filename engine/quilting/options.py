@@ -145,6 +145,13 @@ def check_options(
             raise ValueError(f"adaptive_threshold must be > 0, got {adaptive_threshold}")
     if min_block is None:
         min_block = max(2 * overlap + 1, min(bh, bw) // 4)
+    else:
+        min_block = positive_int(min_block, "min_block")
+        if min_block > min(bh, bw):
+            raise ValueError(
+                f"min_block ({min_block}) is larger than the block ({bw}x{bh}); adaptive "
+                "splitting only makes blocks smaller"
+            )
     min_block = positive_int(min_block, "min_block")
     if min_block <= overlap:
         raise ValueError(f"min_block must be larger than the overlap ({overlap}), got {min_block}")

@@ -190,14 +190,14 @@ def test_over_the_pixel_limit(tmp_path):
         load_image(tmp_path / "big16.tif", max_pixels=1000)
 
 
-@pytest.mark.parametrize("kind", ["5 samples", "float rgb", "negative int"])
+@pytest.mark.parametrize("kind", ["5 samples", "float rgb hdr", "negative int"])
 def test_unsupported_mode(tmp_path, kind):
     path = tmp_path / "odd.tif"
     a = random_uint((4, 5, 5), 8)
     if kind == "5 samples":
         tifffile.imwrite(path, a, photometric="minisblack", planarconfig="contig")
-    elif kind == "float rgb":
-        tifffile.imwrite(path, a[..., :3].astype(np.float32) / 255, photometric="rgb")
+    elif kind == "float rgb hdr":  # float in [0, 1] is read (test_robust_inputs); HDR is not
+        tifffile.imwrite(path, a[..., :3].astype(np.float32) / 64, photometric="rgb")
     else:
         tifffile.imwrite(path, a[..., 0].astype(np.int32) - 100)
     with pytest.raises(ImageError, match=r"odd\.tif: unsupported image mode"):
