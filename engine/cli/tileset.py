@@ -532,15 +532,14 @@ def _run(args, settings: TilesetSettings, rect) -> int:
         ),
         _events(say, settings.candidates),
     )
+    out = args.out
     st = result.seamless
     say(
         f"seamless tile {result.rect[2]}x{result.rect[3]} (overlap {result.overlap}): seam "
         f"criterion h {st.criterion['horizontal']:.2f} v {st.criterion['vertical']:.2f}"
     )
-    out = Path(args.out)
-    inside = _project_inside(args)
 
-    def fill(tmp: Path) -> None:
+    def write(tmp: Path) -> dict:
         manifest = write_files(tmp, result, depth)
         manifest.update(
             settings=settings.to_dict(),
@@ -556,22 +555,37 @@ def _run(args, settings: TilesetSettings, rect) -> int:
             workers=args.workers,
             weights=weights,
         )
-        extra = ["manifest.json"] + ([inside] if inside else [])
-        manifest["files"] = sorted([*os.listdir(tmp), *extra])
-        _write_text(tmp / "manifest.json", json.dumps(manifest, indent=1) + "\n")
-        if inside:
-            save_project_option(args, into=tmp / inside, **project)
+        return manifest
 
     project = (
         project_arguments(result, S, maps, depth, args, weights, excluded)
         if getattr(args, "project", None)
         else {}
     )
-    replace_folder(out, fill, owned=tileset_files, inputs=_inputs(args), action=WRITE_ACTION)
+    write_set(args, write, project)
     say(f"wrote template, {len(result.candidates)} tiles, manifest, layout and preview to {out}")
+    return 0
+
+
+def write_set(args, write, project: dict) -> None:
+    """Write the --out folder as a whole: ``write(tmp)`` writes the images and layout into an
+    empty temporary folder and returns the manifest, which gets the list of every file and is
+    written last, with the project if ``--project`` goes into that folder (``project``: the
+    keyword arguments of :func:`engine.project.project_from_tileset`). The folder is then
+    swapped in (:func:`engine._fs.replace_folder`); a project elsewhere is saved after it."""
+    inside = _project_inside(args)
+
+    def fill(tmp: Path) -> None:
+        manifest = write(tmp)
+        extra = ["manifest.json"] + ([inside] if inside else [])
+        manifest["files"] = sorted([*os.listdir(tmp), *extra])
+        _write_text(tmp / "manifest.json", json.dumps(manifest, indent=1) + "\n")
+        if inside:
+            save_project_option(args, into=tmp / inside, **project)
+
+    replace_folder(args.out, fill, owned=tileset_files, inputs=_inputs(args), action=WRITE_ACTION)
     if project and not inside:
         save_project_option(args, **project)
-    return 0
 
 
 def write_files(out: Path, result, depth: int) -> dict:

@@ -15,7 +15,6 @@ import json
 from pathlib import Path
 
 from engine.cli._args import int_at_least, non_negative_float
-from engine.cli.export import save_project_option
 
 __all__ = ["add_wang_options", "check_wang_args", "run_wang", "wang_changes"]
 
@@ -127,7 +126,16 @@ def _events(say, count: int):
 
 def run_wang(args, settings, rect=None) -> int:
     """Make the Wang set, write its files and (``--project``) the project."""
-    from engine.cli.tileset import _csv, _Reporter, _write_text, load_inputs, write_images
+    from engine.cli.tileset import (
+        FORMAT,
+        VERSION,
+        _csv,
+        _Reporter,
+        _write_text,
+        load_inputs,
+        write_images,
+        write_set,
+    )
     from engine.events import drain
     from engine.tiles.wang_pipeline import iter_wang_tileset, resolve_wang
 
@@ -148,65 +156,68 @@ def run_wang(args, settings, rect=None) -> int:
         _events(say, count),
     )
     ws = result.wang
-    out = Path(args.out)
-    tiles = []
-    for t in ws.tiles:
-        files = write_images(out, f"tile_{t.index:03d}", {"main": t.tile, **t.maps}, depth)
-        tiles.append(
-            {
-                "index": t.index,
-                "file": files["main"],
-                "maps": files,
-                "wang": t.wang,
-                "variant": t.variant,
-                "seed": t.seed,
-                "patch_origin": None if t.patch_origin is None else list(t.patch_origin),
-                "junction": list(t.junction),
-                "scores": {k: float(v) for k, v in t.scores.items()},
-            }
-        )
-    preview = write_images(out, "preview", result.preview, depth)
     rows, cols = s.preview
-    _write_text(out / "layout.csv", _csv(result.layout))
-    layout_doc = {
-        "tile_w": ws.tile_size,
-        "tile_h": ws.tile_size,
-        "rows": rows,
-        "cols": cols,
-        "cells": result.layout.tolist(),
-        "cells_are": "tile indices (tile_NNN.png); every pair of touching edges has one colour",
-    }
-    _write_text(out / "layout.json", json.dumps(layout_doc, indent=1) + "\n")
-    from engine.cli.tileset import FORMAT, VERSION
 
-    manifest = {
-        "format": FORMAT,
-        "version": VERSION,
-        "kind": "wang",
-        "seed": s.seed,
-        "settings": settings.to_dict(),
-        "resolved": s.to_dict(),
-        "wang": wang_record(ws),
-        "tiles": tiles,
-        "layout": {"csv": "layout.csv", "json": "layout.json"},
-        "preview": {"file": preview["main"], "maps": preview},
-        "warnings": list(result.warnings),
-        "source": {
-            "path": str(args.source),
-            "width": int(S.shape[1]),
-            "height": int(S.shape[0]),
-            "channels": int(S.shape[2]),
-            "bit_depth": depth,
-            "maps": {k: p for k, p in args.map},
-            "exclude_mask": args.exclude_mask or None,
-        },
-        "workers": args.workers,
-        "weights": weights,
-    }
-    _write_text(out / "manifest.json", json.dumps(manifest, indent=1) + "\n")
-    say(f"wrote {len(ws.tiles)} Wang tiles, manifest, layout and preview to {out}")
-    if getattr(args, "project", None):
-        save_project_option(args, **project_arguments(result, S, maps, depth, args, weights))
+    def write(out: Path) -> dict:
+        tiles = []
+        for t in ws.tiles:
+            files = write_images(out, f"tile_{t.index:03d}", {"main": t.tile, **t.maps}, depth)
+            tiles.append(
+                {
+                    "index": t.index,
+                    "file": files["main"],
+                    "maps": files,
+                    "wang": t.wang,
+                    "variant": t.variant,
+                    "seed": t.seed,
+                    "patch_origin": None if t.patch_origin is None else list(t.patch_origin),
+                    "junction": list(t.junction),
+                    "scores": {k: float(v) for k, v in t.scores.items()},
+                }
+            )
+        preview = write_images(out, "preview", result.preview, depth)
+        _write_text(out / "layout.csv", _csv(result.layout))
+        layout_doc = {
+            "tile_w": ws.tile_size,
+            "tile_h": ws.tile_size,
+            "rows": rows,
+            "cols": cols,
+            "cells": result.layout.tolist(),
+            "cells_are": "tile indices (tile_NNN.png); every pair of touching edges has one colour",
+        }
+        _write_text(out / "layout.json", json.dumps(layout_doc, indent=1) + "\n")
+        return {
+            "format": FORMAT,
+            "version": VERSION,
+            "kind": "wang",
+            "seed": s.seed,
+            "settings": settings.to_dict(),
+            "resolved": s.to_dict(),
+            "wang": wang_record(ws),
+            "tiles": tiles,
+            "layout": {"csv": "layout.csv", "json": "layout.json"},
+            "preview": {"file": preview["main"], "maps": preview},
+            "warnings": list(result.warnings),
+            "source": {
+                "path": str(args.source),
+                "width": int(S.shape[1]),
+                "height": int(S.shape[0]),
+                "channels": int(S.shape[2]),
+                "bit_depth": depth,
+                "maps": {k: p for k, p in args.map},
+                "exclude_mask": args.exclude_mask or None,
+            },
+            "workers": args.workers,
+            "weights": weights,
+        }
+
+    project = (
+        project_arguments(result, S, maps, depth, args, weights)
+        if getattr(args, "project", None)
+        else {}
+    )
+    write_set(args, write, project)
+    say(f"wrote {len(ws.tiles)} Wang tiles, manifest, layout and preview to {args.out}")
     return 0
 
 
