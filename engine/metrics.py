@@ -9,6 +9,7 @@ channel); absolute differences are averaged over channels.
 * :func:`wrap_border_ratio` — a tile against itself across its wrap.
 * :func:`grid_border_ratio` — the same ratio along the lines of a block grid.
 * :func:`block_grid_border_ratio` — the same along a quilted image's grid, where its cuts run.
+* :func:`corner_border_ratio` — the same near the grid's crossings, where four tiles meet.
 * :func:`detail_ratio` — variance of the Laplacian of a tile over that of the source
   (:func:`laplacian_variance`).
 * :func:`grid_score` — normalised autocorrelation at a lag of one tile period minus the
@@ -50,6 +51,7 @@ __all__ = [
     "Frame",
     "Lattice",
     "block_grid_border_ratio",
+    "corner_border_ratio",
     "border_ratio",
     "duplicates",
     "edge_distance",
@@ -162,6 +164,35 @@ def grid_border_ratio(image, period, *, offset=(0, 0), direction: str = "both") 
     if not ratios:
         raise ValueError(
             f"no grid line of period {(ph, pw)} and offset {(oy, ox)} lies inside the "
+            f"{x.shape[1]}x{x.shape[0]} image"
+        )
+    return float(np.mean(ratios))
+
+
+def corner_border_ratio(image, period, *, radius: int = 2) -> float:
+    """:func:`grid_border_ratio` measured only within ``radius`` pixels of the points where
+    grid lines cross: where four tiles meet (Wang tiles' corner problem, whose diagonal
+    neighbours share no edge). The steps across the lines there over the steps off the lines;
+    mean of both directions. Grid lines as in :func:`grid_border_ratio` (offset 0).
+    """
+    x = _colour(image, "image")
+    ph, pw = _period(period)
+    r = positive_int(radius, "radius")
+    ratios = []
+    for axis, step, other in ((1, pw, ph), (0, ph, pw)):
+        steps = _col_steps(x if axis == 1 else x.transpose(1, 0, 2))  # (along, across - 1)
+        k = np.arange(1, steps.shape[1] + 1)
+        on = k % step == 0
+        along = np.arange(steps.shape[0])
+        # distance of each position along a line to the nearest crossing line (between
+        # pixels m * other - 1 and m * other)
+        d = np.minimum(along % other, other - 1 - along % other)
+        near = (d < r) & (along >= other - r) & (along < steps.shape[0] - other + r)
+        if on.any() and (~on).any() and near.any():
+            ratios.append(_ratio(steps[near][:, on].mean(), steps[:, ~on].mean()))
+    if not ratios:
+        raise ValueError(
+            f"no crossing of grid lines of period {(ph, pw)} lies inside the "
             f"{x.shape[1]}x{x.shape[0]} image"
         )
     return float(np.mean(ratios))

@@ -288,3 +288,16 @@ def test_lattice_of_valid_layouts_against_crops_with_each_tiles_own_border(sourc
     assert dia_above > max(res.above, crops_above) + 4
     with pytest.raises(ValueError, match="layouts must hold tile indices"):
         lattice(k2.tiles, source, margin=m, layouts=[np.full((8, 8), 16)])
+
+
+def test_corner_border_ratio_sees_steps_where_four_tiles_meet():
+    from engine.metrics import corner_border_ratio
+
+    S = smooth_texture((256, 256), 3, seed=1)
+    assert 0.8 < corner_border_ratio(S, 32) < 1.2  # no tiles: the texture's own steps
+    g = np.random.default_rng(0)
+    crops = [S[y : y + 32, x : x + 32] for y, x in g.integers(0, 224, (64, 2))]
+    rows = [np.concatenate(crops[i * 8 : (i + 1) * 8], axis=1) for i in range(8)]
+    assert corner_border_ratio(np.concatenate(rows), 32) > 3  # unrelated crops
+    with pytest.raises(ValueError, match="no crossing"):
+        corner_border_ratio(S[:20, :20], 32)

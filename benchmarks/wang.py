@@ -1,0 +1,254 @@
+"""Wang tile-set benchmark: speed, and quality beside the Somol-Haindl set on the same textures.
+
+Run ``python -m benchmarks.wang`` (``--help`` for options). Tables:
+
+1. **Speed**: 16 tiles (K = 2) of 128x128 from the 512x512 cobblestones sample, default
+   settings, after the seam kernels are loaded (:func:`engine.seams.warmup`): time to the
+   first tile and to the whole set with 1 and 2 workers (median of ``--repeats`` alternating
+   runs; targets: the set <= 2 s on 2 cores, the first tile <= 0.3 s), and the machine's load
+   average meanwhile (the figures only mean something when it is below 2).
+2. **Quality** (``--quality SET``: ``samples`` = the 5 bundled samples, ``public`` /
+   ``private`` = the evaluation sets of ``benchmarks/evalset.py``): per texture, a K = 2 Wang
+   set and a Somol-Haindl set of the same tile size (``--tile``, default 128; smaller sources
+   get the largest that fits), default settings, seed 0:
+
+   * joints: border ratio median / max over every pair of tiles that may touch, both
+     directions (Wang: the pairs whose touching colours match; Somol: all pairs);
+   * lattice (dB above its floor, :func:`engine.metrics.lattice`): Wang over 4 random valid
+     8x8 layouts against crops carrying each tile's own outer margin; Somol over 4 random 8x8
+     layouts against crops carrying the template's margin;
+   * frame (:func:`engine.metrics.frame`, limit 2 w_P; Wang tiles reflected at their border,
+     Somol tiles wrapped), detail (median detail ratio of the tiles);
+   * corners (Wang): :func:`engine.metrics.corner_border_ratio` within 2 px of the points where
+     four tiles meet, in an 8x8 valid layout (the joints elsewhere for comparison).
+
+   Targets (issue 11): Wang joints median <= 1.1 and max <= 1.6, lattice <= +1 dB,
+   frame <= 1.12, detail >= 0.95. ``--docs DIR`` saves both sets' 8x8 layouts there.
+
+Both tables are printed and saved to ``benchmarks/results/wang*.txt``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+if __package__ in (None, ""):  # run as a script: make the repository importable
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+import resources  # noqa: E402
+from benchmarks._util import format_table  # noqa: E402
+from engine.io import load_image  # noqa: E402
+from engine.metrics import (  # noqa: E402
+    border_ratio,
+    corner_border_ratio,
+    detail_ratio,
+    frame,
+    grid_border_ratio,
+    lattice,
+)
+from engine.tiles.layout import assemble  # noqa: E402
+from engine.tiles.wang import WangTile, iter_wang_set, wang_set  # noqa: E402
+from engine.tiles.wang_layout import wang_layout  # noqa: E402
+
+RESULTS = Path(__file__).resolve().parent / "results"
+SAMPLES = ("brick", "cobblestones", "grass", "gravel", "lichen")
+
+
+def _stamp() -> str:
+    try:
+        rev = subprocess.run(
+            ["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, check=False
+        ).stdout.strip()
+    except OSError:
+        rev = "?"
+    return f"{time.strftime('%Y-%m-%d %H:%M')} commit {rev or '?'}"
+
+
+def _load_avg() -> float:
+    return os.getloadavg()[0]
+
+
+# ----------------------------------------------------------------------------- speed
+def run_once(S, workers: int):
+    t0 = time.perf_counter()
+    first = None
+    for ev in iter_wang_set(S, tile_size=128, colours=2, rng=0, workers=workers):
+        if first is None and isinstance(ev, WangTile):
+            first = time.perf_counter() - t0
+    return first, time.perf_counter() - t0
+
+
+def speed(repeats: int) -> str:
+    from engine.seams import warmup
+
+    S = load_image(resources.sample_path("cobblestones")).pixels
+    warmup()
+    run_once(S, 2)  # FFT plans, numba caches, imports
+    times = {1: [], 2: []}
+    loads = []
+    for _ in range(repeats):
+        for w in (1, 2):
+            loads.append(_load_avg())
+            times[w].append(run_once(S, w))
+    rows = []
+    for w in (1, 2):
+        f = float(np.median([t[0] for t in times[w]]))
+        tot = float(np.median([t[1] for t in times[w]]))
+        rows.append([w, f"{f:.3f} s", f"{tot:.3f} s"])
+    sp = np.median([t[1] for t in times[1]]) / np.median([t[1] for t in times[2]])
+    table = format_table(["workers", "first tile", "16 tiles"], rows)
+    return (
+        "Speed: 16 Wang tiles (K = 2) of 128x128 from the 512x512 cobblestones sample "
+        f"(median of {repeats}; targets: first tile <= 0.3 s, set <= 2 s on 2 cores)\n\n"
+        f"{table}\n\n2-worker speed-up {sp:.2f}x; 1-minute load average during the runs "
+        f"{np.median(loads):.1f} (2 cores: figures above 2 mean other work shared them)\n"
+    )
+
+
+# ----------------------------------------------------------------------------- quality
+def _textures(which: str):
+    if which == "samples":
+        for n in SAMPLES:
+            yield n, load_image(resources.sample_path(n)).pixels
+        return
+    from benchmarks import evalset  # the public / private evaluation sets (issue 10)
+    from engine.bitdepth import to_float
+
+    for n in evalset.texture_names(which):
+        a = evalset.load(n)
+        yield n, to_float(a[:, :, None] if a.ndim == 2 else a)
+
+
+def _fit(S, tile: int) -> int:
+    from engine.tiles.wang import _Setup
+
+    while tile >= 16:
+        try:
+            _Setup(S, tile_size=tile)
+            return tile
+        except ValueError:
+            tile = tile * 3 // 4
+    raise ValueError("the source is too small for Wang tiles")
+
+
+def _pairs(tiles, touches) -> list[float]:
+    out = []
+    for a in tiles:
+        for b in tiles:
+            for direction in ("horizontal", "vertical"):
+                if touches(a, b, direction):
+                    out.append(border_ratio(a.tile, b.tile, direction=direction))
+    return out
+
+
+def wang_row(S, T: int, docs: Path | None, name: str):
+    ws = wang_set(S, tile_size=T, rng=0)
+    sigs = ws.signatures
+
+    def touches(a, b, direction):
+        i, j = (1, 3) if direction == "horizontal" else (2, 0)
+        return a.signature[i] == b.signature[j]
+
+    pairs = _pairs(ws.tiles, touches)
+    layouts = [wang_layout(sigs, 8, 8, rng=k) for k in range(4)]
+    m = ws.parameters["margin"]
+    lat = lattice(ws.tiles, S, margin=m, layouts=layouts)
+    fr = frame(ws.tiles, S, limit=2 * ws.parameters["patch_overlap"], wrap=False)
+    det = float(np.median([detail_ratio(t.tile, S) for t in ws.tiles]))
+    img = assemble(ws.tiles, layouts[0])
+    corner = corner_border_ratio(img, T, radius=2)
+    joints = grid_border_ratio(img, T)
+    if docs is not None:
+        from engine.io import save_image
+
+        save_image(docs / f"{name}_wang.png", img)
+    return pairs, lat.above, fr.value, det, corner, joints
+
+
+def somol_row(S, T: int, docs: Path | None, name: str):
+    from engine.settings import TilesetSettings
+    from engine.tiles.pipeline import tileset
+
+    res = tileset(S, TilesetSettings(tile_min=T, tile_max=T, seed=0))
+    cands = res.candidates
+    pairs = _pairs(cands, lambda a, b, d: True)
+    m = res.settings.margin
+    lat = lattice(cands, S, template=res.seamless, margin=m)
+    fr = frame(cands, S, limit=2 * res.settings.patch_overlap)
+    det = float(np.median([detail_ratio(c.tile, S) for c in cands]))
+    if docs is not None:
+        from engine.io import save_image
+
+        save_image(docs / f"{name}_somol.png", res.preview["main"])
+    return pairs, lat.above, fr.value, det
+
+
+def quality(which: str, tile: int, docs: Path | None) -> str:
+    rows = []
+    for name, S in _textures(which):
+        T = _fit(S, tile)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            wp, wl, wf, wd, wc, wj = wang_row(S, T, docs, name)
+            try:
+                sp, sl, sf, sd = somol_row(S, T, docs, name)
+                somol = [f"{np.median(sp):.2f} / {max(sp):.2f}", f"{sl:+.2f}", f"{sf:.2f}"]
+            except ValueError as exc:  # a source too small for the template search
+                somol = ["-", "-", f"({exc})"[:30]]
+        rows.append(
+            [
+                name,
+                T,
+                f"{np.median(wp):.2f} / {max(wp):.2f}",
+                f"{wl:+.2f}",
+                f"{wf:.2f}",
+                f"{wd:.2f}",
+                f"{wc:.2f} ({wj:.2f})",
+                *somol,
+            ]
+        )
+        print(" | ".join(str(c) for c in rows[-1]), file=sys.stderr, flush=True)
+    heads = ["texture", "tile", "Wang joints med / max", "Wang lattice dB", "Wang frame"]
+    heads += ["Wang detail", "corners (joints)", "Somol joints med / max", "Somol lattice dB"]
+    heads += ["Somol frame"]
+    return (
+        f"Quality on the {which} textures: a K = 2 Wang set (16 tiles) and a Somol-Haindl set "
+        "(30 candidates) of the same tile size, default settings, seed 0 (targets for Wang: "
+        "joints <= 1.1 / 1.6, lattice <= +1 dB, frame <= 1.12, detail >= 0.95)\n\n"
+        + format_table(heads, rows)
+        + "\n"
+    )
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--repeats", type=int, default=5, help="speed runs per worker count")
+    ap.add_argument("--no-speed", action="store_true", help="skip the speed table")
+    ap.add_argument("--quality", choices=("samples", "public", "private"), default=None)
+    ap.add_argument("--tile", type=int, default=128, help="tile size of the quality table")
+    ap.add_argument("--docs", type=Path, default=None, help="save the 8x8 layouts here")
+    args = ap.parse_args(argv)
+    RESULTS.mkdir(exist_ok=True)
+    if args.docs is not None:
+        args.docs.mkdir(parents=True, exist_ok=True)
+    if not args.no_speed:
+        text = f"{_stamp()}\n\n{speed(args.repeats)}"
+        print(text)
+        (RESULTS / "wang.txt").write_text(text)
+    if args.quality:
+        text = f"{_stamp()}\n\n{quality(args.quality, args.tile, args.docs)}"
+        print(text)
+        (RESULTS / f"wang_quality_{args.quality}.txt").write_text(text)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
