@@ -64,6 +64,13 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "--seed", type=int_at_least(0), default=0, help="seed of the dither noise (default 0)"
     )
     p.add_argument("--overwrite", action="store_true", help="replace a non-empty --out folder")
+    p.add_argument(
+        "--wang",
+        action="store_true",
+        default=None,
+        help="export the project's Wang set (Tiled Wang set, Godot terrain set) rather than its "
+        "candidates (the default when it holds only a Wang set)",
+    )
     p.set_defaults(func=run)
     return p
 
@@ -87,6 +94,7 @@ def run(args) -> int:
         rng=args.seed,
         tile_format=args.tile_format,
         overwrite=args.overwrite,
+        wang=args.wang,
     )
     print(
         f"quilt-studio export: wrote {manifest['tile_count']} tiles x {len(manifest['maps'])} maps "

@@ -238,28 +238,20 @@ def wang_record(ws) -> dict:
 
 def project_arguments(result, S, maps, depth, args, weights) -> dict:
     """The keyword arguments of :func:`engine.project.project_from_tileset` for a Wang set."""
-    import numpy as np
-
     from engine.cli.tileset import MAIN_MAP, _map_weights
 
-    def as_maps(main, extra):
-        return {MAIN_MAP: np.asarray(main), **{k: np.asarray(v) for k, v in extra.items()}}
-
     s, ws = result.settings, result.wang
+    record = wang_record(ws)
+    record["layout"] = result.layout.tolist()
     return dict(
         sources={MAIN_MAP: S, **maps},
-        tiles=[as_maps(t.tile, t.maps) for t in ws.tiles],
+        tiles=[],
         name="tileset",
-        patch_origins=[t.patch_origin for t in ws.tiles],
-        seeds=[t.seed for t in ws.tiles],
-        scores=[t.scores["criterion"] for t in ws.tiles],
-        tile_params=[{"wang": t.wang, "variant": t.variant} for t in ws.tiles],
-        layout=result.layout,
         parameters={"tileset": s.to_dict()},
         project_seeds={"wang": s.seed, "layout": s.layout_seed},
         bit_depth=depth,
         source_paths={MAIN_MAP: str(args.source), **{k: p for k, p in args.map}},
         map_weights=_map_weights(weights),
-        preview=as_maps(result.preview["main"], {m: result.preview[m] for m in maps}),
-        wang=wang_record(ws),
+        wang=record,
+        wang_tiles=[t.to_candidate() for t in ws.tiles],
     )

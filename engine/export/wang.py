@@ -23,7 +23,16 @@ import numbers
 from collections.abc import Mapping
 from xml.sax.saxutils import quoteattr
 
-__all__ = ["check_wang", "godot_terrain_lines", "godot_tile_terrain", "tiled_wangset_lines"]
+import numpy as np
+
+__all__ = [
+    "check_signatures",
+    "check_wang",
+    "godot_terrain_lines",
+    "godot_tile_terrain",
+    "layout_mismatches",
+    "tiled_wangset_lines",
+]
 
 SIDES = ("n", "e", "s", "w")
 GODOT_MATCH_SIDES = 2  # TileSet.TERRAIN_MODE_MATCH_SIDES
@@ -91,3 +100,36 @@ def godot_terrain_lines(wang: dict) -> list[str]:
         lines.append(f'terrain_set_0/terrain_{c}/name = "{colour_name(c)}"')
         lines.append(f"terrain_set_0/terrain_{c}/color = Color({r:.6g}, {g:.6g}, {b:.6g}, 1)")
     return lines
+
+
+def check_signatures(signatures) -> np.ndarray:
+    """(n, 4) int64 array of (N, E, S, W) colours, validated."""
+    s = np.asarray(signatures)
+    if s.ndim != 2 or s.shape[1] != 4 or s.shape[0] < 1:
+        raise ValueError(
+            f"signatures must be a non-empty list of (n, e, s, w), got shape {s.shape}"
+        )
+    if not np.issubdtype(s.dtype, np.integer) or (s < 0).any():
+        raise ValueError("signatures must hold colour indices >= 0")
+    return s.astype(np.int64)
+
+
+def layout_mismatches(signatures, layout, *, wrap: bool = False) -> int:
+    """Number of neighbouring cell pairs whose touching edge colours differ (0 = valid);
+    -1 cells (empty) are skipped."""
+    sig = check_signatures(signatures)
+    m = np.asarray(layout, dtype=np.int64)
+    if m.ndim != 2 or m.size == 0 or m.max() >= sig.shape[0] or m.min() < -1:
+        raise ValueError("layout must be a 2-D matrix of tile indices (or -1)")
+    bad = 0
+    a, b = m[:, :-1], m[:, 1:]
+    if wrap:
+        a, b = np.hstack([a, m[:, -1:]]), np.hstack([b, m[:, :1]])
+    both = (a >= 0) & (b >= 0)
+    bad += int(np.count_nonzero(sig[a[both], 1] != sig[b[both], 3]))
+    a, b = m[:-1], m[1:]
+    if wrap:
+        a, b = np.vstack([a, m[-1:]]), np.vstack([b, m[:1]])
+    both = (a >= 0) & (b >= 0)
+    bad += int(np.count_nonzero(sig[a[both], 2] != sig[b[both], 0]))
+    return bad

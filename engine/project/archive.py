@@ -308,7 +308,8 @@ def _load_images(project, reader: _Reader, fail, max_pixels, max_decoded_bytes, 
     decoded size of every reference first, then each entry inflated and decoded once."""
     main = project.main_map
     tiles = [c.images(main) for c in project.candidates]  # the candidates' images, by map
-    groups = [project.sources, project.template, project.preview, *tiles]
+    wang = [c.images(main) for c in project.wang_tiles]
+    groups = [project.sources, project.template, project.preview, *tiles, *wang]
     slots = [(g, key) for g in groups if g is not None for key in g]
     heads: dict[str, PNGHeader] = {}
     total = 0
@@ -342,4 +343,8 @@ def _load_images(project, reader: _Reader, fail, max_pixels, max_decoded_bytes, 
     project.candidates = [
         c.replace(tile=t[main], maps={m: a for m, a in t.items() if m != main})
         for c, t in zip(project.candidates, tiles, strict=True)
+    ]
+    project.wang_tiles = [
+        c.replace(tile=t[main], maps={m: a for m, a in t.items() if m != main})
+        for c, t in zip(project.wang_tiles, wang, strict=True)
     ]

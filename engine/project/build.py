@@ -41,6 +41,7 @@ def project_from_tileset(
     extra=None,
     wang=None,
     tile_params=None,
+    wang_tiles=None,
 ) -> Project:
     """Build a validated :class:`Project` from plain arrays (for the ``tileset`` CLI and tests).
 
@@ -49,7 +50,8 @@ def project_from_tileset(
     (kept as they are, re-indexed; the per-tile lists below are then ignored); ``template``
     likewise. ``patch_origins``, ``seeds``, ``scores``, ``locked``, ``tile_params`` (each
     tile's ``CandidateTile.params``) are per-tile lists (or None); ``wang`` a Wang set's
-    record (:attr:`Project.wang`).
+    record (:attr:`Project.wang`) and ``wang_tiles`` its tiles (``CandidateTile``, whose maps
+    are floats in [0, 1], re-indexed).
     """
 
     def as_maps(v, what):
@@ -128,6 +130,7 @@ def project_from_tileset(
         preview=prev,
         extra=dict(extra or {}),
         wang=None if wang is None else dict(wang),
+        wang_tiles=[t.replace(index=i) for i, t in enumerate(wang_tiles or [])],
     )
     check_project(p, "project")
     return p

@@ -77,58 +77,8 @@ def check_project(p: Project, where: str) -> None:
             raise ValueError(
                 f"{where}: template_rect must be 4 integers (x, y, w, h) with w, h >= 1, got {r!r}"
             )
-    tile_shape = None
-
-    def check_tile(maps, what):
-        nonlocal tile_shape
-        if not isinstance(maps, dict) or list(maps) != list(p.sources):
-            raise ValueError(
-                f"{where}: {what} must have the maps {list(p.sources)}, got "
-                f"{list(maps) if isinstance(maps, dict) else type(maps).__name__}"
-            )
-        for m, a in maps.items():
-            s = np.shape(a)
-            if len(s) != 3 or s[2] != shapes[m][2]:
-                raise ValueError(
-                    f"{where}: {what}[{m!r}] is shaped {s}, expected (h, w, {shapes[m][2]})"
-                )
-            if tile_shape is None:
-                tile_shape = s[:2]
-            if s[:2] != tile_shape:
-                raise ValueError(
-                    f"{where}: {what}[{m!r}] is {s[1]}x{s[0]}, other tiles are "
-                    f"{tile_shape[1]}x{tile_shape[0]}"
-                )
-
-    if p.template is not None:
-        check_tile(p.template, "template")
-    for i, c in enumerate(p.candidates):
-        if not isinstance(c, CandidateTile):
-            raise TypeError(f"{where}: candidates[{i}] must be a CandidateTile")
-        check_tile(c.images(p.main_map), f"candidates[{i}]")
-        if c.patch_origin is not None and (
-            len(c.patch_origin) != 2
-            or any(
-                isinstance(v, bool) or not isinstance(v, numbers.Integral) for v in c.patch_origin
-            )
-        ):
-            raise ValueError(
-                f"{where}: candidates[{i}].patch_origin must be (row, col) integers or None"
-            )
-        if c.seed is not None and (
-            isinstance(c.seed, bool)
-            or not isinstance(c.seed, numbers.Integral)
-            or not 0 <= c.seed < 2**64
-        ):
-            raise ValueError(
-                f"{where}: candidates[{i}].seed must be an integer in [0, 2**64) or None"
-            )
-        if not all(finite_number(v) for v in c.scores.values()):
-            raise ValueError(f"{where}: candidates[{i}].scores (and score) must be finite numbers")
-        if not isinstance(c.locked, bool) or not finite_number(c.weight) or c.weight < 0:
-            raise ValueError(
-                f"{where}: candidates[{i}].locked must be a bool and weight a number >= 0"
-            )
+    first = [("template", p.template)] if p.template is not None else []
+    _check_tiles(p, where, shapes, first, "candidates", p.candidates)
     n = len(p.candidates)
     for k in p.picks:
         if isinstance(k, bool) or not isinstance(k, numbers.Integral) or not 0 <= k < n:
@@ -166,17 +116,73 @@ def check_project(p: Project, where: str) -> None:
     for key in ("parameters", "seeds", "extra"):
         if not isinstance(getattr(p, key), dict):
             raise ValueError(f"{where}: {key} must be a dict")
-    if p.wang is not None:
-        check_project_wang(p, where)
+    if p.wang is not None or p.wang_tiles:
+        check_project_wang(p, where, shapes)
 
 
-def check_project_wang(p: Project, where: str) -> None:
-    """A Wang set's record: K colours, 2 K samples, an edge signature on every candidate."""
-    from engine.export.wang import check_wang
+def _check_tiles(p: Project, where: str, shapes, first, key: str, candidates) -> None:
+    """Tiles of one size with every map (``first``: (name, maps) checked before them), and
+    each candidate's fields."""
+    tile_shape = None
+
+    def check_tile(maps, what):
+        nonlocal tile_shape
+        if not isinstance(maps, dict) or list(maps) != list(p.sources):
+            raise ValueError(
+                f"{where}: {what} must have the maps {list(p.sources)}, got "
+                f"{list(maps) if isinstance(maps, dict) else type(maps).__name__}"
+            )
+        for m, a in maps.items():
+            s = np.shape(a)
+            if len(s) != 3 or s[2] != shapes[m][2]:
+                raise ValueError(
+                    f"{where}: {what}[{m!r}] is shaped {s}, expected (h, w, {shapes[m][2]})"
+                )
+            if tile_shape is None:
+                tile_shape = s[:2]
+            if s[:2] != tile_shape:
+                raise ValueError(
+                    f"{where}: {what}[{m!r}] is {s[1]}x{s[0]}, other tiles are "
+                    f"{tile_shape[1]}x{tile_shape[0]}"
+                )
+
+    for what, maps in first:
+        check_tile(maps, what)
+    for i, c in enumerate(candidates):
+        if not isinstance(c, CandidateTile):
+            raise TypeError(f"{where}: {key}[{i}] must be a CandidateTile")
+        check_tile(c.images(p.main_map), f"{key}[{i}]")
+        if c.patch_origin is not None and (
+            len(c.patch_origin) != 2
+            or any(
+                isinstance(v, bool) or not isinstance(v, numbers.Integral) for v in c.patch_origin
+            )
+        ):
+            raise ValueError(
+                f"{where}: {key}[{i}].patch_origin must be (row, col) integers or None"
+            )
+        if c.seed is not None and (
+            isinstance(c.seed, bool)
+            or not isinstance(c.seed, numbers.Integral)
+            or not 0 <= c.seed < 2**64
+        ):
+            raise ValueError(f"{where}: {key}[{i}].seed must be an integer in [0, 2**64) or None")
+        if not all(finite_number(v) for v in c.scores.values()):
+            raise ValueError(f"{where}: {key}[{i}].scores (and score) must be finite numbers")
+        if not isinstance(c.locked, bool) or not finite_number(c.weight) or c.weight < 0:
+            raise ValueError(f"{where}: {key}[{i}].locked must be a bool and weight a number >= 0")
+
+
+def check_project_wang(p: Project, where: str, shapes) -> None:
+    """A Wang set's record (K colours, 2 K samples, a valid layout) and its tiles, each with
+    an edge signature."""
+    from engine.export.wang import check_wang, layout_mismatches
 
     w = p.wang
-    k = w.get("colours") if isinstance(w, dict) else None
-    samples = w.get("samples") if isinstance(w, dict) else None
+    if not isinstance(w, dict):
+        raise ValueError(f"{where}: wang_tiles need the Wang set's record (wang)")
+    k = w.get("colours")
+    samples = w.get("samples")
     if not isinstance(samples, list) or isinstance(k, bool) or not isinstance(k, int):
         raise ValueError(f"{where}: wang must hold 'colours' (int) and 'samples' (list)")
     want = [(a, c) for a in ("h", "v") for c in range(k)]
@@ -191,9 +197,19 @@ def check_project_wang(p: Project, where: str) -> None:
             raise ValueError(f"{where}: wang.samples[{i}] must be {{'axis', 'colour', 'origin'}}")
     if len(samples) != 2 * k:
         raise ValueError(f"{where}: wang.samples must list {2 * k} samples (h, then v colours)")
+    _check_tiles(p, where, shapes, [], "wang_tiles", p.wang_tiles)
     try:
-        check_wang(
-            {"colours": k, "tiles": [c.params.get("wang") for c in p.candidates]}, len(p.candidates)
-        )
+        sigs = check_wang(
+            {"colours": k, "tiles": [c.params.get("wang") for c in p.wang_tiles]},
+            len(p.wang_tiles),
+        )["tiles"]
     except (TypeError, ValueError) as exc:
-        raise ValueError(f"{where}: the candidates' Wang signatures: {exc}") from None
+        raise ValueError(f"{where}: the Wang tiles' signatures: {exc}") from None
+    lay = w.get("layout")
+    if lay is not None:
+        try:
+            bad = layout_mismatches([tuple(s[x] for x in "nesw") for s in sigs], lay)
+        except (TypeError, ValueError):
+            bad = -1
+        if bad:
+            raise ValueError(f"{where}: wang.layout must be a valid layout of the Wang tiles")

@@ -54,12 +54,16 @@ def to_doc(project: Project, put: Callable[[np.ndarray, str], str]) -> dict:
         else {m: put(a, f"images/preview_{m}.png") for m, a in project.preview.items()},
         "extra": project.extra,
         "wang": project.wang,
+        "wang_tiles": [
+            _candidate_doc(c, i, project.main_map, put, "wang")
+            for i, c in enumerate(project.wang_tiles)
+        ],
     }
 
 
-def _candidate_doc(c: CandidateTile, i: int, main: str, put) -> dict:
+def _candidate_doc(c: CandidateTile, i: int, main: str, put, kind: str = "candidate") -> dict:
     """One candidate's entry (its images by map, how it was made, the user's choices)."""
-    images = {m: put(a, f"images/candidate_{i:04}_{m}.png") for m, a in c.images(main).items()}
+    images = {m: put(a, f"images/{kind}_{i:04}_{m}.png") for m, a in c.images(main).items()}
 
     def ints(v):
         return None if v is None else [int(x) for x in v]
@@ -81,10 +85,10 @@ def _candidate_doc(c: CandidateTile, i: int, main: str, put) -> dict:
     }
 
 
-def _candidate(i: int, c: dict, images: dict, main: str, s) -> CandidateTile:
+def _candidate(i: int, c: dict, images: dict, main: str, s, key="candidates") -> CandidateTile:
     """The candidate of entry ``c`` (what :func:`_candidate_doc` wrote; files of version 1
     without ``params`` keep only their score); malformed optional details are dropped."""
-    where = f"candidates[{i}]"
+    where = f"{key}[{i}]"
     po = s.get(c, "patch_origin", list, where, optional=True)
     params = s.get(c, "params", dict, where, optional=True, default={})
     scores = params.get("scores") if isinstance(params.get("scores"), dict) else {}
@@ -209,11 +213,19 @@ def from_doc(doc, fail: Callable[[str], None], image: Callable[[object], object]
         if set(prev_d) - set(maps):
             fail("project.json: preview keys must be map names")
         preview = {m: image(v) for m, v in prev_d.items()}
-    cands = []
-    for i, c in enumerate(s.get(doc, "candidates", list, "")):
-        where = f"candidates[{i}]"
-        imgs = map_images(s.get(c, "images", dict, where), f"{where}.images")
-        cands.append(_candidate(i, c, imgs, maps[0], s))
+
+    def candidates(key, entries):
+        out = []
+        for i, c in enumerate(entries):
+            where = f"{key}[{i}]"
+            imgs = map_images(s.get(c, "images", dict, where), f"{where}.images")
+            out.append(_candidate(i, c, imgs, maps[0], s, key))
+        return out
+
+    cands = candidates("candidates", s.get(doc, "candidates", list, ""))
+    wang_tiles = candidates(
+        "wang_tiles", s.get(doc, "wang_tiles", list, "", optional=True, default=[])
+    )
     rect = s.get(doc, "template_rect", list, "", optional=True)
     layout = s.get(doc, "layout", list, "", optional=True)
     if layout is not None:
@@ -255,4 +267,5 @@ def from_doc(doc, fail: Callable[[str], None], image: Callable[[object], object]
         preview=preview,
         extra=s.get(doc, "extra", dict, "", optional=True, default={}),
         wang=s.get(doc, "wang", dict, "", optional=True),
+        wang_tiles=wang_tiles,
     )

@@ -51,10 +51,12 @@ class Project:
     waypoints: dict[str, list[tuple[int, int]]] = field(default_factory=dict)  # per seam key
     preview: dict[str, np.ndarray] | None = None
     extra: dict = field(default_factory=dict)  # any JSON the editor wants to keep
-    # a Wang set (engine.tiles.wang): {"colours": K, "tile_size": T, "variants": V,
-    # "samples": [{"axis", "colour", "origin": [row, col], "error"}...]}; each candidate's
-    # params hold its edge signature {"wang": {"n", "e", "s", "w"}, "variant": v}
+    # a Wang set (engine.tiles.wang), beside the candidates: its record {"colours": K,
+    # "tile_size": T, "variants": V, "samples": [{"axis", "colour", "origin": [row, col],
+    # "error"}...], "layout": [[tile index...]...] or None, ...} and its tiles, whose params
+    # hold their edge signature {"wang": {"n", "e", "s", "w"}, "variant": v, ...}
     wang: dict | None = None
+    wang_tiles: list[CandidateTile] = field(default_factory=list)
 
     @property
     def main_map(self) -> str:

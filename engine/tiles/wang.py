@@ -67,6 +67,7 @@ __all__ = [
     "canonical_signatures",
     "choose_sample",
     "de_bruijn",
+    "from_candidate",
     "iter_wang_set",
     "make_wang_tile",
     "wang_set",
@@ -191,8 +192,9 @@ class WangTile(Item):
     tile : (T, T, C) float32
     maps : dict
         The same tile for every extra material map.
-    labels : (T, T) uint8
-        Where each pixel comes from: 0 N, 1 E, 2 S, 3 W sample, 4 the interior patch.
+    labels : (T, T) uint8 or None
+        Where each pixel comes from: 0 N, 1 E, 2 S, 3 W sample, 4 the interior patch (None
+        for a tile read back from a project).
     paths : dict
         The cuts in tile (row, col): ``nw``, ``ne``, ``sw``, ``se`` (corner to junction) and
         ``patch`` (the closed loop, absent without an interior patch).
@@ -210,7 +212,7 @@ class WangTile(Item):
     variant: int
     tile: np.ndarray
     maps: dict
-    labels: np.ndarray
+    labels: np.ndarray | None
     paths: dict
     junction: tuple[int, int]
     patch_origin: tuple[int, int] | None = None
@@ -221,6 +223,51 @@ class WangTile(Item):
     def wang(self) -> dict:
         """The signature as ``{"n": c, "e": c, "s": c, "w": c}`` (the manifest's form)."""
         return dict(zip("nesw", self.signature, strict=True))
+
+    def to_candidate(self):
+        """This tile as the project's tile type (:class:`engine.candidate.CandidateTile`): its
+        signature, variant and junction in ``params``; :func:`from_candidate` reads it back."""
+        from engine.candidate import CandidateTile
+
+        cuts = {k: np.asarray(v).tolist() for k, v in self.paths.items() if k != "patch"}
+        return CandidateTile(
+            index=self.index,
+            tile=self.tile,
+            maps=dict(self.maps),
+            patch_origin=self.patch_origin,
+            loop=self.paths.get("patch"),
+            scores={k: float(v) for k, v in self.scores.items()},
+            seed=self.seed,
+            params={
+                "wang": self.wang,
+                "variant": self.variant,
+                "junction": list(self.junction),
+                "cuts": cuts,
+            },
+        )
+
+
+def from_candidate(c) -> WangTile:
+    """The :class:`WangTile` a project keeps as :meth:`WangTile.to_candidate` wrote it (its
+    pixel labels are not kept: ``labels`` is None)."""
+    p = c.params
+    paths = {k: np.asarray(v, dtype=np.intp).reshape(-1, 2) for k, v in p.get("cuts", {}).items()}
+    if c.loop is not None:
+        paths["patch"] = np.asarray(c.loop, dtype=np.intp)
+    junction = p.get("junction") or (0, 0)
+    return WangTile(
+        index=int(c.index),
+        signature=tuple(int(p["wang"][k]) for k in "nesw"),
+        variant=int(p.get("variant", 0)),
+        tile=c.tile,
+        maps=dict(c.maps),
+        labels=None,
+        paths=paths,
+        junction=(int(junction[0]), int(junction[1])),
+        patch_origin=None if c.patch_origin is None else tuple(c.patch_origin),
+        scores=dict(c.scores),
+        seed=c.seed,
+    )
 
 
 @dataclass(frozen=True)

@@ -12,21 +12,10 @@ from __future__ import annotations
 import numpy as np
 
 from engine._validate import as_rng, positive_int
+from engine.export.wang import check_signatures, layout_mismatches
 from engine.tiles.layout import _weights
 
 __all__ = ["check_signatures", "layout_mismatches", "wang_layout"]
-
-
-def check_signatures(signatures) -> np.ndarray:
-    """(n, 4) int64 array of (N, E, S, W) colours, validated."""
-    s = np.asarray(signatures)
-    if s.ndim != 2 or s.shape[1] != 4 or s.shape[0] < 1:
-        raise ValueError(
-            f"signatures must be a non-empty list of (n, e, s, w), got shape {s.shape}"
-        )
-    if not np.issubdtype(s.dtype, np.integer) or (s < 0).any():
-        raise ValueError("signatures must hold colour indices >= 0")
-    return s.astype(np.int64)
 
 
 def wang_layout(
@@ -110,24 +99,3 @@ def wang_layout(
                 k -= 1
             out[r, c] = k
     return out
-
-
-def layout_mismatches(signatures, layout, *, wrap: bool = False) -> int:
-    """Number of neighbouring cell pairs whose touching edge colours differ (0 = valid);
-    -1 cells (empty) are skipped."""
-    sig = check_signatures(signatures)
-    m = np.asarray(layout, dtype=np.int64)
-    if m.ndim != 2 or m.size == 0 or m.max() >= sig.shape[0] or m.min() < -1:
-        raise ValueError("layout must be a 2-D matrix of tile indices (or -1)")
-    bad = 0
-    a, b = m[:, :-1], m[:, 1:]
-    if wrap:
-        a, b = np.hstack([a, m[:, -1:]]), np.hstack([b, m[:, :1]])
-    both = (a >= 0) & (b >= 0)
-    bad += int(np.count_nonzero(sig[a[both], 1] != sig[b[both], 3]))
-    a, b = m[:-1], m[1:]
-    if wrap:
-        a, b = np.vstack([a, m[-1:]]), np.vstack([b, m[:1]])
-    both = (a >= 0) & (b >= 0)
-    bad += int(np.count_nonzero(sig[a[both], 2] != sig[b[both], 0]))
-    return bad

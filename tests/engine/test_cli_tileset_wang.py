@@ -49,9 +49,10 @@ def test_wang_set_files_manifest_layout_and_project(tmp_path, src):
     assert preview.shape == (4 * 32, 6 * 32, 3)
 
     p = load_project(proj)
-    assert p.wang["colours"] == 2 and len(p.wang["samples"]) == 4
-    assert [tuple(c.params["wang"][k] for k in "nesw") for c in p.candidates] == sigs
-    np.testing.assert_array_equal(p.layout, cells)
+    assert p.wang["colours"] == 2 and len(p.wang["samples"]) == 4 and not p.candidates
+    assert [tuple(c.params["wang"][k] for k in "nesw") for c in p.wang_tiles] == sigs
+    np.testing.assert_array_equal(p.wang["layout"], cells)
+    np.testing.assert_array_equal(np.round(p.wang_tiles[0].tile * 65535).astype(np.uint16), tile)
 
     bundle = tmp_path / "b"
     assert main(["export", str(proj), "--out", str(bundle)]) == 0
@@ -76,19 +77,24 @@ def test_wang_flags_are_checked(tmp_path, src, capsys):
 
 
 def test_project_checks_the_wang_record(tmp_path, src):
+    from engine.candidate import CandidateTile
     from engine.project import project_from_tileset
 
     paths, rgb16 = src
-    tiles = [rgb16[:32, :32]] * 2
     good = {"colours": 1, "samples": [{"axis": "h", "colour": 0, "origin": [40, 0]}]}
     good["samples"].append({"axis": "v", "colour": 0, "origin": [0, 40]})
-    params = [{"wang": {"n": 0, "e": 0, "s": 0, "w": 0}}] * 2
-    p = project_from_tileset(sources=rgb16, tiles=tiles, wang=good, tile_params=params)
-    assert p.wang == good
+    t = np.zeros((32, 32, 3), np.float32)
+    tile = CandidateTile(0, t, params={"wang": {"n": 0, "e": 0, "s": 0, "w": 0}})
+    p = project_from_tileset(sources=rgb16, tiles=[], wang=good, wang_tiles=[tile, tile])
+    assert p.wang == good and len(p.wang_tiles) == 2
     with pytest.raises(ValueError, match="wang.samples must list 2 samples"):
         project_from_tileset(
-            sources=rgb16, tiles=tiles, wang={**good, "samples": good["samples"][:1]},
-            tile_params=params,
+            sources=rgb16, tiles=[], wang={**good, "samples": good["samples"][:1]},
+            wang_tiles=[tile],
         )  # fmt: skip
-    with pytest.raises(ValueError, match="the candidates' Wang signatures"):
-        project_from_tileset(sources=rgb16, tiles=tiles, wang=good)
+    with pytest.raises(ValueError, match="the Wang tiles' signatures"):
+        project_from_tileset(sources=rgb16, tiles=[], wang=good, wang_tiles=[CandidateTile(0, t)])
+    with pytest.raises(ValueError, match="wang.layout must be a valid layout"):
+        project_from_tileset(
+            sources=rgb16, tiles=[], wang={**good, "layout": [[0, 5]]}, wang_tiles=[tile]
+        )

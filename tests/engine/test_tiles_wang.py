@@ -301,3 +301,16 @@ def test_corner_border_ratio_sees_steps_where_four_tiles_meet():
     assert corner_border_ratio(np.concatenate(rows), 32) > 3  # unrelated crops
     with pytest.raises(ValueError, match="no crossing"):
         corner_border_ratio(S[:20, :20], 32)
+
+
+def test_a_tile_survives_the_projects_candidate_type(k2):
+    from engine.tiles.wang import from_candidate
+
+    t = k2.tiles[6]
+    back = from_candidate(t.to_candidate())
+    assert back.signature == t.signature and back.variant == t.variant
+    assert back.patch_origin == t.patch_origin and back.junction == t.junction
+    np.testing.assert_array_equal(back.tile, t.tile)
+    assert set(back.paths) == set(t.paths)
+    for k in t.paths:
+        np.testing.assert_array_equal(back.paths[k], t.paths[k])
