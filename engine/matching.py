@@ -32,6 +32,7 @@ __all__ = [
     "ZERO_ERROR_FRACTION",
     "PCAMatcher",
     "SampleSpectrum",
+    "TiledSpectrum",
     "box_sums_float",
     "summed_area",
     "check_block",
@@ -63,6 +64,13 @@ class SampleSpectrum:
     """
 
     def __init__(self, sample: np.ndarray, *, groups=None, workers: int = 1):
+        self._setup(sample, groups, workers)
+        chans = np.moveaxis(self.sample, 2, 0)
+        sq = np.stack([np.sum(chans[list(g)] ** 2, axis=0) for g in self.groups])
+        self._fs = self._forward(chans)
+        self._fsq = self._forward(sq)
+
+    def _setup(self, sample, groups, workers) -> None:
         s = np.ascontiguousarray(np.asarray(sample, dtype=np.float32))
         if s.ndim != 3:
             raise ValueError(f"sample must be (H, W, C), got shape {s.shape}")
@@ -78,10 +86,6 @@ class SampleSpectrum:
             self.group_of[list(g)] = gi
         self.workers = int(workers)
         self.padded = (sfft.next_fast_len(h, real=True), sfft.next_fast_len(w, real=True))
-        chans = np.moveaxis(s, 2, 0)
-        sq = np.stack([np.sum(chans[list(g)] ** 2, axis=0) for g in self.groups])
-        self._fs = self._forward(chans)
-        self._fsq = self._forward(sq)
 
     @property
     def nbytes(self) -> int:
@@ -165,6 +169,45 @@ class SampleSpectrum:
         e += np.asarray(const, dtype=np.float64).astype(np.float32)[:, None, None]
         np.maximum(e, 0, out=e)
         return e
+
+
+class TiledSpectrum(SampleSpectrum):
+    """:class:`SampleSpectrum`'s queries with memory bounded by a tile instead of the sample.
+
+    The anchors are cut into tiles of ``tile`` × ``tile``; each query transforms the sample
+    region a tile's windows cover (``tile + block - 1`` pixels a side) and queries it, so no
+    spectrum of the whole sample is ever held: memory grows with the tile, time about doubles
+    (every query transforms the sample's tiles again). The errors equal the whole-sample
+    query's up to float round-off.
+    """
+
+    def __init__(self, sample: np.ndarray, *, groups=None, workers: int = 1, tile: int = 1024):
+        self._setup(sample, groups, workers)
+        self.tile = positive_int(tile, "tile")
+
+    @property
+    def nbytes(self) -> int:
+        return 0
+
+    def correlate(self, kernels: np.ndarray) -> np.ndarray:
+        raise NotImplementedError("a tiled spectrum answers ssd queries only")
+
+    def ssd_terms(self, kernels, weights, const, *, workers: int | None = None) -> np.ndarray:
+        k = np.asarray(kernels, dtype=np.float32)
+        n, _, bh, bw = k.shape
+        h, w = self.shape
+        if bh > h or bw > w:
+            raise ValueError(f"block {bw}x{bh} is larger than the sample {w}x{h}")
+        t = self.tile
+        out = np.empty((n, h - bh + 1, w - bw + 1), np.float32)
+        wk = self.workers if workers is None else workers
+        for y0 in range(0, h - bh + 1, t):
+            for x0 in range(0, w - bw + 1, t):
+                region = self.sample[y0 : y0 + t + bh - 1, x0 : x0 + t + bw - 1]
+                spec = SampleSpectrum(region, groups=self.groups, workers=wk)
+                part = spec.ssd_terms(k, weights, const, workers=wk)
+                out[:, y0 : y0 + part.shape[1], x0 : x0 + part.shape[2]] = part
+        return out
 
 
 def _channel_sum(fk: np.ndarray, fs: np.ndarray) -> np.ndarray:
@@ -283,8 +326,18 @@ def error_floor(sample: np.ndarray) -> float:
     """Mean squared difference of adjacent sample pixels per channel (the texture's own
     pixel-to-pixel variation), used to decide when an overlap error counts as zero."""
     s = np.asarray(sample, dtype=np.float32)
-    dx = np.mean((s[:, 1:] - s[:, :-1]) ** 2) if s.shape[1] > 1 else 0.0
-    dy = np.mean((s[1:] - s[:-1]) ** 2) if s.shape[0] > 1 else 0.0
+    h, w = s.shape[:2]
+    sx = sy = 0.0
+    for y in range(0, h, 256):  # strips: no temporary of the sample's size
+        strip = s[y : y + 257]  # one row of overlap for the vertical steps
+        if w > 1:
+            d = strip[: min(256, h - y), 1:] - strip[: min(256, h - y), :-1]
+            sx += float(np.einsum("ijk,ijk->", d, d, dtype=np.float64))
+        if len(strip) > 1:
+            d = strip[1:] - strip[:-1]
+            sy += float(np.einsum("ijk,ijk->", d, d, dtype=np.float64))
+    dx = sx / (h * (w - 1) * s.shape[2]) if w > 1 else 0.0
+    dy = sy / ((h - 1) * w * s.shape[2]) if h > 1 else 0.0
     return float(max((dx + dy) / 2, 1e-12))
 
 

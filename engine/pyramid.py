@@ -10,8 +10,9 @@ one over ``4^l``.
 1. **Coarse**: the exact weighted SSD of every position of the top level (one small FFT query),
    and its ``keep`` best positions at least two coarse pixels apart (so they are ``keep``
    different places of the sample, not one place and its shifts).
-2. **Refine**: each level down, the 4 × 4 children around ``2p`` of every candidate ``p`` are
-   scored exactly at that level and the best child of each is kept.
+2. **Refine**: each level down, the 3 × 3 children around ``2p`` of every candidate ``p`` are
+   scored exactly at that level, the best child of each is kept, and the ``keep`` best of
+   those go on.
 3. **Exact re-ranking** at full resolution: every child of the last level's candidates, plus the
    *seeds* (the caller's guesses: the positions that continue the neighbouring blocks' source
    windows, PatchMatch's propagation) and their 3 × 3 neighbourhoods, scored by the exact
@@ -20,7 +21,7 @@ one over ``4^l``.
 
 The caller draws among the re-ranked candidates exactly as the exhaustive search draws among
 all positions. Per block this costs one query of a ≤ ``COARSE_AREA`` sample plus
-``keep × 16`` exact SSDs per level: independent of the sample's area beyond the pyramid's
+``keep × 9`` exact SSDs per level: independent of the sample's area beyond the pyramid's
 construction (linear, once) and its memory (a third of the sample's).
 
 Why this search (measured in ``benchmarks/quilting.py``, README): PatchMatch-style propagation
@@ -58,9 +59,13 @@ MIN_COARSE_OVERLAP = 2
 means ranks the true best window among the first few hundred of a 4096² sample only about
 half the time (brick, measured), a 2-pixel strip most of the time."""
 
-CHILDREN = np.array([(dy, dx) for dy in (-1, 0, 1, 2) for dx in (-1, 0, 1, 2)], np.int64)
-"""Offsets of a candidate's children one level down, around ``2p``: the two positions a
-coarse pixel covers and one more on each side (a 2 × 2 average blurs the alignment)."""
+MAX_COARSE_AREA = 1024 * 1024
+"""A top level larger than this (the overlap too thin to reduce further) is reduced anyway."""
+
+CHILDREN = np.array([(dy, dx) for dy in (-1, 0, 1) for dx in (-1, 0, 1)], np.int64)
+"""Offsets of a candidate's children one level down, around ``2p``: a window at ``2p + 1``
+lies half a coarse pixel from both ``p`` and ``p + 1``, so each parent covers one position on
+either side (16 children, up to ``2p + 2``, found the same windows in twice the time)."""
 
 SEED_NEIGHBOURS = np.array([(dy, dx) for dy in (-1, 0, 1) for dx in (-1, 0, 1)], np.int64)
 
@@ -78,20 +83,32 @@ def box_reduce(a: np.ndarray) -> np.ndarray:
 
 def pyramid_levels(shape, block, overlap: int, *, coarse_area: int = COARSE_AREA) -> int:
     """Number of 2× reductions for a sample of ``shape`` (H, W) and blocks ``block`` (bh, bw)
-    with ``overlap``: enough to bring the sample to ``coarse_area`` pixels, but no more than
-    keeps the overlap at least one pixel and the block at least four (0: search exactly)."""
+    with ``overlap`` (0: search exactly).
+
+    Enough to bring the sample to ``coarse_area`` pixels, but no more than keeps
+    :data:`MIN_COARSE_OVERLAP` pixels of the overlap and 4 of the block; if the top level is
+    then still over :data:`MAX_COARSE_AREA` (a thin overlap on a huge sample), as many as
+    bring it down while the block keeps 2 pixels (the overlap's weights become fractions of a
+    pixel: a weaker top level, but a bounded one)."""
     h, w = int(shape[0]), int(shape[1])
+
+    def most(overlap_px: float, block_px: int) -> int:
+        lev = 0
+        while (
+            need > lev
+            and overlap / 2 ** (lev + 1) >= overlap_px
+            and min(block) >> (lev + 1) >= block_px
+        ):
+            lev += 1
+        return lev
+
     need = 0
     while (h >> need) * (w >> need) > coarse_area:
         need += 1
-    allowed = 0
-    while (
-        overlap >> (allowed + 1) >= MIN_COARSE_OVERLAP
-        and min(block) >> (allowed + 1) >= 4
-        and min(h, w) >> (allowed + 1) >= min(block) >> (allowed + 1)
-    ):
-        allowed += 1
-    return min(need, allowed)
+    lev = most(MIN_COARSE_OVERLAP, 4)
+    if (h >> lev) * (w >> lev) > MAX_COARSE_AREA:
+        lev = max(lev, most(0, 2))
+    return lev
 
 
 def reduce_target(target: np.ndarray, weights: np.ndarray, group_of: np.ndarray):
@@ -219,7 +236,7 @@ class PyramidSearch:
     """
 
     def __init__(
-        self, sample, *, levels: int, groups=None, keep: int = 24, coarse_keep: int = 64, workers=1
+        self, sample, *, levels: int, groups=None, keep: int = 24, coarse_keep: int = 128, workers=1
     ):
         if levels < 1:
             raise ValueError(f"levels must be >= 1, got {levels}")

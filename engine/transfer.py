@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import math
 import numbers
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy import ndimage
@@ -33,10 +33,11 @@ from engine._validate import as_image, as_rng, choice, positive_int
 from engine.cancel import check
 from engine.errormap import colour_channels
 from engine.events import Progress, Snapshot, drain
-from engine.matching import ZERO_ERROR_FRACTION, SampleSpectrum, error_floor
+from engine.matching import ZERO_ERROR_FRACTION, error_floor
 from engine.quilting.core import BlockWork, Quilter
+from engine.quilting.estimate import Estimated, check_plan, plan
 from engine.quilting.layout import grid_rects
-from engine.quilting.options import check_options, resolve_threads
+from engine.quilting.options import check_options, resolve_threads, sample_array
 from engine.quilting.records import BlockRecord
 from engine.quilting.scheduler import run_levels
 
@@ -139,10 +140,10 @@ class _TransferQuilter(Quilter):
         self.alpha = alpha
         self.corr_floor = corr_floor
 
-    def make_spectrum(self) -> SampleSpectrum:
+    def search_sample(self):
         c = self.match_sample.shape[2]
         stack = np.concatenate([self.match_sample, self.corr_sample[:, :, None]], axis=2)
-        return SampleSpectrum(stack, groups=(tuple(range(c)), (c,)), workers=self.threads)
+        return stack, (tuple(range(c)), (c,))
 
     def load(self, wk: BlockWork) -> None:
         super().load(wk)
@@ -168,6 +169,25 @@ class _TransferQuilter(Quilter):
 
     def zero_level_for(self, wk: BlockWork) -> float:
         return wk.extra["zero"]
+
+    def _pyramid_terms(self, wk: BlockWork, kern, wts, const: float):
+        """The coarse-to-fine search on the cost ``const - 2 Σ corr(S, kern) + Σ corr(S², wts)``
+        written as ``Σ_g W_g (S - T)² + R``: weights W = ``wts``, targets T = kern / W, and the
+        constant R added to the re-ranked errors."""
+        c = self.match_sample.shape[2]
+        group_of = np.array([0] * c + [1])
+        w = wts[group_of]
+        t = np.divide(kern, w, out=np.zeros_like(kern), where=w > 0)
+        rest = const - float(np.einsum("chw,chw->", w * t, t, dtype=np.float64))
+        v, _ = self.valid(wk.h, wk.w)
+        anchors, errors = self._pyramid.query(
+            np.moveaxis(t, 0, 2),
+            np.moveaxis(wts, 0, 2),
+            valid=v,
+            seeds=self.seeds(wk),
+            workers=self.fft_workers,
+        )
+        return anchors, np.maximum(errors + rest, 0.0)
 
     def search(self, works: list[BlockWork]) -> None:
         groups: dict[tuple[int, int], list[BlockWork]] = {}
@@ -201,6 +221,10 @@ class _TransferQuilter(Quilter):
                     kern[i, c] = r_corr * t
                     wts[i, 1] = r_corr
                     const[i] += r_corr * float(np.sum(t.astype(np.float64) ** 2))
+            if self._pyramid is not None:
+                for i, wk in enumerate(group):
+                    wk.found = ("list", *self._pyramid_terms(wk, kern[i], wts[i], const[i]))
+                continue
             maps = self.spectrum.ssd_terms(kern, wts, const, workers=self.fft_workers)
             v, _ = self.valid(h, w)
             for wk, e in zip(group, maps, strict=True):
@@ -222,6 +246,7 @@ def iter_transfer(
     tolerance: float = 0.1,
     seam=None,
     excluded=None,
+    mode: str = "auto",
     rng=None,
     cancel=None,
     threads: int | None = None,
@@ -245,16 +270,18 @@ def iter_transfer(
         Number of passes N.
     correspondence : {"luminance", "blurred"}
         Correspondence maps; ``sigma`` is the blur of ``"blurred"``.
-    tolerance, seam, excluded, rng, cancel, threads
-        As in :func:`engine.quilting.iter_quilt`.
+    tolerance, seam, excluded, mode, rng, cancel, threads
+        As in :func:`engine.quilting.iter_quilt`; ``mode`` is planned per pass (the
+        coarse-to-fine search matches the correspondence map as one more channel).
 
     Returns
     -------
     generator
-        Yields :class:`engine.quilting.BlockPlaced`, :class:`IterationDone` and
+        Yields :class:`engine.quilting.Estimated` first (the passes' total time and largest
+        peak), then :class:`engine.quilting.BlockPlaced`, :class:`IterationDone` and
         :class:`~engine.events.Progress`; returns a :class:`TransferResult`.
     """
-    s = as_image(sample, "sample")
+    s = sample_array(sample)
     t = as_image(target, "target")
     choice(correspondence, "correspondence", CORRESPONDENCES)
     _check_alpha(alpha)
@@ -288,17 +315,36 @@ def iter_transfer(
                 tileable=False,
                 adaptive_threshold=None,
                 min_block=None,
-                mode="exact",
+                mode=mode,
             )
         )
+    threads = resolve_threads(threads)
+    passes = [
+        plan(o, threads, channels_extra=1, terms="block", extra_bytes=_transfer_bytes(s, t))
+        for o in plans
+    ]
+    total = replace(
+        passes[0],
+        blocks=sum(p.blocks for p in passes),
+        seconds=sum(p.seconds for p in passes),
+        peak_bytes=max(p.peak_bytes for p in passes),
+    )
+    check_plan(total, f"texture transfer ({n_iter} passes)")
     gen = as_rng(rng)
     seed = int(gen.integers(2**63))
     return _iter_transfer(
-        s, t, plans, sched, correspondence, float(sigma), seed, cancel, resolve_threads(threads)
+        s, t, plans, passes, total, sched, correspondence, float(sigma), seed, cancel, threads
     )
 
 
-def _iter_transfer(s, t, plans, sched, kind, sigma, seed, cancel, threads):
+def _transfer_bytes(sample, target) -> int:
+    """Transfer's own buffers: both correspondence maps, the frozen previous pass."""
+    (h, w), (ht, wt) = sample.shape[:2], target.shape[:2]
+    return 4 * (h * w + ht * wt + ht * wt * sample.shape[2])
+
+
+def _iter_transfer(s, t, plans, passes, total, sched, kind, sigma, seed, cancel, threads):
+    yield Estimated(total)
     corr_s = correspondence_map(s, kind=kind, sigma=sigma)
     corr_t = correspondence_map(t, kind=kind, sigma=sigma)
     corr_floor = error_floor(corr_s[:, :, None])
@@ -319,6 +365,7 @@ def _iter_transfer(s, t, plans, sched, kind, sigma, seed, cancel, threads):
             seed=it_seed,
             cancel=cancel,
             threads=threads,
+            plan=passes[i - 1],
             **opts,
         )
         rects = grid_rects(q.out_shape, q.block, q.overlap, False)

@@ -53,7 +53,7 @@ def add_cut_arguments(p: argparse.ArgumentParser) -> None:
     """Options shared by ``synth`` and ``transfer``: the cut, blending, search, seed, threads."""
     from engine.blend import BLEND_MODES
     from engine.errormap import METRICS
-    from engine.quilting import SEAMS
+    from engine.quilting import MODES, SEAMS
 
     p.add_argument(
         "--seam",
@@ -87,6 +87,13 @@ def add_cut_arguments(p: argparse.ArgumentParser) -> None:
         default=0.1,
         help="draw among windows within 1+T of the best (default 0.1)",
     )
+    p.add_argument(
+        "--mode",
+        choices=MODES,
+        default="auto",
+        help="block search: exact (every sample position, FFT), fast (coarse-to-fine, exact "
+        "re-ranking) or auto: exact where its estimate is under 10 s (default auto)",
+    )
     add_exclusion(p, "sample")
     p.add_argument("--seed", type=int_at_least(0), default=0, help="random seed (default 0)")
     p.add_argument(
@@ -97,7 +104,7 @@ def add_cut_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
-    from engine.quilting import MODES, SELECTIONS
+    from engine.quilting import SELECTIONS
 
     p = subparsers.add_parser(
         "synth",
@@ -125,12 +132,6 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         metavar="K",
         help="windows per block for --select sampled (default 200), or re-ranked "
         "exactly in --mode fast (default 32)",
-    )
-    p.add_argument(
-        "--mode",
-        choices=MODES,
-        default="exact",
-        help="exhaustive FFT search or the fast approximate one (default exact)",
     )
     p.add_argument(
         "--tileable", action="store_true", help="wrap-around overlaps: the output tiles seamlessly"
@@ -161,32 +162,48 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 class ProgressPrinter:
-    """Progress events as stderr lines, at most a few per second (and the last one)."""
+    """Progress events as stderr lines with the time left, at most a few per second (and the
+    last one); the run's plan (search, estimated time and memory) before the first."""
 
     def __init__(self, command: str):
         self.command = command
         self.t0 = time.perf_counter()
         self.last = -1.0
+        self.estimate = None  # seconds, from the plan
+
+    def plan(self, plan) -> None:
+        self.estimate = plan.seconds
+        print(f"{self.command}: {plan.describe()}", file=sys.stderr, flush=True)
 
     def __call__(self, ev) -> None:
+        from engine.quilting.estimate import format_duration
+
         now = time.perf_counter() - self.t0
         if ev.done < ev.total and now - self.last < 0.25:
             return
         self.last = now
+        left = ""
+        if ev.done < ev.total:
+            f = ev.fraction
+            secs = now * (1 - f) / f if f > 0 else self.estimate
+            left = "" if secs is None else f", about {format_duration(secs)} left"
         print(
-            f"[{now:7.2f}s] {self.command}: {ev.done}/{ev.total} {ev.message}",
+            f"[{now:7.2f}s] {self.command}: {ev.done}/{ev.total} {ev.message}{left}",
             file=sys.stderr,
             flush=True,
         )
 
 
 def drive(gen, printer):
-    """Run an engine generator, printing its Progress events; returns its value."""
+    """Run an engine generator, printing its plan and Progress events; returns its value."""
     from engine.events import Progress, drain
+    from engine.quilting.estimate import Estimated
 
     def on_event(ev) -> None:
         if isinstance(ev, Progress):
             printer(ev)
+        elif isinstance(ev, Estimated):
+            printer.plan(ev.plan)
 
     return drain(gen, on_event)
 
@@ -255,7 +272,9 @@ def cut_options(args) -> dict:
         )
     except TypeError as exc:  # a bad --seam-option: a one-line message
         raise ValueError(str(exc)) from None
-    return dict(seam=seam, tolerance=args.tolerance, rng=args.seed, threads=args.threads)
+    return dict(
+        seam=seam, tolerance=args.tolerance, mode=args.mode, rng=args.seed, threads=args.threads
+    )
 
 
 def run(args) -> int:
@@ -271,7 +290,6 @@ def run(args) -> int:
         overlap=args.overlap,
         select=args.select,
         candidates=args.candidates,
-        mode=args.mode,
         tileable=args.tileable,
         adaptive_threshold=args.adaptive_threshold,
         min_block=args.min_block,

@@ -45,6 +45,7 @@ Determinism and threads
     of threads (:mod:`~engine.quilting.scheduler`).
 """
 
+from engine.quilting.estimate import Estimated, Plan
 from engine.quilting.options import MODES, SEAMS, SELECTIONS
 from engine.quilting.records import BlockPlaced, BlockRecord, QuiltResult
 from engine.quilting.synthesis import iter_quilt, quilt
@@ -55,6 +56,8 @@ __all__ = [
     "SELECTIONS",
     "BlockPlaced",
     "BlockRecord",
+    "Estimated",
+    "Plan",
     "QuiltResult",
     "iter_quilt",
     "quilt",

@@ -21,12 +21,14 @@ from engine.matching import (
     ZERO_ERROR_FRACTION,
     PCAMatcher,
     SampleSpectrum,
+    TiledSpectrum,
     error_floor,
     select_within_tolerance,
     ssd_at,
 )
-from engine.pyramid import PyramidSearch, pyramid_levels
+from engine.pyramid import PyramidSearch
 from engine.quilting.cut import blend_alpha, cut_overlap, straight_alpha
+from engine.quilting.estimate import TILE, Plan
 from engine.quilting.layout import arms_of, canvas_index
 from engine.quilting.records import EMPTY_PATH, BlockRecord, read_only
 
@@ -60,12 +62,13 @@ class Quilter:
     :meth:`load`, :meth:`zero_level_for` and :meth:`search` (its α-weighted cost).
     """
 
-    def __init__(self, *, seed: int, cancel, threads: int, **options):
+    def __init__(self, *, seed: int, cancel, threads: int, plan: Plan, **options):
         # options: the validated keywords of iter_quilt, as returned by check_options (sample,
         # out_shape, block, overlap, select, tolerance, candidates, seam (a SeamSpec), excluded,
         # tileable, adaptive_threshold, min_block, mode)
         self.__dict__.update(options)
-        self.seed, self.cancel, self.threads = seed, cancel, threads
+        self.seed, self.cancel, self.threads, self.plan = seed, cancel, threads, plan
+        self.mode = plan.mode  # "auto" resolved
         sample, out_shape = self.sample, self.out_shape
         self.match_sample = np.ascontiguousarray(colour_channels(sample))
         self.canvas = np.zeros((*out_shape, sample.shape[2]), np.float32)
@@ -75,7 +78,6 @@ class Quilter:
         self._spectrum = None
         self._pca = None
         self._pyramid = None
-        self.pyramid_depth = 0  # pyramid reductions of the fast search (0: none)
         self.origin = None  # (H, W, 2) int32: the sample pixel each canvas pixel came from
         self.fft_workers = 1 if threads > 1 else threads  # the pool already uses every thread
         self.stream = True  # False: no events (the benchmark's streaming-overhead reference)
@@ -84,16 +86,15 @@ class Quilter:
         """Build the structures every search shares (before any thread reads them)."""
         if self.select != "best":
             return
-        if self.mode == "fast" and self.pyramid_depth == 0:
-            self.pyramid_depth = pyramid_levels(self.sample.shape[:2], self.block, self.overlap)
-        if self.mode == "fast" and self.pyramid_depth:
+        if self.plan.search == "pyramid":
+            stack, groups = self.search_sample()
             self._pyramid = PyramidSearch(
-                self.match_sample, levels=self.pyramid_depth, workers=self.threads
+                stack, levels=self.plan.levels, groups=groups, workers=self.threads
             )
             self.origin = np.full((*self.out_shape, 2), -1, np.int32)
             return
         _ = self.spectrum
-        if self.mode == "fast":
+        if self.plan.search == "pca":
             self.pca()
 
     def run_block(self, wk: BlockWork) -> list[tuple[BlockRecord, np.ndarray]]:
@@ -111,7 +112,14 @@ class Quilter:
         return self._spectrum
 
     def make_spectrum(self) -> SampleSpectrum:
-        return SampleSpectrum(self.match_sample, workers=self.threads)
+        stack, groups = self.search_sample()
+        if self.plan.search == "tiled fft":
+            return TiledSpectrum(stack, groups=groups, workers=self.threads, tile=TILE)
+        return SampleSpectrum(stack, groups=groups, workers=self.threads)
+
+    def search_sample(self) -> tuple[np.ndarray, tuple | None]:
+        """The channels the search matches and their groups (None: one group): the colours."""
+        return self.match_sample, None
 
     def valid(self, h: int, w: int):
         """(valid anchor map or None if all valid, flat indices of valid anchors)."""
@@ -177,7 +185,7 @@ class Quilter:
                 wk.found = ("list", *self._pyramid_query(wk))
             return
         exact = need
-        if self.mode == "fast":
+        if self.plan.search == "pca":
             exact = []
             fast = []
             for wk in need:

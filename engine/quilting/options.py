@@ -18,7 +18,7 @@ from engine.seams.spec import METHODS as SEAM_METHODS
 from engine.seams.spec import STRAIGHT
 
 SELECTIONS = ("best", "random", "sampled", "bhatia")
-MODES = ("exact", "fast")
+MODES = ("auto", "exact", "fast")
 SEAMS = (STRAIGHT, *SEAM_METHODS)
 QUILT_SEAM = SeamSpec("dp", metric="ssd")
 """Quilting's default cut: Efros & Freeman's minimum error boundary cut on the squared error,
@@ -39,6 +39,7 @@ __all__ = [
     "SELECTIONS",
     "check_options",
     "check_out_shape",
+    "sample_array",
     "resolve_threads",
 ]
 
@@ -64,6 +65,21 @@ def check_out_shape(out_shape) -> tuple[int, int]:
     return int(h), int(w)
 
 
+def sample_array(sample, name: str = "sample") -> np.ndarray:
+    """``sample`` as float32 (H, W, C) in [0, 1]: a read-only view when it already is float32
+    (a large photo is not copied; the caller must not change it while a run reads it), else
+    :func:`engine._validate.as_image`'s converted copy."""
+    a = sample if isinstance(sample, np.ndarray) else None
+    if a is None or a.dtype != np.float32 or a.ndim not in (2, 3) or 0 in a.shape:
+        return as_image(sample, name)
+    for i in range(0, a.shape[0], 256):  # finite, checked in strips (no full-size temporary)
+        if not np.isfinite(a[i : i + 256]).all():
+            raise ValueError(f"{name} contains NaN or infinite values")
+    v = a[:, :, None] if a.ndim == 2 else a.view()
+    v.setflags(write=False)
+    return v
+
+
 def check_options(
     sample,
     out_shape,
@@ -83,7 +99,7 @@ def check_options(
     """The keywords of :func:`engine.quilting.iter_quilt` validated, defaults filled in: a dict
     with the same names (``sample`` as float32 (H, W, C), ``seam`` a :class:`SeamSpec`,
     ``excluded`` as bool or None)."""
-    s = as_image(sample, "sample")
+    s = sample_array(sample)
     H, W = s.shape[:2]
     Ho, Wo = check_out_shape(out_shape)
     bh, bw = check_block(block)

@@ -8,6 +8,7 @@ from engine._validate import as_rng
 from engine.events import drain
 from engine.quilting.bhatia import iter_bhatia
 from engine.quilting.core import Quilter
+from engine.quilting.estimate import Estimated, check_plan, plan
 from engine.quilting.layout import grid_rects
 from engine.quilting.options import check_options, resolve_threads
 from engine.quilting.records import QuiltResult
@@ -30,7 +31,7 @@ def iter_quilt(
     tileable: bool = False,
     adaptive_threshold: float | None = None,
     min_block: int | None = None,
-    mode: str = "exact",
+    mode: str = "auto",
     rng=None,
     cancel=None,
     threads: int | None = None,
@@ -74,8 +75,13 @@ def iter_quilt(
     min_block : int, optional
         Smallest block adaptive splitting makes (default max(2 overlap + 1, block / 4)); children
         of a block of n pixels measure (n + overlap + 1) // 2 and overlap like the grid.
-    mode : {"exact", "fast"}
-        Exhaustive FFT search, or principal-component ranking with exact re-ranking.
+    mode : {"auto", "exact", "fast"}
+        ``"exact"``: every sample position is scored (FFT; on tiles of the sample when its
+        whole spectra would not fit the memory budget). ``"fast"``: a coarse-to-fine search
+        (:mod:`engine.pyramid`; principal components on samples under 256²) whose candidates
+        are re-ranked exactly. ``"auto"``: exact where its estimate is at most
+        :data:`engine.quilting.estimate.AUTO_EXACT_SECONDS`, else fast
+        (:func:`engine.quilting.estimate.plan`).
     rng : int, Generator or None
         Seed; the same seed gives the same output for any ``threads``.
     cancel : CancelToken, optional
@@ -86,8 +92,14 @@ def iter_quilt(
     Returns
     -------
     generator
-        Yields :class:`BlockPlaced` and :class:`~engine.events.Progress`; returns a
-        :class:`QuiltResult`.
+        Yields :class:`~engine.quilting.estimate.Estimated` first (the plan: search, time and
+        peak memory), then :class:`BlockPlaced` and :class:`~engine.events.Progress`; returns
+        a :class:`QuiltResult`.
+
+    Raises
+    ------
+    engine.budget.MemoryBudgetError
+        Before any work, when the run's estimated peak exceeds the memory available here.
     """
     return _iter_quilt(
         _build_quilter(
@@ -113,8 +125,11 @@ def iter_quilt(
 
 def _build_quilter(sample, out_shape, *, rng, cancel, threads, **options):
     opts = check_options(sample, out_shape, **options)
+    threads = resolve_threads(threads)
+    p = plan(opts, threads)
+    check_plan(p, "quilting")
     seed = int(as_rng(rng).integers(2**63))
-    return Quilter(seed=seed, cancel=cancel, threads=resolve_threads(threads), **opts)
+    return Quilter(seed=seed, cancel=cancel, threads=threads, plan=p, **opts)
 
 
 def quilt_unstreamed(sample, out_shape, **options) -> QuiltResult:
@@ -128,6 +143,8 @@ def quilt_unstreamed(sample, out_shape, **options) -> QuiltResult:
 
 
 def _iter_quilt(q: Quilter):
+    if q.stream:
+        yield Estimated(q.plan)
     bh, bw = q.block
     Ho, Wo = q.out_shape
     if q.select == "bhatia":
@@ -153,6 +170,7 @@ def _iter_quilt(q: Quilter):
             tolerance=q.tolerance,
             candidates=q.candidates,
             mode=q.mode,
+            search=q.plan.search,
             adaptive_threshold=q.adaptive_threshold,
             min_block=q.min_block,
         ),

@@ -7,7 +7,7 @@ from engine.events import Progress
 from engine.exclusion import exclusion_mask
 from engine.matching import ZERO_ERROR_FRACTION, error_floor
 from engine.metrics import block_grid_border_ratio, wrap_border_ratio
-from engine.quilting import BlockPlaced, iter_quilt, quilt, scheduler
+from engine.quilting import BlockPlaced, Estimated, iter_quilt, quilt, scheduler
 from engine.quilting.synthesis import quilt_unstreamed
 from resources import SAMPLE_NAMES
 from tests.engine.helpers import cut, events_and_result
@@ -299,8 +299,8 @@ def test_input_types_gray_uint8_and_straight_feather():
 def test_cancel_raises_cleanly(cobbles):
     token = CancelToken()
     gen = iter_quilt(cobbles, (120, 120), block=24, overlap=4, rng=0, cancel=token)
-    first = next(gen)
-    assert isinstance(first, BlockPlaced)
+    assert isinstance(next(gen), Estimated)  # the plan comes first
+    assert isinstance(next(gen), BlockPlaced)
     token.cancel()
     with pytest.raises(Cancelled):
         for _ in gen:

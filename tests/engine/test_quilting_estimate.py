@@ -1,0 +1,111 @@
+"""The plan of a quilting run: auto's switch, tiled exact search, memory estimate and refusal."""
+
+import tracemalloc
+
+import numpy as np
+import pytest
+
+from engine.budget import MemoryBudgetError
+from engine.matching import SampleSpectrum, TiledSpectrum
+from engine.quilting import Estimated, estimate, iter_quilt, quilt
+from engine.quilting.options import check_options
+from tests.engine.helpers import smooth_texture
+
+
+@pytest.fixture(autouse=True)
+def steady_machine(monkeypatch):
+    """Plans from the cost model alone (no timing of this machine's load)."""
+    monkeypatch.setattr(estimate, "machine_factor", lambda: 1.0)
+
+
+def options(sample, out, block=48, overlap=8, mode="auto", **kw):
+    return check_options(
+        sample,
+        out,
+        block=block,
+        overlap=overlap,
+        select=kw.pop("select", "best"),
+        tolerance=0.1,
+        candidates=None,
+        seam=None,
+        excluded=None,
+        tileable=False,
+        adaptive_threshold=None,
+        min_block=None,
+        mode=mode,
+    )
+
+
+def test_auto_switches_to_the_fast_search_at_the_threshold(monkeypatch):
+    s = smooth_texture((600, 600))
+    opts = options(s, (400, 400))
+    exact = estimate.plan({**opts, "mode": "exact"}, 2)
+    fast = estimate.plan({**opts, "mode": "fast"}, 2)
+    assert (exact.search, fast.search) == ("fft", "pyramid")
+    assert fast.seconds < exact.seconds
+    monkeypatch.setattr(estimate, "AUTO_EXACT_SECONDS", exact.seconds * 1.01)
+    assert estimate.plan(opts, 2).mode == "exact"
+    monkeypatch.setattr(estimate, "AUTO_EXACT_SECONDS", exact.seconds * 0.99)
+    assert estimate.plan(opts, 2).search == "pyramid"
+    # the run follows its plan and announces it first
+    monkeypatch.setattr(estimate, "AUTO_EXACT_SECONDS", 0.0)
+    events = list(iter_quilt(s, (200, 200), block=48, overlap=8, rng=0, threads=1))
+    assert isinstance(events[0], Estimated) and events[0].plan.search == "pyramid"
+
+
+def test_small_samples_stay_exact_in_auto():
+    s = smooth_texture((128, 128))
+    res = quilt(s, (200, 200), block=32, overlap=6, rng=0, threads=1)
+    assert res.params["mode"] == "exact" and res.params["search"] == "fft"
+
+
+@pytest.mark.parametrize(
+    "size, out, mode, threads",
+    [(600, 300, "fast", 2), (600, 300, "exact", 2), (1200, 300, "fast", 1), (400, 256, "exact", 1)],
+)
+def test_peak_memory_estimate_matches_tracemalloc(size, out, mode, threads):
+    """Stated tolerance: the traced peak lies within 60-125 % of the estimate (numpy's
+    allocations are traced; the estimate also counts a fixed 2 MiB for what is not)."""
+    warm = smooth_texture((300, 300))
+    quilt(warm, (100, 100), block=32, overlap=6, mode=mode, rng=0, threads=threads)  # numba
+    s = smooth_texture((size, size), seed=1)
+    tracemalloc.start()
+    try:
+        plan = None
+        for ev in iter_quilt(s, (out, out), block=48, overlap=8, mode=mode, rng=0, threads=threads):
+            if isinstance(ev, Estimated):
+                plan = ev.plan
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    assert 0.6 * plan.peak_bytes <= peak <= 1.25 * plan.peak_bytes
+
+
+def test_large_samples_are_planned_within_the_budget():
+    """A 10000² sample (issue 12 D3) runs on the coarse-to-fine search in about 0.5 GiB; an
+    exact search of an 8192² sample works on tiles instead of whole-sample spectra (np.empty:
+    the pages are never touched)."""
+    big = np.empty((10000, 10000, 3), np.float32)
+    p = estimate.plan(options(big, (256, 256), block=32, overlap=6), 2)
+    assert p.search == "pyramid" and p.peak_bytes < estimate.SEARCH_BUDGET / 2
+    del big
+    s8 = np.empty((8192, 8192, 3), np.float32)
+    p = estimate.plan(options(s8, (2048, 2048), block=96, overlap=16, mode="exact"), 2)
+    assert p.search == "tiled fft" and p.peak_bytes < estimate.SEARCH_BUDGET
+
+
+def test_tiled_spectrum_equals_the_whole_sample_query():
+    rng = np.random.default_rng(0)
+    s = rng.random((300, 270, 3), dtype=np.float32)
+    old = rng.random((2, 30, 25, 3), dtype=np.float32)
+    m = rng.random((2, 30, 25)) < 0.4
+    whole = SampleSpectrum(s).ssd(old, m)
+    tiled = TiledSpectrum(s, tile=64).ssd(old, m)
+    np.testing.assert_allclose(tiled, whole, atol=2e-3)
+
+
+def test_a_run_beyond_the_memory_limit_is_refused_before_any_work(monkeypatch):
+    monkeypatch.setenv("QUILT_MEMORY_LIMIT", "1M")
+    s = smooth_texture((300, 300))
+    with pytest.raises(MemoryBudgetError, match=r"quilting .* needs about .* smaller sample"):
+        iter_quilt(s, (400, 400), block=32, overlap=6, rng=0)
