@@ -112,8 +112,10 @@ def colour_range(value, name):
 class TilesetSettings:
     """Every option of the tile-set workflow (Somol & Haindl), with its default.
 
-    Template search: ``tile_min``/``tile_max`` (N or (h, w); None: a quarter / half of the
-    source's shorter side, ``tile_max`` defaults to ``tile_min`` when only that is given),
+    Template search: ``tile_size`` (N or (h, w): the tile's size, the search only places it;
+    None: searched between ``tile_min`` and ``tile_max``), ``tile_min``/``tile_max`` (N or
+    (h, w); None: a quarter / half of the source's shorter side, ``tile_max`` defaults to
+    ``tile_min`` when only that is given),
     ``overlap`` w_T (None: about a tenth of the tile), ``joint_weight`` λ of the natural wrap
     joint. Cuts: ``seam`` (method, options, metric, blending of the patches) and
     ``template_blend`` (the template's blending; None: the same as ``seam.blend``).
@@ -131,6 +133,7 @@ class TilesetSettings:
     ``patch_overlap``, ``margin`` (None: 1), the preview and the exclusion as above.
     """
 
+    tile_size: tuple[int, int] | None = setting(None, optional(as_size))
     tile_min: tuple[int, int] | None = setting(None, optional(as_size))
     tile_max: tuple[int, int] | None = setting(None, optional(as_size))
     overlap: int | None = setting(None, optional(at_least(2)))
@@ -176,8 +179,11 @@ class TilesetSettings:
         return dataclasses.replace(self, **changes)
 
     def tile_range(self, shape) -> tuple[tuple[int, int], tuple[int, int]]:
-        """(tile_min, tile_max) as (h, w) for a source of ``shape`` (H, W): the defaults are
-        a quarter and half of the shorter side (at least 8 px)."""
+        """(tile_min, tile_max) as (h, w) for a source of ``shape`` (H, W): ``tile_size``
+        twice when it is set, else the range (by default a quarter and half of the shorter
+        side, at least 8 px)."""
+        if self.tile_size is not None:
+            return self.tile_size, self.tile_size
         short = min(int(shape[0]), int(shape[1]))
         lo = self.tile_min or as_size(max(8, short // 4), "tile_min")
         if self.tile_max is not None:

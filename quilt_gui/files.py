@@ -27,7 +27,7 @@ from engine.project import (
     recovery_path,
     save_project,
 )
-from quilt_gui import jobs, project_io, settings
+from quilt_gui import jobs, params, project_io, settings
 from quilt_gui.imaging import prepare_display
 from quilt_gui.jobs import error_text
 from quilt_gui.model import Source, safe_name
@@ -191,15 +191,26 @@ class ProjectFiles(QObject):
             kinds={MAIN_MAP: "color"},
         )
         self.doc.set_source(source)
+        note = self._fit_parameters(loaded.pixels.shape)
         self._remember(path, "last_open_dir", remember)
         h, w = loaded.pixels.shape[:2]
         self._say(
             "info",
             f"Opened {Path(path).name}: {w}×{h}, {loaded.bit_depth}-bit "
-            f"{mode_text(loaded.mode)}. Next: Find best tile (Ctrl+T) or draw the "
+            f"{mode_text(loaded.mode)}. {note}Next: Find best tile (Ctrl+T) or draw the "
             "tile rectangle.",
         )
         self.image_opened.emit()
+
+    def _fit_parameters(self, shape) -> str:
+        """Sizes left from a larger image go back to Auto (not an undo step: a new image
+        starts a new history); returns a sentence saying which, or ""."""
+        changes = params.fit_to_source(self.doc.params, shape)
+        if not changes:
+            return ""
+        self.doc.apply_params(changes)
+        names = ", ".join(params.BY_KEY[k].label for k in changes)
+        return f"{names}: too large for this image, back to automatic. "
 
     def _on_project_loaded(self, path: str, project) -> None:
         project_io.apply_project(self.doc, project, path)

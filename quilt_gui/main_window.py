@@ -261,7 +261,7 @@ class MainWindow(QMainWindow):
         self.params_panel = ParamsPanel(
             doc,
             {
-                "Template": [self.act_find],
+                "Tile": [self.act_find],
                 "Candidates": [self.act_generate],
                 "Preview": [self.act_reroll_layout],
                 "Quilting": [self.act_quilt],

@@ -1,8 +1,10 @@
-"""Every user parameter of the editor in one table: type, default, range, label, tooltip.
+"""The editor's parameters as data: the table's indexes, and the settings the engine takes.
 
-The parameters panel is built from :data:`PARAMS`; the document stores a flat dict
-``{key: value}``; :func:`engine_options` turns it into the keyword arguments of the
-engine calls. Keeping the table here means a new option is one line, not three widgets.
+The table itself (labels, tooltips, ranges) is :mod:`quilt_gui.param_table`; the document stores
+a flat dict ``{key: value}``. :func:`tileset_settings` turns it into the tile set's
+:class:`engine.settings.TilesetSettings` (what the command line reads and writes too),
+:func:`seam_spec` and :func:`seam_options` into seam arguments, :func:`ui_words` puts the
+labels into the engine's messages.
 """
 
 from __future__ import annotations
@@ -10,531 +12,45 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import re
-from dataclasses import dataclass
 from typing import Any
 
 from engine.exclusion import colour_range_around
-from engine.seams.spec import (
-    BLEND_MODES,
-    METHODS,
-    METRICS,
-    MINIMAX_VARIANTS,
-    OPTIONS,
-    OSCILLATING_VARIANTS,
-    SeamSpec,
-)
+from engine.seams.spec import BLEND_MODES, METHODS, OPTIONS, SeamSpec
 from engine.settings import TilesetSettings, settings_from_parameters
+from quilt_gui.param_table import (
+    ANY,
+    AUTO,
+    PARAMS,
+    QUILT_SEAMS,
+    QUILT_SELECTIONS,
+    SAME,
+    TILE_SIZES,
+    Param,
+)
+
+__all__ = [
+    "ANY",
+    "AUTO",
+    "BY_KEY",
+    "DEFAULTS",
+    "GROUPS",
+    "PARAMS",
+    "QUILT_SEAMS",
+    "QUILT_SELECTIONS",
+    "Param",
+    "auto_tile_size",
+    "coerce_all",
+    "fit_to_source",
+    "output_shape",
+    "seam_option_keys",
+    "seam_options",
+    "seam_spec",
+    "tileset_settings",
+    "ui_words",
+]
 
 SEAM_METHODS = METHODS
 BLENDS = BLEND_MODES
-SAME = "same"  # template_blend: as the patches' blending
-QUILT_SELECTIONS = ("best", "sampled", "random", "bhatia")
-QUILT_SEAMS = ("straight", *SEAM_METHODS)
-
-
-@dataclass(frozen=True)
-class Param:
-    key: str
-    default: Any
-    label: str
-    tip: str
-    group: str
-    minimum: float | None = None
-    maximum: float | None = None
-    choices: tuple = ()
-    step: float = 1
-    decimals: int = 2
-    special: str = ""  # shown instead of the minimum (e.g. "auto" where 0 means the default)
-
-    @property
-    def kind(self) -> type:
-        return type(self.default)
-
-    def coerce(self, value: Any) -> Any:
-        """``value`` converted to this parameter's type and clamped; ValueError if invalid."""
-        if self.choices:
-            if value not in self.choices:
-                raise ValueError(
-                    f"{self.key} must be one of {', '.join(map(str, self.choices))}, got {value!r}"
-                )
-            return value
-        if isinstance(self.default, bool):
-            return bool(value)
-        if isinstance(self.default, str):
-            text = str(value).strip()
-            if text and not re.fullmatch(r"#[0-9a-fA-F]{6}", text):
-                raise ValueError(f"{self.key} must be a colour like #336699, got {value!r}")
-            return text.lower()
-        v = self.kind(value)
-        if self.minimum is not None:
-            v = max(self.kind(self.minimum), v)
-        if self.maximum is not None:
-            v = min(self.kind(self.maximum), v)
-        return v
-
-
-_P = Param
-PARAMS: tuple[Param, ...] = (
-    # -- template search
-    _P(
-        "tile_min",
-        64,
-        "Tile min",
-        "Smallest tile side the template search may choose (px).",
-        "Template",
-        8,
-        4096,
-    ),
-    _P(
-        "tile_max",
-        192,
-        "Tile max",
-        "Largest tile side the template search may choose (px).",
-        "Template",
-        8,
-        4096,
-    ),
-    _P(
-        "overlap",
-        16,
-        "Overlap w_T",
-        "Width of the border regions R_L/R_R and R_T/R_B that are "
-        "matched and stitched (px). About 1/10 of the tile.",
-        "Template",
-        2,
-        256,
-    ),
-    _P(
-        "joint_weight",
-        TilesetSettings().joint_weight,
-        "Joint weight",
-        "Weight of the tile's natural wrap joint in the template search: the tile edge falls "
-        "where the texture is calm (0 = strip mismatch only, as in the paper).",
-        "Template",
-        0.0,
-        4.0,
-        step=0.1,
-    ),
-    # -- seam
-    _P(
-        "method",
-        "dp",
-        "Seam method",
-        "How the minimum-error seam through each overlap is found:\n"
-        "dp: dynamic programming, one pixel per row (Efros & Freeman)\n"
-        "dijkstra: shortest path, may wind\n"
-        "minimax: smallest worst error, then sum (Long & Mould)\n"
-        "oscillating: anytime control-point search (Somol & Haindl)\n"
-        "resistance: minimum resistance cut line (Bhatia)",
-        "Seam",
-        choices=SEAM_METHODS,
-    ),
-    _P(
-        "metric",
-        "euclid",
-        "Error metric",
-        "Per-pixel error between the overlapping regions.",
-        "Seam",
-        choices=METRICS,
-    ),
-    _P(
-        "blend",
-        "adaptive",
-        "Blending",
-        "After the cut: none (hard cut), feather (fixed width) or "
-        "adaptive (width follows the error along the seam, parameter rho).",
-        "Seam",
-        choices=BLENDS,
-    ),
-    _P(
-        "width",
-        4,
-        "Feather width",
-        "Width of the feather ramp across the seam (px).",
-        "Seam",
-        0,
-        64,
-    ),
-    _P("rho", 3, "rho", "Adaptive blending strength (Somol & Haindl, default 3).", "Seam", 0, 16),
-    _P(
-        "template_blend",
-        SAME,
-        "Template blending",
-        "Blending of the seamless tile's two cuts: the same as the patches' (Blending above), "
-        "or its own (quilt-studio tileset leaves the template's cuts hard by default).",
-        "Seam",
-        choices=(SAME, *BLEND_MODES),
-    ),
-    # -- candidates
-    _P(
-        "n_candidates",
-        30,
-        "Candidates",
-        "How many variant tiles 'Generate' makes.",
-        "Candidates",
-        1,
-        500,
-    ),
-    _P(
-        "patch_size",
-        0,
-        "Patch size",
-        "Side of the patch stitched into each candidate (px); 0 = the tile size.",
-        "Candidates",
-        0,
-        4096,
-        special="auto",
-    ),
-    _P(
-        "patch_overlap",
-        0,
-        "Patch ring w_P",
-        "Width of the ring along the tile border in which the closed patch seam runs (px).\n"
-        "auto (0): half the template overlap w_T, at least 8 px and at most w_T, as the "
-        "tileset command does (w_T 16 -> 8 px, w_T 26 -> 13 px).\nEverything outside the "
-        "seam is the template, the same in every tile: a narrower ring shows less of a grid "
-        "in the preview but leaves the seam less room (higher seam error).",
-        "Candidates",
-        0,
-        256,
-        special="auto",
-    ),
-    _P(
-        "margin",
-        2,
-        "Margin",
-        "Outer pixels of every tile that always stay the template's, so all tiles connect (px).",
-        "Candidates",
-        0,
-        32,
-    ),
-    _P(
-        "neighbourhood",
-        5,
-        "Neighbourhood",
-        "Random patch positions are refined within this many pixels.",
-        "Candidates",
-        0,
-        64,
-    ),
-    _P(
-        "seed",
-        1,
-        "Seed",
-        "Random seed of the candidates (same seed, same tiles).",
-        "Candidates",
-        0,
-        2**31 - 1,
-    ),
-    # -- preview
-    _P("preview_rows", 6, "Rows", "Rows of tiles in the preview.", "Preview", 1, 64),
-    _P("preview_cols", 6, "Columns", "Columns of tiles in the preview.", "Preview", 1, 64),
-    _P(
-        "no_equal_neighbours",
-        True,
-        "No equal neighbours",
-        "Never put the same tile next to itself in the preview layout.",
-        "Preview",
-    ),
-    _P(
-        "layout_seed",
-        1,
-        "Layout seed",
-        "Random seed of the preview layout (Re-roll changes it).",
-        "Preview",
-        0,
-        2**31 - 1,
-    ),
-    # -- quilting / transfer
-    # fmt: off
-    _P(
-        "out_width",
-        384,
-        "Output width",
-        "Width of the synthesized texture (px).",
-        "Quilting",
-        16,
-        8192,
-    ),
-    _P(
-        "out_height",
-        384,
-        "Output height",
-        "Height of the synthesized texture (px).",
-        "Quilting",
-        16,
-        8192,
-    ),
-    _P(
-        "block",
-        48,
-        "Block",
-        "Block size B (px): must capture the texture's structures.",
-        "Quilting",
-        4,
-        1024,
-    ),
-    _P(
-        "q_overlap",
-        0,
-        "Overlap",
-        "Overlap between blocks (px); 0 = the method's default "
-        "(block / 6; block / 2 for minimax; block / 4 as Bhatia's cut band).",
-        "Quilting",
-        0,
-        512,
-        special="auto",
-    ),
-    _P(
-        "select",
-        "best",
-        "Selection",
-        "best: among the blocks within the tolerance of the best "
-        "overlap match (Efros & Freeman, exhaustive FFT search)\nsampled: best of N random "
-        "blocks (CS194, Core S2)\nrandom: any block\nbhatia: random blocks with extensions cut "
-        "by minimum resistance lines (Bhatia)",
-        "Quilting",
-        choices=QUILT_SELECTIONS,
-    ),
-    _P(
-        "tolerance",
-        0.1,
-        "Tolerance",
-        "best: draw among blocks whose overlap error is within (1 + tolerance) of the best.",
-        "Quilting",
-        0.0,
-        2.0,
-        step=0.05,
-    ),
-    _P(
-        "q_candidates",
-        0,
-        "Candidates",
-        "sampled: random blocks tried per position; fast mode: "
-        "blocks re-ranked exactly (0 = default: 200 / 32).",
-        "Quilting",
-        0,
-        100_000,
-        special="auto",
-    ),
-    _P(
-        "q_mode",
-        "exact",
-        "Search",
-        "exact: exhaustive FFT search; fast: principal-component "
-        "ranking, exact re-ranking of the best candidates.",
-        "Quilting",
-        choices=("exact", "fast"),
-    ),
-    _P(
-        "q_method",
-        "dp",
-        "Seam method",
-        "The cut between blocks: straight (no cut) or a seam method.",
-        "Quilting",
-        choices=QUILT_SEAMS,
-    ),
-    _P(
-        "q_metric",
-        "ssd",
-        "Error metric",
-        "Error map the cut runs on (the block search always uses the SSD).",
-        "Quilting",
-        choices=METRICS,
-    ),
-    _P(
-        "q_blend",
-        "none",
-        "Blending",
-        "Softening of the cut: none, feather (fixed width) or adaptive (rho).",
-        "Quilting",
-        choices=BLENDS,
-    ),
-    _P("q_width", 4, "Feather width", "Feather width across block seams (px).", "Quilting", 0, 64),
-    _P("q_rho", 3, "rho", "Adaptive blending strength across block seams.", "Quilting", 0, 16),
-    _P(
-        "adaptive_threshold",
-        0.0,
-        "Split above",
-        "Split a block in four when its best overlap "
-        "error (mean squared difference per pixel and channel) exceeds this; 0 = never.",
-        "Quilting",
-        0.0,
-        1.0,
-        step=0.005,
-        decimals=3,
-    ),
-    _P(
-        "min_block",
-        0,
-        "Min block",
-        "Smallest block when splitting (0 = default).",
-        "Quilting",
-        0,
-        1024,
-        special="auto",
-    ),
-    _P(
-        "tileable",
-        False,
-        "Tileable output",
-        "Wrap-around overlaps on the last column and row: the output tiles seamlessly.",
-        "Quilting",
-    ),
-    _P("q_seed", 1, "Seed", "Random seed of the synthesis.", "Quilting", 0, 2**31 - 1),
-    # -- excluded source pixels: template search, candidates and quilting
-    _P(
-        "exclude_color",
-        "",
-        "Excluded colour",
-        "#rrggbb of a source colour never to use: no tile rectangle, patch or quilting block "
-        "contains it (Ctrl+Shift+click the source to pick it; Ctrl+click in the Quilting "
-        "tab); empty = none.",
-        "Exclusion",
-    ),
-    _P(
-        "exclude_tolerance",
-        0.0,
-        "Exclude colour ±",
-        "Never use source pixels within this distance of the picked colour (per channel); 0 = off.",
-        "Exclusion",
-        0.0,
-        0.5,
-        step=0.01,
-    ),
-    _P(
-        "brush",
-        8,
-        "Brush radius",
-        "Radius of the exclusion brush: Shift+drag on the source (or the Quilting tab's "
-        "sample) paints pixels never to use, Shift+right-drag erases.",
-        "Exclusion",
-        1,
-        256,
-    ),
-    # -- options of the seam methods (shared by the tile set and quilting)
-    _P(
-        "o_max",
-        3,
-        "o_max",
-        "oscillating: largest block of control points moved at once.",
-        "Seam options",
-        1,
-        64,
-    ),
-    _P(
-        "osc_variant",
-        "resume",
-        "Oscillating variant",
-        "oscillating: resume (continue from the "
-        "last improvement) or faithful (restart the sweep, as in the paper).",
-        "Seam options",
-        choices=OSCILLATING_VARIANTS,
-    ),
-    _P(
-        "osc_init",
-        "dp",
-        "Oscillating start",
-        "oscillating: the path the search starts from. dp: the exact one-pixel-per-row cut "
-        "(default; ends within a few % of the optimum); argmin: each row's smallest error, as "
-        "in the paper (Somol & Haindl; with 'faithful' this is the published algorithm, which "
-        "ends 30-60 % above the optimum on real overlaps); smoothed: argmin of a blurred map.",
-        "Seam options",
-        choices=("dp", "argmin", "smoothed"),
-    ),
-    _P(
-        "resistance_variant",
-        "published",
-        "Resistance variant",
-        "resistance: published (Bhatia's two lines from the overlap's corners, the second "
-        "stopping where it meets the first, as in the paper) or walk (one greedy walk from the "
-        "top row down).",
-        "Seam options",
-        choices=("published", "walk"),
-    ),
-    _P(
-        "max_run",
-        5,
-        "Max run",
-        "resistance: longest straight run of a cut line (px; 5 in Bhatia's figure).",
-        "Seam options",
-        1,
-        256,
-    ),
-    _P(
-        "connectivity",
-        "8",
-        "Connectivity",
-        "dijkstra, minimax: pixel neighbours of the path graph.",
-        "Seam options",
-        choices=("8", "4"),
-    ),
-    _P(
-        "minimax_variant",
-        "exact",
-        "Minimax variant",
-        "minimax: exact (smallest peak, then sum), lm (Long & Mould) or sorted.",
-        "Seam options",
-        choices=MINIMAX_VARIANTS,
-    ),
-    _P(
-        "levels",
-        32,
-        "Minimax levels",
-        "minimax: error quantisation levels.",
-        "Seam options",
-        2,
-        1024,
-    ),
-    _P(
-        "alpha_ramp",
-        True,
-        "Ramp alpha",
-        "Texture transfer: alpha rises from 0.1 to 0.9 over the iterations (Efros & Freeman); "
-        "off: the fixed alpha below in every iteration.",
-        "Transfer",
-    ),
-    _P(
-        "alpha",
-        0.5,
-        "Alpha",
-        "Texture transfer: weight of the texture match (overlap and previous iteration) against "
-        "the target correspondence (1 = plain quilting, 0 = only follow the target).",
-        "Transfer",
-        0.0,
-        1.0,
-        step=0.05,
-    ),
-    _P(
-        "iterations",
-        3,
-        "Iterations",
-        "Texture transfer passes, each with a block 2/3 the size.",
-        "Transfer",
-        1,
-        8,
-    ),
-    _P(
-        "correspondence",
-        "luminance",
-        "Correspondence",
-        "What is matched against the target: its luminance, or its luminance blurred by sigma.",
-        "Transfer",
-        choices=("luminance", "blurred"),
-    ),
-    _P(
-        "sigma",
-        2.0,
-        "Blur sigma",
-        "Gaussian blur of the blurred correspondence map (px).",
-        "Transfer",
-        0.5,
-        16.0,
-        step=0.5,
-        decimals=1,
-    ),
-    # fmt: on
-)
 
 BY_KEY: dict[str, Param] = {p.key: p for p in PARAMS}
 GROUPS: tuple[str, ...] = tuple(dict.fromkeys(p.group for p in PARAMS))
@@ -547,6 +63,8 @@ SEAMLESS_KEYS = (
     frozenset({"overlap", "method", "metric", "blend", "width", "rho", "template_blend"})
     | SEAM_OPTION_KEYS
 )
+#: Parameters whose change means a new tile size: the template search runs again.
+TILE_SIZE_KEYS = frozenset({"tile_size", "tile_min", "tile_max"})
 PREVIEW_KEYS = frozenset({"preview_rows", "preview_cols", "no_equal_neighbours", "layout_seed"})
 #: Parameters whose change re-runs a shown quilting / transfer result (the brush only paints).
 QUILT_KEYS = frozenset(
@@ -604,7 +122,7 @@ def seam_options(p: dict, method: str) -> dict:
 _RENAMED = {"n_candidates": "candidates"}
 #: editor parameters that make up one settings field (or its seam)
 _COMPOSED = frozenset(
-    {"method", "metric", "blend", "width", "rho", "template_blend"}
+    {"tile_size", "method", "metric", "blend", "width", "rho", "template_blend"}
     | {"preview_rows", "preview_cols", "exclude_color", "exclude_tolerance"}
 )
 _FIELDS = {f.name for f in dataclasses.fields(TilesetSettings)}
@@ -612,14 +130,74 @@ _FIELDS = {f.name for f in dataclasses.fields(TilesetSettings)}
 TILESET_KEYS = frozenset(k for k in BY_KEY if k in _FIELDS or k in _RENAMED or k in _COMPOSED) - {
     "exclude_color",
     "exclude_tolerance",
+    "tile_size",  # kept as the editor's own too: "auto" is resolved for the source at hand
 }
 
 
-def tileset_settings(p: dict) -> TilesetSettings:
-    """The :class:`engine.tiles.TilesetSettings` of the editor's parameters ``p``."""
+def auto_tile_size(shape) -> int | None:
+    """The "Auto" tile size for a source of ``shape`` (H, W): the largest power of two of
+    64 … 2048 px that is at most half the shorter side; None (search a range) for a source
+    under 128 px."""
+    half = min(int(shape[0]), int(shape[1])) // 2
+    fits = [int(s) for s in TILE_SIZES if int(s) <= half]
+    return fits[-1] if fits else None
+
+
+def tile_size(p: dict, shape=None) -> int | None:
+    """The square tile side the parameters ask for (None: the search chooses the size)."""
+    if p["tile_size"] == ANY:
+        return None
+    if p["tile_size"] == AUTO:
+        return None if shape is None else auto_tile_size(shape)
+    return int(p["tile_size"])
+
+
+def fit_to_source(p: dict, shape) -> dict:
+    """The sizes in ``p`` that cannot work on a source of ``shape`` (H, W), set back to their
+    automatic value (a new image smaller than the last one's tile must not fail)."""
+    short = min(int(shape[0]), int(shape[1]))
+    changes = {}
+    if p["tile_size"] not in (AUTO, ANY) and int(p["tile_size"]) > short - 2:
+        changes["tile_size"] = AUTO
+    for key, limit in (
+        ("tile_min", short - 2),
+        ("tile_max", short - 2),
+        ("overlap", short // 4),
+        ("patch_size", short - 2),
+    ):
+        if p[key] > max(limit, 0):
+            changes[key] = 0
+    if p["block"] > short:
+        changes["block"] = max(BY_KEY["block"].minimum, short // 2)
+    return changes
+
+
+#: the largest side of an Auto quilting output
+MAX_AUTO_OUTPUT = 2048
+
+
+def output_shape(p: dict, source_shape) -> tuple[int, int]:
+    """(height, width) of the quilting output: the parameters, or (auto) twice the source,
+    at most :data:`MAX_AUTO_OUTPUT` a side."""
+    H, W = int(source_shape[0]), int(source_shape[1])
+    return (
+        int(p["out_height"]) or min(2 * H, MAX_AUTO_OUTPUT),
+        int(p["out_width"]) or min(2 * W, MAX_AUTO_OUTPUT),
+    )
+
+
+def tileset_settings(p: dict, shape=None) -> TilesetSettings:
+    """The :class:`engine.tiles.TilesetSettings` of the editor's parameters ``p`` (``shape``
+    (H, W) of the source settles the Auto tile size; without it Auto searches a range)."""
     values = {_RENAMED.get(k, k): p[k] for k in BY_KEY if _RENAMED.get(k, k) in _FIELDS}
+    lo, hi = p["tile_min"] or None, p["tile_max"] or None
+    if lo is not None and hi is not None:
+        hi = max(lo, hi)
     values.update(
-        tile_max=max(p["tile_min"], p["tile_max"]),
+        tile_size=tile_size(p, shape),
+        tile_min=lo,
+        tile_max=hi,
+        overlap=p["overlap"] or None,
         seam=seam_spec(p),
         template_blend=None if p["template_blend"] == SAME else p["template_blend"],
         patch_size=p["patch_size"] or None,
@@ -644,7 +222,12 @@ def settings_params(s: TilesetSettings) -> dict:
             if value is not None:
                 out[k] = value
     seam = s.seam
+    size = s.tile_size or (
+        s.tile_min if s.tile_min is not None and s.tile_min == s.tile_max else None
+    )
+    square = size is not None and size[0] == size[1] and str(size[0]) in TILE_SIZES
     out.update(
+        tile_size=str(size[0]) if square else ANY,
         method=seam.method,
         metric=seam.metric,
         blend=seam.blend,
@@ -663,10 +246,11 @@ def settings_params(s: TilesetSettings) -> dict:
     return out
 
 
-def project_parameters(p: dict) -> dict:
-    """A project's ``parameters``: the tile set's settings and the editor's own parameters."""
+def project_parameters(p: dict, shape=None) -> dict:
+    """A project's ``parameters``: the tile set's settings (for a source of ``shape``) and the
+    editor's own parameters."""
     return {
-        "tileset": tileset_settings(p).to_dict(),
+        "tileset": tileset_settings(p, shape).to_dict(),
         "editor": {k: v for k, v in p.items() if k not in TILESET_KEYS},
     }
 
@@ -680,7 +264,24 @@ def from_project_parameters(parameters: dict, seeds: dict | None = None) -> dict
     for k, v in settings_params(settings).items():
         with contextlib.suppress(TypeError, ValueError):
             out[k] = BY_KEY[k].coerce(v)
+    if isinstance(own, dict) and own.get("tile_size") == AUTO:
+        out["tile_size"] = AUTO  # the settings hold the size Auto chose for that source
     return out
+
+
+#: names in the engine's messages -> the words on screen: the identifiers only (a plain word
+#: such as "overlap" or "width" is left alone, it may mean something else in the sentence)
+_UI_NAMES = {
+    p.key: p.label for p in PARAMS if "_" in p.key and not p.key.startswith(("q_", "osc_"))
+} | {"rho": BY_KEY["rho"].label, "blend_width": BY_KEY["q_width"].label}
+
+
+def ui_words(text: str) -> str:
+    """``text`` (an engine message) with parameter names replaced by the labels on screen:
+    "tile_min must be ..." reads "Smallest tile must be ..."."""
+    names = sorted(_UI_NAMES, key=len, reverse=True)
+    pattern = r"(?<![\w./])(" + "|".join(map(re.escape, names)) + r")(?![\w/])"
+    return re.sub(pattern, lambda m: f"“{_UI_NAMES[m.group(1)]}”", text)
 
 
 def _option_key(option: str, method: str) -> str:

@@ -52,6 +52,7 @@ class Pipeline(QObject):
         self.seamless_inputs = None  # the inputs doc.tileset.seamless was computed from
         self._seamless_pending = None
         self._template_old_rect = None
+        self._auto_size: int | None = None  # the Auto tile size being searched
         self._seamless_timer = _soon(self, self._start_seamless)
         doc.source_changed.connect(self._on_source_changed)
         doc.maps_changed.connect(self.schedule_seamless)
@@ -72,7 +73,7 @@ class Pipeline(QObject):
 
     # ------------------------------------------------------------------ helpers
     def _error(self, exc: BaseException) -> None:
-        self.message.emit("error", error_text(exc))
+        self.message.emit("error", params.ui_words(error_text(exc)))
 
     @Slot()
     def _on_source_changed(self) -> None:
@@ -84,6 +85,9 @@ class Pipeline(QObject):
 
     @Slot(object)
     def _on_params_changed(self, keys) -> None:
+        if keys & params.TILE_SIZE_KEYS and self.doc.source is not None and len(keys) < 4:
+            self.find_template()  # a new tile size: search where it sits (not on a reset)
+            return
         if keys & params.SEAMLESS_KEYS:
             if "overlap" in keys and self.doc.tileset.template_rect is not None:
                 clamped = self.doc.tileset.clamp_rect(self.doc.tileset.template_rect)
@@ -123,8 +127,11 @@ class Pipeline(QObject):
         return bool(self.jobs.running() or any(t.isActive() for t in timers))
 
     # ------------------------------------------------------------------ template search
-    def find_template(self) -> jobs.Job | None:
-        """Search the best tile rectangle; the rectangle animates as the search improves."""
+    def find_template(self, *, size: int | None = None) -> jobs.Job | None:
+        """Search the best tile rectangle; the rectangle animates as the search improves.
+
+        ``size``: a square tile side instead of the parameters' (the Auto size retries with
+        half the side when no tile of its size fits outside the excluded pixels)."""
         from engine.tiles import iter_find_template
 
         doc = self.doc
@@ -132,7 +139,13 @@ class Pipeline(QObject):
             self.message.emit("warning", "Open a source image first.")
             return None
         s = self.settings()
-        self._template_old_rect = doc.tileset.template_rect
+        if size is not None:
+            s = s.replace(tile_size=size)
+        auto = doc.params["tile_size"] == params.AUTO and s.tile_size is not None
+        self._auto_size = s.tile_size[0] if auto else None
+        if size is None:
+            self._template_old_rect = doc.tileset.template_rect
+        lo, hi = s.tile_range(doc.source.shape)
         self.template_searching.emit(True)
         return self.jobs.start(
             "template",
@@ -140,9 +153,9 @@ class Pipeline(QObject):
             doc.source.main,
             label="Finding the best tile",
             exclusion=self.exclusion(),
-            tile_min=s.tile_min,
-            tile_max=s.tile_max,
-            overlap=s.overlap,
+            tile_min=lo,
+            tile_max=hi,
+            overlap=s.overlap or doc.tileset.overlap(),
             joint_weight=s.joint_weight,
             on_event=self._on_template_event,
             on_done=self._on_template_done,
@@ -168,6 +181,10 @@ class Pipeline(QObject):
         self.template_searching.emit(False)
 
     def _on_template_error(self, exc) -> None:
+        size = self._auto_size
+        if size is not None and size > 64 and isinstance(exc.__cause__ or exc, ValueError):
+            self.find_template(size=size // 2)  # Auto: the next smaller square that fits
+            return
         self._restore_template_rect()
         self._error(exc)
 
@@ -188,7 +205,7 @@ class Pipeline(QObject):
             return None
         wps = {k: list(v) for k, v in doc.tileset.waypoints.items() if v}
         kwargs = dict(
-            overlap=doc.params["overlap"],
+            overlap=doc.tileset.overlap(),
             waypoints=wps or None,
             seam=self.seam_spec(),
             **self._maps(),
@@ -256,7 +273,7 @@ class Pipeline(QObject):
 
     def settings(self):
         """The tile set's :class:`engine.tiles.TilesetSettings`, from the parameters."""
-        return params.tileset_settings(self.doc.params)
+        return self.doc.tileset.settings()
 
     def seam_spec(self):
         """The seamless tile's cut (the candidates' is ``settings().seam``)."""
@@ -471,7 +488,7 @@ class Pipeline(QObject):
             return None
         self._quilt_mode = "quilt"
         p = doc.params
-        shape = (int(p["out_height"]), int(p["out_width"]))
+        shape = params.output_shape(p, doc.source.shape)
         doc.quilting.start(shape)
         return self.jobs.start(
             "quilt",

@@ -44,7 +44,7 @@ def to_project(doc) -> Project:
         map_kinds=dict(doc.source.kinds),
         map_weights={k: v for k, v in ts.map_weights.items() if k in doc.source.maps},
         bit_depth=doc.source.bit_depth,
-        parameters=params.project_parameters(doc.params),
+        parameters=params.project_parameters(doc.params, doc.source.shape),
         seeds={"candidates": doc.params["seed"], "layout": doc.params["layout_seed"]},
         template_rect=ts.template_rect,
         template=template,

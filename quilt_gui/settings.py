@@ -31,6 +31,7 @@ DEFAULTS: dict[str, Any] = {
     "heat_overlay": True,
     "preview_grid": False,
     "thumbnail_size": 112,
+    "params_view": "Basic",  # the parameters panel's view: "Basic" or "Advanced"
     "parameters": {},  # the last used tile-set / quilting parameters (JSON-able dict)
 }
 

@@ -15,7 +15,7 @@ import numpy as np
 from PySide6.QtCore import QObject, Signal
 
 from engine.candidate import CandidateTile
-from quilt_gui import commands
+from quilt_gui import commands, params
 from quilt_gui.model import WAYPOINT_KEYS
 
 
@@ -102,6 +102,20 @@ class TileSetDocument(QObject):
             and not (self.connects_to_template(self.candidates[0]))
         )
 
+    def settings(self):
+        """The tile set's :class:`engine.settings.TilesetSettings` for the source at hand."""
+        source = self.root.source
+        return params.tileset_settings(self.root.params, None if source is None else source.shape)
+
+    def overlap(self) -> int:
+        """w_T, the Seam search width: the parameter, or (auto) about a tenth of the tile."""
+        from engine.tiles.pipeline import resolve
+
+        source = self.root.source
+        if self.root.params["overlap"] or source is None:
+            return int(self.root.params["overlap"]) or 16
+        return int(resolve(self.settings(), source.shape).overlap)
+
     def clamp_rect(self, rect) -> tuple[int, int, int, int]:
         """``rect`` (x, y, w, h) moved and shrunk so its footprint (the rectangle plus the
         overlap to the right and below) lies inside the source."""
@@ -110,7 +124,7 @@ class TileSetDocument(QObject):
         if source is None:
             return x, y, max(1, w), max(1, h)
         H, W = source.shape
-        e = min(int(self.root.params["overlap"]), max(0, min(H, W) - 1))
+        e = min(self.overlap(), max(0, min(H, W) - 1))
         w, h = max(1, min(w, W - e)), max(1, min(h, H - e))
         x, y = min(max(0, x), W - e - w), min(max(0, y), H - e - h)
         return x, y, w, h

@@ -225,7 +225,7 @@ class OverlapPanel(QWidget):
     def current_frame(self) -> tuple | None:
         """(rect, w_T) of the document's tile rectangle: what live seams belong to."""
         rect = self.doc.tileset.template_rect
-        return None if rect is None else (tuple(rect), int(self.doc.params["overlap"]))
+        return None if rect is None else (tuple(rect), self.doc.tileset.overlap())
 
     def _show_live_frame(self, update, frame) -> None:
         """Show the overlap a running job's update belongs to, from the regions and error

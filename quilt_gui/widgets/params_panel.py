@@ -11,6 +11,7 @@ from functools import partial
 
 from PySide6.QtCore import Qt, Slot
 from PySide6.QtWidgets import (
+    QButtonGroup,
     QCheckBox,
     QComboBox,
     QDoubleSpinBox,
@@ -29,9 +30,10 @@ from PySide6.QtWidgets import (
 from superqt import QLabeledDoubleSlider, QLabeledSlider
 from superqt.utils import signals_blocked
 
-from quilt_gui import params
+from quilt_gui import params, settings
 from quilt_gui.commands import new_merge_id
 from quilt_gui.document import Document
+from quilt_gui.param_table import ADVANCED, BASIC
 
 #: Integer parameters edited with a slider (the rest use spin boxes).
 SLIDERS = frozenset(
@@ -50,8 +52,8 @@ SLIDERS = frozenset(
 )
 MATERIALS = "Material maps"
 TILESET_GROUPS = (
-    "Template",
-    "Seam",
+    "Tile",
+    "Seams",
     MATERIALS,
     "Seam options",
     "Candidates",
@@ -59,17 +61,23 @@ TILESET_GROUPS = (
     "Exclusion",
 )
 QUILT_GROUPS = ("Quilting", "Exclusion", "Seam options", "Transfer")
+VIEWS = (BASIC, ADVANCED)
 
 
-class ParamsPanel(QScrollArea):
-    """Group boxes of parameter widgets plus the actions of each step."""
+class ParamsPanel(QWidget):
+    """Group boxes of parameter widgets plus the actions of each step, in a Basic view (what
+    most photos need) or an Advanced one (everything), and a Reset to defaults."""
 
     def __init__(self, doc: Document, actions: dict[str, list] | None = None, parent=None) -> None:
         super().__init__(parent)
         self.doc = doc
         self.widgets: dict[str, QWidget] = {}
+        self.labels: dict[str, QLabel] = {}
         self.groups: dict[str, QGroupBox] = {}
+        self._forms: dict[str, QFormLayout] = {}
+        self._has_actions: set[str] = set()
         self._merge: dict[str, int] = {}
+        self._shown: tuple = TILESET_GROUPS
         body = QWidget()
         lay = QVBoxLayout(body)
         lay.setContentsMargins(6, 6, 6, 6)
@@ -82,13 +90,15 @@ class ParamsPanel(QScrollArea):
                 if p.group != group:
                     continue
                 w = self._make_widget(p)
-                w.setToolTip(p.tip)
+                w.setToolTip(p.tooltip)
                 label = QLabel(p.label)
-                label.setToolTip(p.tip)
+                label.setToolTip(p.tooltip)
                 form.addRow(label, w)
                 self.widgets[p.key] = w
+                self.labels[p.key] = label
             buttons = (actions or {}).get(group, [])
             if buttons:
+                self._has_actions.add(group)
                 row = QHBoxLayout()
                 for action in buttons:
                     b = QToolButton()
@@ -99,27 +109,91 @@ class ParamsPanel(QScrollArea):
                 form.addRow(row)
             lay.addWidget(box)
             self.groups[group] = box
-            if group == "Seam":
+            self._forms[group] = form
+            if group == "Seams":
                 self.materials = MaterialWeights(doc)
                 lay.addWidget(self.materials)
                 self.groups[MATERIALS] = self.materials
         lay.addStretch(1)
-        self.setWidget(body)
+        self.scroll = QScrollArea()
+        self.scroll.setWidget(body)
+        self.scroll.setWidgetResizable(True)
+        self.scroll.setHorizontalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+        self.scroll.setFrameShape(QScrollArea.Shape.NoFrame)
+        bar = QHBoxLayout()
+        bar.setContentsMargins(6, 4, 6, 0)
+        self.view_buttons = QButtonGroup(self)
+        for i, name in enumerate(VIEWS):
+            b = QToolButton()
+            b.setText(name)
+            b.setCheckable(True)
+            b.setToolTip("Only what most photos need" if name == BASIC else "Every parameter")
+            self.view_buttons.addButton(b, i)
+            bar.addWidget(b)
+        self.view_buttons.idClicked.connect(self._on_view_clicked)
+        bar.addStretch(1)
+        self.reset_button = QToolButton()
+        self.reset_button.setText("Reset to defaults")
+        self.reset_button.setToolTip(
+            "Every parameter shown here back to its default (Auto sizes follow the image); "
+            "one undo step"
+        )
+        self.reset_button.clicked.connect(self.reset_to_defaults)
+        bar.addWidget(self.reset_button)
+        outer = QVBoxLayout(self)
+        outer.setContentsMargins(0, 0, 0, 0)
+        outer.addLayout(bar)
+        outer.addWidget(self.scroll, 1)
         self.setMinimumWidth(body.sizeHint().width() + 24)
-        self.setWidgetResizable(True)
-        self.setHorizontalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
         self._quilting = False
+        self.view = settings.get("params_view") if settings.get("params_view") in VIEWS else BASIC
+        self.view_buttons.button(VIEWS.index(self.view)).setChecked(True)
         doc.params_changed.connect(self._on_params_changed)
         self._on_params_changed(frozenset(params.DEFAULTS))
 
+    # ------------------------------------------------------------------ what is shown
     def show_groups(self, groups) -> None:
         """Show only these groups (the tile-set or the quilting mode)."""
-        for name, box in self.groups.items():
-            box.setVisible(name in groups)
+        self._shown = tuple(groups)
         self.materials.wanted = MATERIALS in groups
         self.materials.refresh()
         self._quilting = "Quilting" in groups
+        self._apply_view()
         self._enable_seam_options()
+
+    def set_view(self, view: str) -> None:
+        """Basic (the parameters most photos need) or Advanced (every parameter)."""
+        self.view = view
+        self.view_buttons.button(VIEWS.index(view)).setChecked(True)
+        settings.set("params_view", view)
+        self._apply_view()
+
+    @Slot(int)
+    def _on_view_clicked(self, index: int) -> None:
+        self.set_view(VIEWS[index])
+
+    def _apply_view(self) -> None:
+        basic = self.view == BASIC
+        for p in params.PARAMS:
+            self._forms[p.group].setRowVisible(self.widgets[p.key], p.basic or not basic)
+        for name, box in self.groups.items():
+            if name == MATERIALS:
+                continue
+            has_basic = any(p.basic for p in params.PARAMS if p.group == name)
+            wanted = not basic or has_basic or name in self._has_actions
+            box.setVisible(name in self._shown and wanted)
+
+    def shown_keys(self) -> list[str]:
+        """The parameters on screen (tests, screenshots)."""
+        return [k for k, w in self.widgets.items() if w.isVisibleTo(self)]
+
+    @Slot()
+    def reset_to_defaults(self) -> None:
+        """The parameters of the shown groups back to their defaults, as one undo step."""
+        keys = [p.key for p in params.PARAMS if p.group in self._shown and p.key != "brush"]
+        self.doc.set_params(
+            {k: params.DEFAULTS[k] for k in keys}, text="Reset parameters to defaults"
+        )
 
     def _enable_seam_options(self) -> None:
         """Only the options in use are editable: those of the seam method of the mode, the
@@ -136,8 +210,17 @@ class ParamsPanel(QScrollArea):
                 unused[width] = "only for feather blending"
             if p[blend] != "adaptive":
                 unused[rho] = "only for adaptive blending"
-        for key in params.SEAM_OPTION_KEYS | {"width", "rho", "q_width", "q_rho"}:
-            w, tip = self.widgets[key], params.BY_KEY[key].tip
+        if p["tile_size"] != params.ANY:
+            unused["tile_min"] = unused["tile_max"] = "only for Tile size Any"
+        for key in (
+            params.SEAM_OPTION_KEYS
+            | {"width", "rho", "q_width", "q_rho"}
+            | {
+                "tile_min",
+                "tile_max",
+            }
+        ):
+            w, tip = self.widgets[key], params.BY_KEY[key].tooltip
             w.setEnabled(key not in unused)
             w.setToolTip(f"{tip}\n({unused[key]})" if key in unused else tip)
 
@@ -146,8 +229,11 @@ class ParamsPanel(QScrollArea):
         key = p.key
         if p.choices:
             w = QComboBox()
-            w.addItems([str(c) for c in p.choices])
-            w.currentTextChanged.connect(partial(self._edit, key))
+            w.setSizeAdjustPolicy(QComboBox.SizeAdjustPolicy.AdjustToMinimumContentsLengthWithIcon)
+            w.setMinimumContentsLength(12)  # long choice names must not widen the panel
+            for c in p.choices:
+                w.addItem(p.choice_label(c), c)
+            w.currentIndexChanged.connect(partial(self._edit_choice, key, w))
             return w
         if isinstance(p.default, bool):
             w = QCheckBox()
@@ -191,6 +277,9 @@ class ParamsPanel(QScrollArea):
         except ValueError:
             widget.setText(self.doc.params[key])  # not a colour: back to the valid value
 
+    def _edit_choice(self, key: str, widget: QComboBox, _index: int) -> None:
+        self._edit(key, widget.currentData())
+
     def _edit(self, key: str, value) -> None:
         self.doc.set_param(key, value, merge_id=self._merge.get(key))
 
@@ -198,7 +287,7 @@ class ParamsPanel(QScrollArea):
         """What the widget of ``key`` shows (for tests)."""
         w = self.widgets[key]
         if isinstance(w, QComboBox):
-            return w.currentText()
+            return w.currentData()
         if isinstance(w, QCheckBox):
             return w.isChecked()
         if isinstance(w, QLineEdit):
@@ -214,14 +303,14 @@ class ParamsPanel(QScrollArea):
             v = self.doc.params[key]
             with signals_blocked(w):
                 if isinstance(w, QComboBox):
-                    w.setCurrentText(str(v))
+                    w.setCurrentIndex(w.findData(v))
                 elif isinstance(w, QCheckBox):
                     w.setChecked(bool(v))
                 elif isinstance(w, QLineEdit):
                     w.setText(str(v))
                 else:
                     w.setValue(v)
-        if keys & {"method", "q_method", "blend", "q_blend"}:
+        if keys & {"method", "q_method", "blend", "q_blend", "tile_size"}:
             self._enable_seam_options()
 
 

@@ -135,7 +135,7 @@ class SourceView(ImageCanvas):
     @Slot()
     def _on_template_changed(self) -> None:
         rect = self.doc.tileset.template_rect
-        overlap = int(self.doc.params["overlap"])
+        overlap = self.doc.tileset.overlap()
         if rect is None:
             for item in (self.rect_item, *self.shades.values()):
                 item.hide()
@@ -158,7 +158,7 @@ class SourceView(ImageCanvas):
         return (
             s is not None
             and tuple(s.rect) == self.doc.tileset.template_rect
-            and s.overlap == self.doc.params["overlap"]
+            and s.overlap == self.doc.tileset.overlap()
         )
 
     @Slot()
@@ -272,7 +272,7 @@ class SourceView(ImageCanvas):
         rect = self.doc.tileset.template_rect
         if rect is None:
             return None
-        overlap = int(self.doc.params["overlap"])
+        overlap = self.doc.tileset.overlap()
         regions = region_rects(rect, overlap)
         x, y = rect[0], rect[1]
         for which, key in (("horizontal", "R_L"), ("vertical", "R_T")):

@@ -169,6 +169,8 @@ def test_waypoint_click_in_overlap_panel_steers_the_seam(qtbot, win):
     row = h // 2
     col = next(c for c in range(2, w - 2) if (row, c) not in path)
     ox, oy = view.offsets[2]  # the error-map panel
+    view.set_zoom(2.0)  # an integer zoom: the click lands on exactly this pixel
+    view.centerOn(QPointF(ox + col + 0.5, oy + row + 0.5))
     pos = view.mapFromScene(QPointF(ox + col + 0.5, oy + row + 0.5))
     qtbot.mouseClick(view.viewport(), Qt.MouseButton.LeftButton, pos=pos)
     assert win.doc.tileset.waypoints["horizontal"] == [(row, col)]
@@ -188,7 +190,7 @@ def test_live_seams_of_a_new_rectangle_are_drawn_on_both_its_overlaps(qtbot, win
     from quilt_gui.imaging import heat_rgba
 
     template(qtbot, win, (150, 120, 128, 112))
-    panel, ov = win.overlap_panel, win.doc.params["overlap"]
+    panel, ov = win.overlap_panel, win.doc.tileset.overlap()
     old = win.doc.tileset.seamless
     new = (60, 40, 100, 90)
     seen = []
@@ -394,10 +396,15 @@ def test_image_too_small_for_the_tile(qtbot, win, tmp_path):
     Image.fromarray(np.zeros((24, 24, 3), np.uint8) + 100).save(tiny)
     with qtbot.waitSignal(win.doc.source_changed, timeout=5000):
         win.files.open_path(str(tiny), confirm=False)
-    win.act_find.trigger()
+    win.doc.set_params({"tile_size": "any", "tile_min": 64, "tile_max": 64})
     wait_idle(qtbot, win)
-    assert "smaller than the minimum tile" in win.last_message("error")
+    error = win.last_message("error")
+    assert "smaller than the minimum tile" in error and "tile_min" not in error
     assert win.doc.tileset.template_rect is None
+    win.doc.set_params({"tile_min": 0, "tile_max": 0})  # automatic: scaled to the image
+    wait_idle(qtbot, win)
+    assert win.doc.tileset.template_rect is not None and win.doc.tileset.seamless is not None
+    win.doc.set_param("overlap", 8)
     win.doc.tileset.set_template_rect((0, 0, 10, 10))  # a hand-drawn rectangle too small for w_T
     wait_idle(qtbot, win)
     assert "at least 2*overlap" in win.last_message("error") and win.doc.tileset.seamless is None

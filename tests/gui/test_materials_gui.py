@@ -106,7 +106,7 @@ def test_seam_weights_of_the_maps_steer_the_cut_undo_and_survive_a_reopen(qtbot,
     expected = make_seamless(
         src.main,
         rect,
-        overlap=w.doc.params["overlap"],
+        overlap=w.doc.tileset.overlap(),
         seam=w.pipeline.seam_spec(),
         maps={"height": src.maps["height"]},
         weights={"main": 1.0, "height": 2.0},

@@ -45,7 +45,7 @@ def test_param_coercion():
     p = params.BY_KEY["overlap"]
     assert p.coerce(10_000) == p.maximum
     assert p.coerce("12") == 12
-    with pytest.raises(ValueError, match="method"):
+    with pytest.raises(ValueError, match="Seam shape"):
         params.BY_KEY["method"].coerce("nope")
     assert params.coerce_all({"overlap": 20, "bogus": 1, "method": "nope"})["overlap"] == 20
     assert params.coerce_all({"method": "nope"})["method"] == params.DEFAULTS["method"]
@@ -71,7 +71,7 @@ def test_slider_drag_is_one_undo_step(qtbot):
         doc.set_param("overlap", v, merge_id=mid)
     doc.set_param("rho", 5)
     assert doc.undo_stack.count() == 2
-    assert doc.undo_stack.text(0) == "Change Overlap w_T"  # the label, not the key
+    assert doc.undo_stack.text(0) == "Change Seam search width"  # the label, not the key
     doc.undo_stack.undo()
     doc.undo_stack.undo()
     assert doc.params["overlap"] == params.DEFAULTS["overlap"]
@@ -89,7 +89,7 @@ def test_rect_drag_merges_and_is_clamped():
     doc.tileset.set_template_rect(
         (500, -3, 30, 30)
     )  # footprint (rect + overlap) clamped into 80x64
-    ov = doc.params["overlap"]
+    ov = doc.tileset.overlap()
     assert doc.tileset.template_rect == (80 - ov - 30, 0, 30, 30)
     assert doc.undo_stack.count() == 2
     doc.undo_stack.undo()

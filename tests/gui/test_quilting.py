@@ -21,7 +21,7 @@ def test_blocks_stream_in_and_a_click_inspects_one(qtbot):
     w.act_quilt.trigger()
     assert w.tabs.currentWidget() is w.quilt_view
     assert w.params_panel.groups["Quilting"].isVisible()
-    assert not w.params_panel.groups["Template"].isVisible()
+    assert not w.params_panel.groups["Tile"].isVisible()
     wait_idle(qtbot, w)
     res = w.doc.quilting.result
     assert res is not None and res.image.shape[:2] == (128, 160)

@@ -61,11 +61,11 @@ def test_shift_drag_on_the_source_paints_one_undoable_exclusion(qtbot, win):
 
 def test_template_search_and_candidates_avoid_the_excluded_pixels(qtbot, win):
     doc = win.doc
-    doc.set_params({"tile_min": 96, "tile_max": 128, "n_candidates": 6})
+    doc.set_params({"tile_size": "any", "tile_min": 96, "tile_max": 128, "n_candidates": 6})
     win.act_find.trigger()
     wait_idle(qtbot, win)
     first = doc.tileset.template_rect
-    ov = doc.params["overlap"]
+    ov = doc.tileset.overlap()
     painted = np.zeros(doc.source.shape, bool)
     painted[footprint(first, ov)] = True  # exactly where the best tile was
     doc.set_painted(painted)

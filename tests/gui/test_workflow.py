@@ -25,12 +25,13 @@ def test_tile_set_workflow_open_to_reopen(qtbot, tmp_path):
     wait_idle(qtbot, w)
     x, y, tw, th = doc.tileset.template_rect
     p = doc.params
-    assert p["tile_min"] <= tw <= p["tile_max"] and p["tile_min"] <= th <= p["tile_max"]
+    (lo, _), (hi, _) = doc.tileset.settings().tile_range(doc.source.shape)
+    assert lo <= tw <= hi and lo <= th <= hi
     assert w.source_view.rect_item.isVisible() and w.source_view.rect_item.rect == (x, y, tw, th)
     assert doc.undo_stack.undoText() == "Find best tile"
     for k, shade in w.source_view.shades.items():
         assert shade.isVisible(), k
-    ov = p["overlap"]
+    ov = doc.tileset.overlap()
     assert w.source_view.shades["R_R"].rect().getRect() == (x + tw, y, ov, th + ov)
 
     # -- seamless tile: error maps, seams and the wrapped 3x3 view
