@@ -24,7 +24,6 @@ def test_tile_set_workflow_open_to_reopen(qtbot, tmp_path):
     w.act_find.trigger()
     wait_idle(qtbot, w)
     x, y, tw, th = doc.tileset.template_rect
-    p = doc.params
     (lo, _), (hi, _) = doc.tileset.settings().tile_range(doc.source.shape)
     assert lo <= tw <= hi and lo <= th <= hi
     assert w.source_view.rect_item.isVisible() and w.source_view.rect_item.rect == (x, y, tw, th)
