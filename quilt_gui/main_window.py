@@ -383,6 +383,7 @@ class MainWindow(QMainWindow):
         self.tabs.currentChanged.connect(self._on_tab_changed)
         self.quilt_view.selection_changed.connect(self._show_criteria)
         self.tile_view.repeats_changed.connect(self._on_repeats_changed)
+        self.params_panel.tile_size_edited.connect(self._on_tile_size_edited)
         self.tile_view.wrap_requested.connect(partial(self.tabs.setCurrentWidget, self.wrap_view))
         for canvas in self.canvases():
             canvas.hovered.connect(partial(self._on_hover, canvas))
@@ -416,6 +417,12 @@ class MainWindow(QMainWindow):
             if level is None or lv == level:
                 return text
         return ""
+
+    @Slot()
+    def _on_tile_size_edited(self) -> None:
+        """A new tile size: search where a tile of that size sits best."""
+        if self.doc.has_source:
+            self.pipeline.find_template()
 
     @Slot()
     def _fill_recent_menu(self) -> None:

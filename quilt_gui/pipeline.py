@@ -85,9 +85,6 @@ class Pipeline(QObject):
 
     @Slot(object)
     def _on_params_changed(self, keys) -> None:
-        if keys & params.TILE_SIZE_KEYS and self.doc.source is not None and len(keys) < 4:
-            self.find_template()  # a new tile size: search where it sits (not on a reset)
-            return
         if keys & params.SEAMLESS_KEYS:
             if "overlap" in keys and self.doc.tileset.template_rect is not None:
                 clamped = self.doc.tileset.clamp_rect(self.doc.tileset.template_rect)

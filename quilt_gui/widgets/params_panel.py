@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from functools import partial
 
-from PySide6.QtCore import Qt, Slot
+from PySide6.QtCore import Qt, Signal, Slot
 from PySide6.QtWidgets import (
     QButtonGroup,
     QCheckBox,
@@ -67,6 +67,8 @@ VIEWS = (BASIC, ADVANCED)
 class ParamsPanel(QWidget):
     """Group boxes of parameter widgets plus the actions of each step, in a Basic view (what
     most photos need) or an Advanced one (everything), and a Reset to defaults."""
+
+    tile_size_edited = Signal()  # the person chose another tile size (not an undo)
 
     def __init__(self, doc: Document, actions: dict[str, list] | None = None, parent=None) -> None:
         super().__init__(parent)
@@ -281,7 +283,10 @@ class ParamsPanel(QWidget):
         self._edit(key, widget.currentData())
 
     def _edit(self, key: str, value) -> None:
+        before = self.doc.params[key]
         self.doc.set_param(key, value, merge_id=self._merge.get(key))
+        if key in params.TILE_SIZE_KEYS and self.doc.params[key] != before:
+            self.tile_size_edited.emit()
 
     def value(self, key: str):
         """What the widget of ``key`` shows (for tests)."""
