@@ -397,11 +397,13 @@ def test_image_too_small_for_the_tile(qtbot, win, tmp_path):
     with qtbot.waitSignal(win.doc.source_changed, timeout=5000):
         win.files.open_path(str(tiny), confirm=False)
     win.doc.set_params({"tile_size": "any", "tile_min": 64, "tile_max": 64})
+    win.act_find.trigger()
     wait_idle(qtbot, win)
     error = win.last_message("error")
     assert "smaller than the minimum tile" in error and "tile_min" not in error
     assert win.doc.tileset.template_rect is None
     win.doc.set_params({"tile_min": 0, "tile_max": 0})  # automatic: scaled to the image
+    win.act_find.trigger()
     wait_idle(qtbot, win)
     assert win.doc.tileset.template_rect is not None and win.doc.tileset.seamless is not None
     win.doc.set_param("overlap", 8)
