@@ -31,6 +31,7 @@ from engine.tiles.seamless import (
 )
 from engine.tiles.template import (
     Template,
+    TemplateSweep,
     TemplateUpdate,
     default_overlap,
     find_template,
@@ -46,6 +47,7 @@ __all__ = [
     "Template",
     "TilesetResult",
     "TilesetSettings",
+    "TemplateSweep",
     "TemplateUpdate",
     "assemble",
     "candidate_seed",

@@ -38,10 +38,11 @@ from engine._checks import as_size
 from engine._validate import as_image, positive_int
 from engine.cancel import Cancelled, is_cancelled
 from engine.errormap import colour_channels
-from engine.events import Progress, Snapshot, drain
+from engine.events import Item, Progress, Snapshot, drain, frozen_array
 
 __all__ = [
     "Template",
+    "TemplateSweep",
     "TemplateUpdate",
     "default_overlap",
     "find_template",
@@ -61,6 +62,27 @@ class TemplateUpdate(Snapshot):
     cost: float
     overlap: int
     phase: str = ""
+
+
+@dataclass(frozen=True, slots=True)
+class TemplateSweep(Item):
+    """A sample of the rectangles the search has just scored (``sweep`` > 0), to draw the sweep.
+
+    ``rects`` (n, 4) holds (x, y, w, h) tile rectangles in source pixels (as
+    :attr:`Template.rect`; a phase scores them all at once over its rows or columns), ``costs``
+    their criterion; ``best`` / ``best_cost`` the phase's best so far. ``phase`` is
+    ``"horizontal"`` or ``"vertical"``, ``round`` 0 for the search and 1.. for the refinement
+    rounds, ``coarse`` True on the reduced image of a large source (coordinates scaled back).
+    """
+
+    phase: str
+    round: int
+    coarse: bool
+    rects: np.ndarray
+    costs: np.ndarray
+    best: tuple[int, int, int, int]
+    best_cost: float
+    overlap: int
 
 
 @dataclass(frozen=True, slots=True)
@@ -250,40 +272,56 @@ class _Scan:
         W = S.shape[1]
         self.sum = np.zeros((self.shifts.size, W), dtype=np.float64)
         self.cnt = np.zeros((self.shifts.size, W), dtype=np.float64)
+        self._G = None
 
     def chunks(self):
-        """Run the kernel chunk by chunk; yields the number of shifts done so far."""
+        """Run the kernel chunk by chunk; yields the (start, end) shifts done."""
         for k0 in range(0, self.shifts.size, _CHUNK):
             k1 = min(k0 + _CHUNK, self.shifts.size)
             _sums(
                 self.S, self.valid, self.rows, self.shifts[k0:k1], self.sum[k0:k1], self.cnt[k0:k1]
             )
-            yield k1
+            yield k0, k1
 
-    def costs(self, feasible_run: np.ndarray | None) -> np.ndarray:
-        """(K, W) cost of the border pair at x with shift shifts[k]; inf where invalid.
+    def costs(self, feasible_run: np.ndarray | None, k0: int = 0, k1: int | None = None):
+        """(k1 - k0, W) cost of the border pair at x with shift shifts[k]; inf where invalid.
 
         ``feasible_run[x]`` is the widest footprint allowed to start at column x.
         """
-        K, W = self.sum.shape
+        k1 = self.shifts.size if k1 is None else k1
+        K, W = k1 - k0, self.sum.shape[1]
         w = self.overlap
-        G = self.joint_weight * _joint_steps(self.S, self.valid, self.rows)
-        cs = np.cumsum(np.pad(self.sum, ((0, 0), (1, 0))), axis=1)
-        cc = np.cumsum(np.pad(self.cnt, ((0, 0), (1, 0))), axis=1)
+        if self._G is None:
+            self._G = self.joint_weight * _joint_steps(self.S, self.valid, self.rows)
         out = np.full((K, W), np.inf)
-        for k, a in enumerate(self.shifts):
-            n = W - int(a) - w + 1  # positions with the whole footprint inside
-            if n <= 0:
-                continue
-            s = cs[k, w : w + n] - cs[k, :n]
-            c = cc[k, w : w + n] - cc[k, :n]
-            with np.errstate(invalid="ignore", divide="ignore"):
-                d = np.where(c > 0, s / np.maximum(c, 1), np.inf)
-            d = d + G[int(a) : int(a) + n]
-            if feasible_run is not None:
-                d = np.where(feasible_run[:n] >= int(a) + w, d, np.inf)
-            out[k, :n] = d
+        n = W - w + 1  # positions of the overlap strip
+        if K == 0 or n <= 0:
+            return out
+        cs = np.zeros((K, W + 1))
+        cc = np.zeros((K, W + 1))
+        np.cumsum(self.sum[k0:k1], axis=1, out=cs[:, 1:])
+        np.cumsum(self.cnt[k0:k1], axis=1, out=cc[:, 1:])
+        s = cs[:, w : w + n] - cs[:, :n]
+        c = cc[:, w : w + n] - cc[:, :n]
+        x = np.arange(n)[None, :]
+        a = self.shifts[k0:k1, None]
+        ok = (c > 0) & (x + a + w <= W)  # the whole footprint inside
+        if feasible_run is not None:
+            ok &= feasible_run[:n][None, :] >= a + w
+        with np.errstate(invalid="ignore", divide="ignore"):
+            d = s / np.maximum(c, 1) + self._G[np.minimum(x + a, W - 1)]
+        out[:, :n] = np.where(ok, d, np.inf)
         return out
+
+
+def _sample(costs: np.ndarray, n: int) -> np.ndarray:
+    """Flat indices of ``n`` finite entries of ``costs`` spread evenly over them, and the
+    smallest."""
+    finite = np.flatnonzero(np.isfinite(costs))
+    if finite.size == 0:
+        return finite
+    pick = finite[np.linspace(0, finite.size - 1, min(n, finite.size)).astype(np.int64)]
+    return np.union1d(pick, [int(np.argmin(costs))])
 
 
 def _argmin(costs: np.ndarray, shifts: np.ndarray) -> tuple[int, int, float] | None:
@@ -395,6 +433,7 @@ def iter_find_template(
     refine: bool = True,
     coarse: int | None = None,
     joint_weight: float = JOINT_WEIGHT,
+    sweep: int = 0,
     cancel=None,
 ):
     """Search the tile rectangle; returns a generator of events whose value is a Template.
@@ -422,11 +461,16 @@ def iter_find_template(
         ``x + w - 1, x + w`` and row pair ``y + h - 1, y + h``) added to the strip mismatch,
         so the wrap does not fall on an edge of the texture (module docstring). 0 searches
         the strip mismatch alone (the paper's criterion).
+    sweep : int
+        0 (default): no sweep events. n > 0: after every chunk of widths (or heights) a
+        :class:`TemplateSweep` with about n of the rectangles just scored (spread evenly over
+        them, plus the chunk's best) and the phase's best so far, for drawing the search.
     cancel : CancelToken or None
         Once a first rectangle exists the search returns the best so far; before that it
         raises :class:`engine.cancel.Cancelled`.
 
-    Yields :class:`TemplateUpdate` for every better rectangle and :class:`Progress`.
+    Yields :class:`TemplateUpdate` for every better rectangle, :class:`TemplateSweep` (with
+    ``sweep``) and :class:`Progress`.
     """
     S = np.ascontiguousarray(colour_channels(as_image(source, "source")))
     H, W = S.shape[:2]
@@ -449,8 +493,9 @@ def iter_find_template(
     if coarse is not None:
         positive_int(coarse, "coarse")
     lam = _joint_weight(joint_weight)
+    sweep = positive_int(sweep, "sweep", minimum=0)
     return _iter_find_template(
-        S, valid, run0, lo, hi, overlap, bool(refine), cancel, tuple(notes), coarse, lam
+        S, valid, run0, lo, hi, overlap, bool(refine), cancel, tuple(notes), coarse, lam, sweep
     )
 
 
@@ -484,7 +529,7 @@ def _coarse_factor(shape, n_shifts: int) -> int:
 
 
 def _iter_find_template(
-    S, valid, run0, lo, hi, overlap, refine, cancel, notes, coarse=None, lam=JOINT_WEIGHT
+    S, valid, run0, lo, hi, overlap, refine, cancel, notes, coarse=None, lam=JOINT_WEIGHT, sweep=0
 ):
     H, W = S.shape[:2]
     n_a = hi[1] - lo[1] + 1
@@ -508,7 +553,9 @@ def _iter_find_template(
             run0c = None if vc is None else _feasible_run0(vc, loc[0] + ovc)
             if run0c is None or run0c.max(initial=0) >= loc[1] + ovc:
                 c, stopped = yield from _phases(
-                    Sc, vc, run0c, loc, hic, ovc, refine, cancel, notes, prog, "coarse ", lam
+                    *(Sc, vc, run0c, loc, hic, ovc, refine, cancel, notes, prog, "coarse ", lam),
+                    sweep=sweep,
+                    scale=f,
                 )
                 if stopped:
                     raise Cancelled("cancelled before the first tile rectangle was found")
@@ -533,10 +580,11 @@ def _iter_find_template(
         lam,
         xwin,
         ywin,
+        sweep=sweep,
     )
     if best is None and not stopped and xwin is not None:  # the windows missed: search it all
         best, stopped = yield from _phases(
-            S, valid, run0, lo, hi, overlap, refine, cancel, notes, prog, "", lam
+            S, valid, run0, lo, hi, overlap, refine, cancel, notes, prog, "", lam, sweep=sweep
         )
     if best is None:
         if stopped:
@@ -549,31 +597,80 @@ def _iter_find_template(
 
 
 def _phases(
-    S, valid, run0, lo, hi, overlap, refine, cancel, notes, prog, label, lam, xwin=None, ywin=None
+    S,
+    valid,
+    run0,
+    lo,
+    hi,
+    overlap,
+    refine,
+    cancel,
+    notes,
+    prog,
+    label,
+    lam,
+    xwin=None,
+    ywin=None,
+    sweep=0,
+    scale=1,
 ):
-    """The two phases (+ refinement rounds); returns (best Template or None, cancelled)."""
+    """The two phases (+ refinement rounds); returns (best Template or None, cancelled).
+
+    ``sweep`` > 0 streams a :class:`TemplateSweep` of about that many scored rectangles per
+    chunk of shifts (coordinates times ``scale``)."""
     H, W = S.shape[:2]
     a_shifts = np.arange(lo[1], hi[1] + 1)
     b_shifts = np.arange(lo[0], hi[0] + 1)
     rounds = 4 if refine else 1
     best: Template | None = None
 
-    def scan(St, vt, rows, shifts, feasible, what):
+    def scan(St, vt, rows, shifts, feasible, what, to_rect):
+        """``to_rect(positions, shifts)`` -> (n, 4) rects of a phase's scored pairs."""
         sc = _Scan(St, vt, rows, shifts, overlap, lam)
-        for k in sc.chunks():
+        top = (np.inf, None)
+        for k0, k1 in sc.chunks():
+            if sweep:
+                c = sc.costs(feasible, k0, k1)
+                flat = _sample(c, sweep)
+                kk, pos = np.unravel_index(flat, c.shape)
+                rects = to_rect(pos, shifts[k0 + kk]) * scale
+                if flat.size and c.flat[flat].min() < top[0]:
+                    i = int(np.argmin(c.flat[flat]))
+                    top = (float(c.flat[flat[i]]), tuple(int(v) for v in rects[i]))
+                if top[1] is not None:
+                    yield TemplateSweep(
+                        phase=what,
+                        round=_round,
+                        coarse=bool(label),
+                        rects=frozen_array(rects),
+                        costs=frozen_array(c.flat[flat]),
+                        best=top[1],
+                        best_cost=top[0],
+                        overlap=overlap * scale,
+                    )
             yield Progress(
-                min(prog["done"] + k, prog["total"]), prog["total"], f"template: {label}{what}"
+                min(prog["done"] + k1, prog["total"]),
+                prog["total"],
+                f"template: {label}{what} phase",
             )
             if is_cancelled(cancel):
                 return None
         prog["done"] += shifts.size
         return _argmin(sc.costs(feasible), shifts)
 
+    def horizontal_rects(r0, r1):
+        return lambda x, a: np.stack(
+            [x, np.full_like(x, r0), a, np.full_like(x, r1 - r0 - overlap)], 1
+        )
+
     rows = (0, H)
     feasible_h = _window(run0, W, xwin)
     current = None
+    _round = 0
     for _round in range(rounds):
-        hx = yield from scan(S, valid, rows, a_shifts, feasible_h, "horizontal phase")
+        hx = yield from scan(
+            S, valid, rows, a_shifts, feasible_h, "horizontal", horizontal_rects(*rows)
+        )
         if is_cancelled(cancel):
             return best, True
         if hx is None:
@@ -587,7 +684,15 @@ def _phases(
             vt = np.ascontiguousarray(valid[:, band].T)
             feasible_v = _runs_1d(valid[:, band].all(axis=1))
         feasible_v = _window(feasible_v, H, ywin)
-        vy = yield from scan(St, vt, (0, a + overlap), b_shifts, feasible_v, "vertical phase")
+        vy = yield from scan(
+            St,
+            vt,
+            (0, a + overlap),
+            b_shifts,
+            feasible_v,
+            "vertical",
+            lambda y, b, x=x, a=a: np.stack([np.full_like(y, x), y, np.full_like(y, a), b], 1),
+        )
         if is_cancelled(cancel):
             return best, True
         if vy is None:
