@@ -48,3 +48,22 @@ def format_table(headers: Sequence[str], rows: Sequence[Sequence[object]]) -> st
         if k == 0:
             lines.append("|" + "|".join("-" * (wd + 1) + ":" for wd in widths) + "|")
     return "\n".join(lines)
+
+
+def provenance() -> str:
+    """Date, commit and machine load, for the first line of the results file."""
+    import datetime
+    import os
+    import subprocess
+
+    try:
+        commit = subprocess.run(
+            ["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, check=True
+        ).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        commit = "unknown"
+    load = ", ".join(f"{v:.1f}" for v in os.getloadavg())
+    return (
+        f"# measured {datetime.date.today()} on this {os.cpu_count()}-core machine at commit "
+        f"{commit}; load average {load}"
+    )

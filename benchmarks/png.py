@@ -21,7 +21,7 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
 
 import resources  # noqa: E402
 from benchmarks import _png_baseline as baseline  # noqa: E402
-from benchmarks._util import format_table, median_time  # noqa: E402
+from benchmarks._util import format_table, median_time, provenance  # noqa: E402
 from engine import png  # noqa: E402
 from engine.io import load_image  # noqa: E402
 
@@ -111,27 +111,8 @@ def main(argv=None) -> int:
     )
     print(table)
     RESULTS.parent.mkdir(exist_ok=True)
-    RESULTS.write_text(f"{_provenance()}\npython -m benchmarks.png\n\n{table}\n")
+    RESULTS.write_text(f"{provenance()}\npython -m benchmarks.png\n\n{table}\n")
     return 0
-
-
-def _provenance() -> str:
-    """Date, commit and machine load, for the first line of the results file."""
-    import datetime
-    import os
-    import subprocess
-
-    try:
-        commit = subprocess.run(
-            ["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, check=True
-        ).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        commit = "unknown"
-    load = ", ".join(f"{v:.1f}" for v in os.getloadavg())
-    return (
-        f"# measured {datetime.date.today()} on this {os.cpu_count()}-core machine at commit "
-        f"{commit}; load average {load}"
-    )
 
 
 if __name__ == "__main__":

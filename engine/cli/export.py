@@ -5,13 +5,14 @@ from __future__ import annotations
 import argparse
 import sys
 
+from engine.cli import SUBCOMMANDS
 from engine.cli._args import add_bit_depth, int_at_least
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
     p = subparsers.add_parser(
         "export",
-        help="export a project's picked tiles as a bundle (PNGs, atlases, manifest, Tiled, Godot)",
+        help=SUBCOMMANDS["export"],
         description="Write the export bundle of a .quiltproj project: per-tile PNGs per map, "
         "one atlas per map, a JSON manifest, the layout index matrix (CSV + JSON), a Tiled "
         ".tsx/.tmx, a Godot 4 .tres and the preview. The folder appears complete or not at all.",

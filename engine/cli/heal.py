@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import sys
 
+from engine.cli import SUBCOMMANDS
 from engine.cli._args import (
     add_bit_depth,
     add_exclusion,
@@ -37,7 +38,7 @@ def add_parser(subparsers):
 
     p = subparsers.add_parser(
         "heal",
-        help="fill a masked region of an image from the rest of it (remove a leaf, a logo...)",
+        help=SUBCOMMANDS["heal"],
         description="Heal: replace the pixels MASK marks by quilting from the rest of SRC, "
         "blocks matched by masked SSD, cut along minimum-error seams and blended; pixels "
         "outside the mask are kept exactly.",

@@ -13,6 +13,7 @@ import json
 import sys
 import time
 
+from engine.cli import SUBCOMMANDS
 from engine.cli._args import add_seam_options, int_at_least, non_negative_float
 from engine.seams.spec import BLEND_MODES, METHODS, METRICS, SeamSpec
 
@@ -20,7 +21,7 @@ from engine.seams.spec import BLEND_MODES, METHODS, METRICS, SeamSpec
 def add_parser(subparsers) -> argparse.ArgumentParser:
     p = subparsers.add_parser(
         "seam",
-        help="find a minimum-error seam between two equally sized overlap images",
+        help=SUBCOMMANDS["seam"],
         description="Find a top-to-bottom seam through the overlap of R1 (kept on the left) and "
         "R2 (kept on the right). Prints criterion (sum of the error on the path), peak (its "
         "largest error) and the time of the seam search.",

@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
+from engine.cli import SUBCOMMANDS
 from engine.cli._args import (
     add_bit_depth,
     add_exclusion,
@@ -108,7 +109,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
     p = subparsers.add_parser(
         "synth",
-        help="synthesize a larger texture from a sample by image quilting",
+        help=SUBCOMMANDS["synth"],
         description="Image quilting (Efros & Freeman; Long & Mould; Bhatia; CS194; Core S2): "
         "blocks of SAMPLE placed with overlaps and cut along minimum-error seams.",
     )

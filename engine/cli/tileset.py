@@ -32,6 +32,7 @@ import time
 from pathlib import Path
 
 from engine._fs import replace_folder, write_bytes_atomically
+from engine.cli import SUBCOMMANDS
 from engine.cli._args import (
     add_exclusion,
     add_seam_options,
@@ -99,7 +100,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     d = TilesetSettings()
     p = subparsers.add_parser(
         "tileset",
-        help="make a seamless template tile and N mutually connectable candidate tiles",
+        help=SUBCOMMANDS["tileset"],
         description="Search the template tile in SOURCE, make it seamless, derive N candidate "
         "tiles that all connect to each other (Somol & Haindl), and write them with a "
         "manifest, an index matrix and a synthesized preview into DIR. Options not given "

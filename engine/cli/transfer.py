@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import sys
 
+from engine.cli import SUBCOMMANDS
 from engine.cli._args import int_at_least, non_negative_float
 from engine.cli.synth import (
     ProgressPrinter,
@@ -38,7 +39,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
     p = subparsers.add_parser(
         "transfer",
-        help="texture transfer: render TARGET with the texture of SAMPLE",
+        help=SUBCOMMANDS["transfer"],
         description="Texture transfer (Efros & Freeman): quilt SAMPLE into TARGET's size, each "
         "block chosen by alpha * texture cost + (1 - alpha) * correspondence cost, iterated "
         "with blocks shrinking by a third.",

@@ -1,5 +1,35 @@
+"""``quilt-studio --help`` lists every sub-command and starts fast: it loads no numpy, numba,
+scipy or Qt; a sub-command loads only its own module of the command line."""
+
+import json
 import subprocess
 import sys
+
+import pytest
+
+from engine.cli import SUBCOMMANDS
+
+HEAVY = ("numpy", "numba", "scipy", "PySide6", "skimage", "PIL", "superqt")
+
+PROBE = """
+import contextlib, io, json, sys
+from quilt_gui.__main__ import main
+with contextlib.redirect_stdout(io.StringIO()):
+    try:
+        main({argv!r})
+    except SystemExit:
+        pass
+loaded = sorted(m for m in sys.modules if m.split(".")[0] in {heavy!r})
+cli = sorted(m for m in sys.modules if m.startswith("engine.cli."))
+print(json.dumps([loaded, cli]))
+"""
+
+
+def _loaded(argv: list[str]) -> tuple[list[str], list[str]]:
+    code = PROBE.format(argv=argv, heavy=HEAVY)
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    heavy, cli = json.loads(out.stdout)
+    return heavy, cli
 
 
 def test_help_lists_subcommands():
@@ -7,3 +37,20 @@ def test_help_lists_subcommands():
         [sys.executable, "-m", "quilt_gui", "--help"], capture_output=True, text=True, check=True
     )
     assert "SUBCOMMAND" in out.stdout
+    for name, line in SUBCOMMANDS.items():
+        assert name in out.stdout and line.split()[0] in out.stdout
+
+
+def test_help_loads_no_numerical_library_and_no_subcommand():
+    heavy, cli = _loaded(["--help"])
+    assert heavy == [] and cli == []
+
+
+@pytest.mark.parametrize("name", ["seam", "tileset", "export"])
+def test_a_subcommands_help_loads_only_its_own_command(name):
+    heavy, cli = _loaded([name, "--help"])
+    assert heavy == []  # their parsers read the engine's light tables
+    own = {f"engine.cli.{name}", "engine.cli._args"}
+    if name == "tileset":
+        own |= {"engine.cli.export", "engine.cli.tileset_wang"}  # --project, --wang
+    assert set(cli) <= own, cli
