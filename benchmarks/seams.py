@@ -288,7 +288,10 @@ def product_overlaps(names=None, *, quilting=True) -> dict[str, list[Overlap]]:
         with recording_oscillating(sets["template"]):
             tile = make_seamless(S, template, seam=SeamSpec("oscillating"))
         with recording_oscillating(sets["patch ring"]):
-            candidates(S, tile, 4, seam=SeamSpec("oscillating", blend="adaptive"), rng=0, workers=1)
+            # the rings' own error maps: without the candidates' outward bias (a ramp that
+            # makes every row's argmin the outer column, i.e. the paper's start near-optimal)
+            seam = SeamSpec("oscillating", blend="adaptive")
+            candidates(S, tile, 4, seam=seam, rng=0, workers=1, outward=0)
         if quilting:
             with recording_oscillating(sets["quilting"]):
                 quilt(

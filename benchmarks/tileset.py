@@ -28,6 +28,13 @@ options. Three tables:
 6. With ``--patch-rings w_T,w_T/2,8,default --ring-tiles 64,128,256``: the candidates' patch
    ring w_P on every sample (``w_T/2`` is ``max(4, w_T // 2)``; ``default`` the engine's
    :func:`engine.tiles.default_patch_overlap`, chosen from this table).
+7. With ``--evalset public|private|all``: every texture of the evaluation set
+   (:mod:`benchmarks.evalset`) through the ``tileset`` command's defaults (tile range a quarter
+   to a half of the shorter side, 30 candidates), one row per texture with the interior metrics
+   (README "Interior metrics") next to the joint ones and the acceptance of issue 10: frame <=
+   1.15, ring tone <= 1.3, no duplicates, lattice <= +1.5 dB above its floor, pairs median <=
+   1.2 / max <= 1.6, wrap <= 1.15, detail >= 0.95. ``--layouts DIR`` writes each texture's 8x8
+   random layout (no equal neighbours) there at 100 % (``docs/tilesets`` for the public set).
 """
 
 from __future__ import annotations
@@ -514,6 +521,143 @@ def stage_scaling(S: np.ndarray, tile: int, seed: int, calls: int = 20) -> list:
     return rows
 
 
+#: Issue 10's acceptance per texture: (metric, limit, "max" or "min").
+ACCEPT = {
+    "frame": (1.15, "max"),
+    "tone": (1.3, "max"),
+    "dups": (0, "max"),
+    "lattice": (1.5, "max"),
+    "pairs med": (1.2, "max"),
+    "pairs max": (1.6, "max"),
+    "wrap": (1.15, "max"),
+    "detail": (0.95, "min"),
+}
+
+
+def evaluate_texture(S: np.ndarray, seed: int = 0, **changes) -> dict:
+    """The ``tileset`` command's defaults (``TilesetSettings()`` with ``changes``, e.g.
+    ``outward``-free engine options go through the settings) on one texture, and every figure
+    of issue 10."""
+    from engine.metrics import duplicates, frame, lattice, ring_tone, template_share
+    from engine.settings import TilesetSettings
+    from engine.tiles.pipeline import tileset
+
+    t0 = time.perf_counter()
+    res = tileset(S, TilesetSettings(seed=seed, **changes))
+    elapsed = time.perf_counter() - t0
+    st, cands, s = res.seamless, res.candidates, res.settings
+    wp, m = s.patch_overlap, s.margin
+    ratios = pair_ratios([c.tile for c in cands]) if len(cands) > 1 else np.ones(1)
+    fr = frame(cands, S, limit=2 * wp)
+    lat = lattice(cands, S, template=st.tile, margin=m)
+    return {
+        "S": S,
+        "result": res,
+        "seamless": st,
+        "cands": cands,
+        "n": len(cands),
+        "tile": st.tile.shape[:2],
+        "w_P": wp,
+        "frame": fr.value,
+        "frame_low": fr.low,
+        "tone": ring_tone(cands, S, width=wp),
+        "dups": duplicates(cands, st.tile).count,
+        "lattice": lat.above,
+        "lattice_floor": lat.floor,
+        "pairs med": float(np.median(ratios)),
+        "pairs max": float(ratios.max()),
+        "wrap": wrap_border_ratio(st.tile),
+        "detail": detail_ratio(st.tile, S),
+        "share": float(template_share(cands, st.tile).mean()),
+        "warnings": res.warnings,
+        "seconds": elapsed,
+    }
+
+
+def failures(f: dict) -> list[str]:
+    """The acceptance lines a texture's figures miss."""
+    out = []
+    for key, (limit, kind) in ACCEPT.items():
+        v = f[key]
+        if (kind == "max" and v > limit) or (kind == "min" and v < limit):
+            out.append(key)
+    return out
+
+
+def save_layout(f: dict, path: Path, seed: int = 0) -> None:
+    """An 8x8 random layout of the candidates (no equal neighbours) at 100 %."""
+    from PIL import Image
+
+    from engine.bitdepth import quantize
+
+    cands = f["cands"]
+    ids = random_layout(len(cands), 8, 8, rng=seed, no_equal_neighbours=len(cands) > 1)
+    img = quantize(assemble(cands, ids), 8, dither=False)
+    if img.ndim == 3 and img.shape[2] == 1:
+        img = img[:, :, 0]
+    path.parent.mkdir(parents=True, exist_ok=True)
+    Image.fromarray(img).save(path, quality=90) if path.suffix == ".jpg" else Image.fromarray(
+        img
+    ).save(path)
+
+
+def evaluation(which: str, seed: int, layouts: Path | None) -> str:
+    from benchmarks import evalset
+
+    rows = []
+    for name in evalset.texture_names(which):
+        S = load_image_array(evalset.load(name))
+        f = evaluate_texture(S, seed)
+        if layouts is not None:
+            save_layout(f, layouts / f"{name}.jpg", seed)
+        miss = failures(f)
+        h, w = f["tile"]
+        rows.append(
+            [
+                name,
+                f"{S.shape[1]}x{S.shape[0]}",
+                f"{w}x{h}",
+                f"{f['n']}",
+                f"{f['frame']:.2f} ({f['frame_low']:.2f})",
+                f"{f['tone']:.2f}",
+                f"{f['dups']}",
+                f"{f['lattice']:+.2f} ({f['lattice_floor']:.1f})",
+                pair_text((f["pairs med"], f["pairs max"])),
+                f"{f['wrap']:.2f}",
+                f"{f['detail']:.2f}",
+                f"{f['share']:.0%}",
+                f"{f['seconds']:.1f}",
+                ", ".join(miss) if miss else "ok",
+            ]
+        )
+    return format_table(
+        [
+            "texture",
+            "source",
+            "tile",
+            "cands",
+            "frame (low)",
+            "ring tone",
+            "dups",
+            "lattice dB above floor (floor)",
+            "pairs med / max",
+            "wrap",
+            "detail",
+            "template share",
+            "s",
+            "fails",
+        ],
+        rows,
+    )
+
+
+def load_image_array(a: np.ndarray) -> np.ndarray:
+    """uint8 array -> the float32 (H, W, C) pixels the engine loads from a file."""
+    from engine._validate import as_image
+
+    return as_image(a)
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(
         prog="python -m benchmarks.tileset",
@@ -555,6 +699,17 @@ def main(argv=None) -> int:
         default=[256],
         metavar="T1,T2,...",
         help="tile sizes of the --patch-rings comparison (default 256)",
+    )
+    ap.add_argument(
+        "--evalset",
+        choices=("public", "private", "all"),
+        help="also run the evaluation set's textures through the defaults (issue 10 table)",
+    )
+    ap.add_argument(
+        "--layouts",
+        type=Path,
+        metavar="DIR",
+        help="with --evalset: write every texture's 8x8 layout there (JPEG, 100 %%)",
     )
     args = ap.parse_args(argv)
     unknown = set(args.patch_rings or ()) - set(RINGS)
@@ -599,6 +754,9 @@ def main(argv=None) -> int:
             patch_ring_sweep(args.patch_rings, args.ring_tiles, args.candidates, args.seed),
             flush=True,
         )
+    if args.evalset:
+        print(f"\n## Evaluation set: {args.evalset} (tileset defaults, 30 candidates)\n")
+        print(evaluation(args.evalset, args.seed, args.layouts), flush=True)
     return 0
 
 

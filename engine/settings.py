@@ -86,6 +86,10 @@ def wang_interior(value, name):
     return choice(value, name, ("patch", "diamonds"))
 
 
+def patch_search_mode(value, name):
+    return choice(value, name, ("global", "local"))
+
+
 def blend_mode(value, name):
     return choice(value, name, BLEND_MODES)
 
@@ -120,10 +124,12 @@ class TilesetSettings:
     joint. Cuts: ``seam`` (method, options, metric, blending of the patches) and
     ``template_blend`` (the template's blending; None: the same as ``seam.blend``).
     Candidates: ``candidates`` N, ``seed``, ``patch_size`` (None: the tile), ``patch_overlap``
-    w_P (None: :func:`engine.tiles.default_patch_overlap`), ``margin`` (None: 2, at most
-    w_P - 1), ``neighbourhood``. Preview: ``preview`` (rows, cols), ``no_equal_neighbours``,
-    ``layout_seed`` (None: ``seed``). ``exclude_color``: a colour range (lo, hi) no tile or
-    patch may contain.
+    w_P (None: :func:`engine.tiles.default_patch_overlap`), ``margin`` (None: 1, at most
+    w_P - 1), ``patch_search`` ("global": the best ring matches over the whole source, kept
+    ``min_distance`` apart (None: :func:`engine.tiles.default_min_distance`); "local": the
+    paper's random position refined within ``neighbourhood``). Preview: ``preview`` (rows,
+    cols), ``no_equal_neighbours``, ``layout_seed`` (None: ``seed``). ``exclude_color``: a
+    colour range (lo, hi) no tile or patch may contain.
 
     Wang set instead (:mod:`engine.tiles.wang`, when ``wang`` = K colours per edge direction
     is set): square tiles of ``tile_min`` = ``tile_max`` (None: a quarter of the source's
@@ -146,6 +152,8 @@ class TilesetSettings:
     patch_overlap: int | None = setting(None, optional(at_least(2)))
     margin: int | None = setting(None, optional(at_least(0)))
     neighbourhood: int = setting(5, at_least(0))
+    patch_search: str = setting("global", patch_search_mode)
+    min_distance: int | None = setting(None, optional(at_least(0)))
     preview: tuple[int, int] = setting((8, 8), as_size)
     no_equal_neighbours: bool = setting(True, boolean)
     layout_seed: int | None = setting(None, optional(at_least(0)))

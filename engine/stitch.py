@@ -544,9 +544,14 @@ def patch_cut(
     margin: int = 2,
     seam: SeamSpec | None = None,
     error=None,
+    bias=None,
     cancel=None,
 ) -> PatchCut:
     """Closed-path cut for moving window ``q`` onto ``u`` (ALGORITHMS §1.5).
+
+    ``bias`` (ph, pw), optional, is added to the error for the choice of the corner points
+    and the paths only (e.g. to draw the cut toward the outer margin); the blend widths and
+    the reported criterion and peak use the error itself.
 
     Four oriented stitches (left, top, right, bottom) run in the outer ring of width ``ring``
     (w_P), at ring offsets ``margin .. ring - 1``, with R1 = Q (inside) and R2 = U (outside).
@@ -572,44 +577,51 @@ def patch_cut(
         )
     d = error_map(qq, uu, metric=spec.metric) if error is None else _given_error(error, (ph, pw))
     d64 = d.astype(np.float64)
+    s64 = d64 if bias is None else d64 + _given_error(bias, (ph, pw), "bias")
     n = wp - m
-    tl = _corner(d64, m, m, n, False)
-    tr = _corner(d64, m, pw - wp, n, True)
-    br = _corner(d64, ph - wp, pw - wp, n, False)
-    bl = _corner(d64, ph - wp, m, n, True)
+    tl = _corner(s64, m, m, n, False)
+    tr = _corner(s64, m, pw - wp, n, True)
+    br = _corner(s64, ph - wp, pw - wp, n, False)
+    bl = _corner(s64, ph - wp, m, n, True)
+
     # each side: (canonical error map, start, end, canonical (row, col) -> window (row, col))
-    specs = {
-        "top": (
-            d64[m:wp, tl[1] : tr[1] + 1][::-1].T,
-            wp - 1 - tl[0],
-            wp - 1 - tr[0],
-            lambda p: (wp - 1 - p[:, 1], p[:, 0] + tl[1]),
-        ),
-        "right": (
-            d64[tr[0] : br[0] + 1, pw - wp : pw - m],
-            tr[1] - (pw - wp),
-            br[1] - (pw - wp),
-            lambda p: (p[:, 0] + tr[0], p[:, 1] + pw - wp),
-        ),
-        "bottom": (
-            d64[ph - wp : ph - m, bl[1] : br[1] + 1].T,
-            bl[0] - (ph - wp),
-            br[0] - (ph - wp),
-            lambda p: (p[:, 1] + ph - wp, p[:, 0] + bl[1]),
-        ),
-        "left": (
-            d64[tl[0] : bl[0] + 1, m:wp][:, ::-1],
-            wp - 1 - tl[1],
-            wp - 1 - bl[1],
-            lambda p: (p[:, 0] + tl[0], wp - 1 - p[:, 1]),
-        ),
-    }
+    def side_maps(x):
+        return {
+            "top": (
+                x[m:wp, tl[1] : tr[1] + 1][::-1].T,
+                wp - 1 - tl[0],
+                wp - 1 - tr[0],
+                lambda p: (wp - 1 - p[:, 1], p[:, 0] + tl[1]),
+            ),
+            "right": (
+                x[tr[0] : br[0] + 1, pw - wp : pw - m],
+                tr[1] - (pw - wp),
+                br[1] - (pw - wp),
+                lambda p: (p[:, 0] + tr[0], p[:, 1] + pw - wp),
+            ),
+            "bottom": (
+                x[ph - wp : ph - m, bl[1] : br[1] + 1].T,
+                bl[0] - (ph - wp),
+                br[0] - (ph - wp),
+                lambda p: (p[:, 1] + ph - wp, p[:, 0] + bl[1]),
+            ),
+            "left": (
+                x[tl[0] : bl[0] + 1, m:wp][:, ::-1],
+                wp - 1 - tl[1],
+                wp - 1 - bl[1],
+                lambda p: (p[:, 0] + tl[0], wp - 1 - p[:, 1]),
+            ),
+        }
+
+    specs = side_maps(d64)
+    search = specs if bias is None else side_maps(s64)
     sides, pieces = {}, {}
     b_at = np.zeros((ph, pw))
     for name, (ce, start, end, to_window) in specs.items():
         check(cancel)
         ce = np.ascontiguousarray(ce)
-        side = spec.find(ce, start=start, end=end, cancel=cancel)
+        # the path on the (biased) search map; the blend widths from the error itself
+        side = spec.find(np.ascontiguousarray(search[name][0]), start=start, end=end, cancel=cancel)
         sides[name] = side
         p = np.asarray(side.path)
         rows, cols = to_window(p)

@@ -264,7 +264,7 @@ PARAMS: tuple[Param, ...] = (
     ),
     _P(
         "margin",
-        2,
+        1,
         "Fixed border",
         "Outer pixels of every candidate that stay the tile's, so all candidates connect (px).",
         "Candidates",
@@ -275,7 +275,8 @@ PARAMS: tuple[Param, ...] = (
         "neighbourhood",
         5,
         "Patch search radius",
-        "Each random patch position is improved within this many pixels.",
+        "Local patch search only: each random patch position is improved within this many "
+        "pixels (the default global search looks over the whole source).",
         "Candidates",
         0,
         64,

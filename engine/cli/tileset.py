@@ -167,13 +167,22 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "--margin",
         type=int_at_least(0),
         metavar="N",
-        help="outer pixels every candidate keeps from the template (default 2, at most w_P - 1)",
+        help="outer pixels every candidate keeps from the template (default 1, at most w_P - 1)",
+    )
+    p.add_argument(
+        "--patch-search",
+        choices=("global", "local"),
+        help="where patches come from: 'global' (default) draws each among the best matches "
+        "of the template's ring over the whole source, away from the template's position and "
+        "from each other; 'local' is the paper's random position refined within "
+        "--neighbourhood",
     )
     p.add_argument(
         "--neighbourhood",
         type=int_at_least(0),
         metavar="N",
-        help=f"refine each random patch position within +-N px (default {d.neighbourhood})",
+        help="--patch-search local: refine each random patch position within +-N px "
+        f"(default {d.neighbourhood})",
     )
     p.add_argument("--seam", choices=METHODS, help=f"seam method (default {d.seam.method})")
     add_seam_options(p)
@@ -251,6 +260,7 @@ _FIELDS = {
     "patch_overlap": "patch_overlap",
     "margin": "margin",
     "neighbourhood": "neighbourhood",
+    "patch_search": "patch_search",
     "preview": "preview",
     "exclude_color": "exclude_color",
 }
@@ -266,6 +276,9 @@ def settings_from_args(args) -> TilesetSettings:
     from engine.cli.tileset_wang import wang_changes
 
     changes.update(wang_changes(args))
+    if args.wang is None and args.min_distance is not None:  # --min-distance of the candidates
+        changes.pop("wang_min_distance", None)
+        changes["min_distance"] = int(round(args.min_distance))
     if args.equal_neighbours:
         changes["no_equal_neighbours"] = False
     seam = {"method": args.seam, "metric": args.metric, "width": args.width, "rho": args.rho}

@@ -62,7 +62,9 @@ def add_wang_options(p, size) -> None:
         "--wang-min-distance",
         type=non_negative_float,
         metavar="PX",
-        help="least distance between edge samples and interior windows (default: tile/2)",
+        help="least distance between edge samples and interior windows (default: tile/2); "
+        "without --wang: between the candidates' patch sources and from the template's "
+        "position (--patch-search global; default: a quarter tile, less on small sources)",
     )
     g.add_argument(
         "--wang-tolerance",

@@ -3,19 +3,31 @@
 Each candidate is the seamless template with one patch from another source position stitched
 in along a closed minimum-error path whose four corner points are pinned and which never
 enters the outer ``margin`` pixels, so every candidate keeps the template's border exactly and
-connects to every other. Per candidate ``k``:
+connects to every other.
 
-1. a source position ``s0`` uniform over the valid positions (outside ``excluded``);
-2. refined to ``s*`` = argmin over ``s0 + [-n, n]^2`` of the mean error between the source
-   window and the template over the ring band (offsets ``margin .. patch_overlap - 1``);
-   the ring width w_P defaults to :func:`default_patch_overlap` of the template's w_T;
-3. :func:`engine.stitch.patch_cut` gives the closed cut; :func:`engine.materials.apply_cut`
-   applies it to every map.
+**Where the patch comes from** (``patch_search``):
 
-Candidates are independent: they run on a thread pool (``workers``) and are yielded as they
-finish (each carries its ``index``); the returned list is in index order. Candidate ``k`` is
-seeded from ``(seed, k)`` only, so the same seed gives identical tiles whatever the worker
-count or the number of candidates asked for.
+* ``"global"`` (default, issue 10 [REC]): the ring-band error (offsets ``margin ..
+  patch_overlap - 1``) between every source window and the template is computed at once by
+  FFT (masked SSD, :class:`engine.matching.SampleSpectrum`). Candidate ``k`` is drawn (seeded)
+  among the positions within ``1 + tolerance`` of the best remaining one, so structure (brick
+  courses, shelves) lines up across the closed cut. The template's own position and every
+  earlier candidate's are excluded within ``min_distance`` px (Chebyshev), so no two
+  candidates repeat; positions worse than ``1 + quality`` times the source's best match are
+  never used: when the source cannot give ``n`` such positions, fewer candidates are made and
+  a :class:`CandidatesNotice` (and a warning) says why.
+* ``"local"`` (the paper's rule): ``s0`` uniform over the valid positions, refined to the best
+  ring-band match within ``s0 + [-n, n]^2`` (``neighbourhood``).
+
+Then :func:`engine.stitch.patch_cut` gives the closed cut — searched on the error plus a bias
+that makes cuts nearer the outer margin cheaper (``outward``), so the part every tile repeats
+(the template share) stays thin — and :func:`engine.materials.apply_cut` applies it to every
+map. The ring width w_P defaults to :func:`default_patch_overlap` of the template's w_T.
+
+Cuts run on a thread pool (``workers``) and candidates are yielded as they finish (each carries
+its ``index``); the returned list is in index order. Candidate ``k`` is seeded from
+``(seed, k)`` and (global search) the positions of candidates ``0 .. k-1`` only, so the same
+seed gives identical tiles whatever the worker count or the number of candidates asked for.
 """
 
 from __future__ import annotations
@@ -24,16 +36,18 @@ import math
 import numbers
 import warnings
 from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
+from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
 
-from engine._validate import as_image, positive_int
+from engine._validate import as_image, choice, non_negative_number, positive_int
 from engine.cancel import Cancelled, CancelToken, check, is_cancelled
 from engine.candidate import CandidateTile
 from engine.errormap import colour_channels
-from engine.events import Progress, drain, frozen_array
+from engine.events import Item, Progress, drain, frozen_array
 from engine.exclusion import valid_anchors
+from engine.matching import ZERO_ERROR_FRACTION, SampleSpectrum, error_floor
 from engine.materials import apply_cut
 from engine.seams.spec import SeamSpec, as_seam_spec
 from engine.stitch import PATCH_SEAM, patch_cut
@@ -41,14 +55,22 @@ from engine.tiles.seamless import MAIN, SeamlessTile, as_maps, check_weights, se
 from engine.tiles.template import as_size, excluded_mask, flat_warning
 
 __all__ = [
+    "PATCH_SEARCHES",
     "CandidateTile",
+    "CandidatesNotice",
     "candidate_seed",
     "candidates",
+    "default_min_distance",
     "default_patch_overlap",
     "iter_candidates",
     "make_candidate",
 ]
 
+MARGIN = 1  # px every candidate keeps from the template (default of ``margin``)
+PATCH_SEARCHES = ("global", "local")
+TOLERANCE = 0.25  # global search: draw within (1 + TOLERANCE) x the best remaining ring match
+QUALITY = 2.0  # global search: never use a ring match worse than (1 + QUALITY) x the best
+OUTWARD = 2.0  # bias of the closed cut toward the outer margin, in units of the mean error
 PATCH_RING_FLOOR = 8  # px: narrower rings leave the closed cut no room (default_patch_overlap)
 
 
@@ -69,6 +91,24 @@ def default_patch_overlap(overlap: int) -> int:
     """
     w = positive_int(overlap, "overlap")
     return min(w, max(PATCH_RING_FLOOR, w // 2))
+
+
+def default_min_distance(tile_shape, positions: int) -> int:
+    """Default minimum distance (px, Chebyshev) between candidates' patch sources and from
+    the template's own position: a quarter of the tile's shorter side, or an eighth of the
+    span of the patch positions (the square root of their number ``positions``, e.g.
+    ``(H - h + 1) * (W - w + 1)`` without exclusions) when that is smaller, so that a source
+    holds about 30 such positions; at least 4."""
+    h, w = tile_shape[:2]
+    return max(4, min(min(int(h), int(w)) // 4, int(math.sqrt(max(1, positions))) // 8))
+
+
+@dataclass(frozen=True, slots=True)
+class CandidatesNotice(Item):
+    """Something the user must be told about a candidate run (e.g. fewer candidates than
+    asked, and why); the same text is also issued as a warning."""
+
+    message: str
 
 
 # --------------------------------------------------------------------------- seeds
@@ -189,6 +229,11 @@ class _Setup:
         excluded,
         maps,
         weights,
+        patch_search="global",
+        tolerance=TOLERANCE,
+        quality=QUALITY,
+        min_distance=None,
+        outward=OUTWARD,
     ):
         if not isinstance(template, SeamlessTile):
             raise TypeError(
@@ -228,6 +273,14 @@ class _Setup:
         self.ty, self.tx = (th - ph) // 2, (tw - pw) // 2
         self.n = positive_int(neighbourhood, "neighbourhood", minimum=0)
         self.seam = as_seam_spec(seam, default=PATCH_SEAM)
+        self.search = choice(patch_search, "patch_search", PATCH_SEARCHES)
+        self.tolerance = non_negative_number(tolerance, "tolerance")
+        self.quality = non_negative_number(quality, "quality")
+        self._min_distance = min_distance
+        self.outward = non_negative_number(outward, "outward")
+        tx0, ty0 = template.rect[:2]
+        self.template_origin = (ty0 + (th - ph) // 2, tx0 + (tw - pw) // 2)
+        self._costs = None
         extra = as_maps(maps, (H, W))
         if set(extra) != set(template.maps):
             raise ValueError(
@@ -245,6 +298,14 @@ class _Setup:
         self.U = {k: v[win] for k, v in tmaps.items()}
         ex = excluded_mask(excluded, (H, W))
         self.valid = None if ex is None else valid_anchors(ex, (ph, pw))
+        positions = (H - ph + 1) * (W - pw + 1) if self.valid is None else self.valid.sum()
+        self.min_distance = positive_int(
+            default_min_distance((th, tw), int(positions))
+            if self._min_distance is None
+            else self._min_distance,
+            "min_distance",
+            minimum=0,
+        )
         if self.valid is not None and not self.valid.any():
             raise ValueError(
                 f"no {pw}x{ph} patch fits outside the excluded region: paint a smaller "
@@ -262,11 +323,70 @@ class _Setup:
         # ring band for the position refinement (offsets margin .. ring-1)
         r, c = np.mgrid[0:ph, 0:pw]
         d = np.minimum.reduce([r, c, ph - 1 - r, pw - 1 - c])
-        self.band_runs = _runs((d >= self.margin) & (d < self.ring))
+        self.band = (d >= self.margin) & (d < self.ring)
+        self.band_runs = _runs(self.band)
+        # outward bias of the cut: 0 at the margin, `outward` x the mean error at the ring's
+        # inner edge (added to the error map the cut is searched on)
+        depth = np.clip((d - self.margin) / max(1, self.ring - 1 - self.margin), 0, 1)
+        self.bias = np.where(d < self.ring, depth, 0.0)
         self.Sc = np.ascontiguousarray(colour_channels(self.S))
         self.Up = np.ascontiguousarray(colour_channels(self.U[MAIN]).transpose(2, 0, 1))
 
     # ---- positions
+    def ring_costs(self) -> np.ndarray:
+        """Mean squared ring-band error (per pixel and channel) of every source window against
+        the template; ``inf`` where the patch would hold excluded pixels. Computed once."""
+        if self._costs is None:
+            band = self.band.astype(np.float32)
+            spec = SampleSpectrum(self.Sc)
+            e = spec.ssd(self.Up.transpose(1, 2, 0)[None], band[None])[0]
+            e /= band.sum() * self.Sc.shape[2]
+            if self.valid is not None:
+                e[~self.valid] = np.inf
+            self._costs = e
+        return self._costs
+
+    def _keep_away(self, allowed: np.ndarray, origin) -> None:
+        d = self.min_distance
+        if d <= 0:
+            return
+        y, x = origin
+        allowed[max(0, y - d + 1) : y + d, max(0, x - d + 1) : x + d] = False
+
+    def plan(self, seeds, avoid=()) -> tuple[list[tuple[int, int]], str | None]:
+        """Global search: the patch origins of candidates with these ``seeds`` (in order),
+        each away from the template's position, from ``avoid`` and from the earlier ones; and
+        a note when fewer than ``len(seeds)`` could be given."""
+        e = self.ring_costs()
+        allowed = np.isfinite(e)
+        self._keep_away(allowed, self.template_origin)
+        for o in avoid:
+            self._keep_away(allowed, o)
+        zero = ZERO_ERROR_FRACTION * error_floor(self.Sc)
+        origins: list[tuple[int, int]] = []
+        if allowed.any():
+            limit = max(float(e[allowed].min()), zero) * (1 + self.quality)
+            for seed in seeds:
+                ok = allowed & (e <= limit)
+                if not ok.any():
+                    break
+                pool = np.flatnonzero(
+                    ok & (e <= max(float(e[ok].min()), zero) * (1 + self.tolerance))
+                )
+                k = int(pool[np.random.default_rng(seed).integers(pool.size)])
+                origin = divmod(k, e.shape[1])
+                origins.append((int(origin[0]), int(origin[1])))
+                self._keep_away(allowed, origin)
+        note = None
+        if len(origins) < len(seeds):
+            note = (
+                f"made {len(origins)} of {len(seeds)} candidates: the source has no more patch "
+                f"positions at least {self.min_distance} px from the template's and from each "
+                f"other whose ring matches the template within {1 + self.quality:g}x the best "
+                "match (a larger source, smaller tiles or a smaller minimum distance give more)"
+            )
+        return origins, note
+
     def random_origin(self, gen: np.random.Generator) -> tuple[int, int]:
         H, W = self.S.shape[:2]
         if self.valid is None:
@@ -303,6 +423,7 @@ class _Setup:
         win = (slice(sy, sy + self.ph), slice(sx, sx + self.pw))
         Q = {k: v[win] for k, v in self.stack.items()}
         err = seam_error(Q, self.U, self.weights, self.seam.metric)
+        bias = (self.outward * float(err.mean())) * self.bias if self.outward else None
         cut = patch_cut(
             Q[MAIN],
             self.U[MAIN],
@@ -310,6 +431,7 @@ class _Setup:
             margin=self.margin,
             seam=self.seam,
             error=err,
+            bias=bias,
             cancel=cancel,
         )
         check(cancel)
@@ -370,8 +492,13 @@ def iter_candidates(
     *,
     patch_size=None,
     patch_overlap=None,
-    margin: int = 2,
+    margin: int = MARGIN,
+    patch_search: str = "global",
     neighbourhood: int = 5,
+    tolerance: float = TOLERANCE,
+    quality: float = QUALITY,
+    min_distance: int | None = None,
+    outward: float = OUTWARD,
     seam: SeamSpec | None = None,
     excluded=None,
     maps=None,
@@ -395,9 +522,21 @@ def iter_candidates(
         w_P, the ring in which the closed cut runs (default: :func:`default_patch_overlap`
         of the template's w_T, ``min(w_T, max(8, w_T // 2))``).
     margin : int
-        Outer pixels that always stay the template (default 2).
+        Outer pixels that always stay the template (default :data:`MARGIN`, 1).
+    patch_search : {"global", "local"}
+        Where patches come from (module docstring): the best ring matches over the whole
+        source (default) or the paper's random position refined within ``neighbourhood``.
     neighbourhood : int
-        n of the position refinement (search s0 + [-n, n]^2).
+        n of the local search (s0 + [-n, n]^2); unused by the global search.
+    tolerance, quality : float
+        Global search: draw among positions within ``1 + tolerance`` of the best remaining
+        ring match; never use one worse than ``1 + quality`` times the source's best.
+    min_distance : int or None
+        Global search: px (Chebyshev) between any two candidates' patch sources and from
+        the template's position (default :func:`default_min_distance`).
+    outward : float
+        Bias of the closed cut toward the outer margin (0 = none), in units of the mean
+        error; thinner shared rings repeat less of the template in a layout.
     seam : SeamSpec, optional
         Seam method and options, error metric and blending of the patch cuts (default
         :data:`engine.stitch.PATCH_SEAM`: dp with adaptive blending).
@@ -412,8 +551,9 @@ def iter_candidates(
     cancel : CancelToken or None
         Stops the run; the candidates already finished are kept and returned.
 
-    Yields :class:`CandidateTile` items as they finish (any order; each has its ``index``)
-    and :class:`Progress`.
+    Yields :class:`CandidateTile` items as they finish (any order; each has its ``index``),
+    :class:`Progress` and, when fewer candidates than asked can be made, one
+    :class:`CandidatesNotice` (also issued as a warning).
     """
     setup = _Setup(
         source,
@@ -426,6 +566,11 @@ def iter_candidates(
         excluded=excluded,
         maps=maps,
         weights=weights,
+        patch_search=patch_search,
+        tolerance=tolerance,
+        quality=quality,
+        min_distance=min_distance,
+        outward=outward,
     )
     n = positive_int(n, "n")
     workers = positive_int(workers, "workers")
@@ -439,12 +584,21 @@ def _iter_candidates(setup: _Setup, n: int, base: int, workers: int, cancel):
     seeds = [candidate_seed(base, k) for k in range(n)]
     made: dict[int, CandidateTile] = {}
     yield Progress(0, n, "candidates")
+    origins: list = [None] * n
+    if setup.search == "global":
+        check(cancel)
+        origins, note = setup.plan(seeds)
+        if note:
+            warnings.warn(note, stacklevel=2)
+            yield CandidatesNotice(note)
+        n = len(origins)
+    step = 0 if setup.search == "global" else setup.n
     if workers == 1:
         for k in range(n):
             if is_cancelled(cancel):
                 break
             try:
-                c = setup.make(k, seeds[k], None, setup.n, cancel)
+                c = setup.make(k, seeds[k], origins[k], step, cancel)
             except Cancelled:
                 break
             made[k] = c
@@ -456,7 +610,7 @@ def _iter_candidates(setup: _Setup, n: int, base: int, workers: int, cancel):
         pool = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="candidates")
         try:
             pending = {
-                pool.submit(setup.make, k, seeds[k], None, setup.n, token): k for k in range(n)
+                pool.submit(setup.make, k, seeds[k], origins[k], step, token): k for k in range(n)
             }
             while pending:
                 finished, _ = wait(pending, return_when=FIRST_COMPLETED)
@@ -479,6 +633,8 @@ def _iter_candidates(setup: _Setup, n: int, base: int, workers: int, cancel):
             pool.shutdown(wait=True, cancel_futures=True)
     if len(made) < n:
         yield Progress(len(made), n, "candidates: cancelled")
+    elif n < len(seeds):
+        yield Progress(n, n, f"candidates: {n} of {len(seeds)}")
     return [made[k] for k in sorted(made)]
 
 
@@ -496,9 +652,15 @@ def make_candidate(
     seed: int | None = None,
     rng=None,
     neighbourhood: int | None = None,
+    patch_search: str = "global",
+    avoid=(),
+    tolerance: float = TOLERANCE,
+    quality: float = QUALITY,
+    min_distance: int | None = None,
+    outward: float = OUTWARD,
     patch_size=None,
     patch_overlap=None,
-    margin: int = 2,
+    margin: int = MARGIN,
     seam: SeamSpec | None = None,
     excluded=None,
     maps=None,
@@ -510,7 +672,10 @@ def make_candidate(
     With ``patch_origin`` the patch is taken exactly there (``neighbourhood`` defaults to 0;
     give one to let the position settle nearby). Without it the position is drawn from
     ``seed`` (a candidate's own seed, to rebuild it) or, if that is None too, from ``rng``
-    (a re-roll). Raises :class:`engine.cancel.Cancelled` when cancelled.
+    (a re-roll): by the global search (away from the template's position and from the
+    patch origins in ``avoid``, e.g. the other candidates') or the local one. Raises
+    :class:`engine.cancel.Cancelled` when cancelled, ``ValueError`` when the global search
+    finds no position.
     """
     setup = _Setup(
         source,
@@ -523,6 +688,11 @@ def make_candidate(
         excluded=excluded,
         maps=maps,
         weights=weights,
+        patch_search=patch_search,
+        tolerance=tolerance,
+        quality=quality,
+        min_distance=min_distance,
+        outward=outward,
     )
     if isinstance(index, bool) or not isinstance(index, numbers.Integral) or index < 0:
         raise ValueError(f"index must be a non-negative integer, got {index!r}")
@@ -544,4 +714,9 @@ def make_candidate(
         if seed is None:
             seed = candidate_seed(_base_seed(rng), index)
         n = 5 if neighbourhood is None else setup.n
+        if setup.search == "global":
+            found, note = setup.plan([seed], avoid=[tuple(int(v) for v in o) for o in avoid])
+            if not found:
+                raise ValueError(note)
+            origin, n = found[0], 0
     return setup.make(index, seed, origin, n, cancel)

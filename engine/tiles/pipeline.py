@@ -15,7 +15,13 @@ import numpy as np
 
 from engine.events import Progress
 from engine.settings import TilesetSettings
-from engine.tiles.candidates import CandidateTile, default_patch_overlap, iter_candidates
+from engine.tiles.candidates import (
+    MARGIN,
+    CandidatesNotice,
+    CandidateTile,
+    default_patch_overlap,
+    iter_candidates,
+)
 from engine.tiles.layout import assemble, random_layout
 from engine.tiles.seamless import MAIN, SeamlessTile, iter_make_seamless
 from engine.tiles.template import default_overlap, iter_find_template, template_cost
@@ -62,7 +68,7 @@ def resolve(settings: TilesetSettings, shape, *, overlap: int | None = None) -> 
         tile_max=hi,
         overlap=w_t,
         patch_overlap=ring,
-        margin=min(2, ring - 1) if settings.margin is None else settings.margin,
+        margin=min(MARGIN, ring - 1) if settings.margin is None else settings.margin,
         layout_seed=settings.seed if settings.layout_seed is None else settings.layout_seed,
         template_blend=settings.template_seam.blend,
     )
@@ -139,21 +145,26 @@ def _iter_tileset(source, s, rect, maps, weights, excluded, picks, workers, canc
         cancel=cancel,
     )
     notes += [w for w in seamless.warnings if w not in notes]
-    cands = yield from iter_candidates(
-        source,
-        seamless,
-        resolved.candidates,
-        patch_size=resolved.patch_size,
-        patch_overlap=resolved.patch_overlap,
-        margin=resolved.margin,
-        neighbourhood=resolved.neighbourhood,
-        seam=resolved.seam,
-        excluded=excluded,
-        maps=maps,
-        weights=weights,
-        rng=resolved.seed,
-        workers=workers,
-        cancel=cancel,
+    cands = yield from _noting(
+        iter_candidates(
+            source,
+            seamless,
+            resolved.candidates,
+            patch_size=resolved.patch_size,
+            patch_overlap=resolved.patch_overlap,
+            margin=resolved.margin,
+            patch_search=resolved.patch_search,
+            neighbourhood=resolved.neighbourhood,
+            min_distance=resolved.min_distance,
+            seam=resolved.seam,
+            excluded=excluded,
+            maps=maps,
+            weights=weights,
+            rng=resolved.seed,
+            workers=workers,
+            cancel=cancel,
+        ),
+        notes,
     )
     chosen = list(picks) if picks is not None else [c.index for c in cands]
     made = {c.index for c in cands}
@@ -185,6 +196,18 @@ def _iter_tileset(source, s, rect, maps, weights, excluded, picks, workers, canc
         preview=preview,
         warnings=tuple(notes),
     )
+
+
+def _noting(gen, notes: list):
+    """Re-yield ``gen``'s events, adding every :class:`CandidatesNotice` to ``notes``."""
+    while True:
+        try:
+            ev = next(gen)
+        except StopIteration as stop:
+            return stop.value
+        if isinstance(ev, CandidatesNotice) and ev.message not in notes:
+            notes.append(ev.message)
+        yield ev
 
 
 def tileset(source, settings: TilesetSettings | None = None, **options) -> TilesetResult:

@@ -108,7 +108,7 @@ def test_from_dict_reads_the_seam_as_a_dict_and_names_unknown_keys():
 def test_resolve_fills_in_what_comes_from_the_source():
     r = resolve(TilesetSettings(seed=4), (300, 200))
     assert (r.tile_min, r.tile_max) == ((50, 50), (100, 100))
-    assert r.overlap == 8 and r.patch_overlap == 8 and r.margin == 2 and r.layout_seed == 4
+    assert r.overlap == 8 and r.patch_overlap == 8 and r.margin == 1 and r.layout_seed == 4
     assert r.template_blend == "none"
     fixed = resolve(TilesetSettings(tile_min=64, template_blend=None), (300, 200), overlap=20)
     assert (fixed.tile_min, fixed.tile_max) == ((64, 64), (64, 64))

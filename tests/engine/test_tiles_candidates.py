@@ -21,7 +21,7 @@ from engine.tiles import (
     make_seamless,
     random_layout,
 )
-from engine.tiles.candidates import _Setup
+from engine.tiles.candidates import MARGIN, _Setup
 from tests.engine.helpers import events_and_result, smooth_texture
 
 
@@ -116,8 +116,13 @@ def test_closing_the_generator_stops_the_pool(small):
 def test_make_candidate_from_origin_and_from_seed(small):
     S, st = small
     cands = candidates(S, st, 3, rng=9, workers=1)
-    again = make_candidate(S, st, seed=cands[2].seed, index=2)
+    # the global search keeps candidate 2 away from the earlier ones: give their origins
+    avoid = [c.patch_origin for c in cands[:2]]
+    again = make_candidate(S, st, seed=cands[2].seed, index=2, avoid=avoid)
     np.testing.assert_array_equal(again.tile, cands[2].tile)
+    local = candidates(S, st, 3, rng=9, workers=1, patch_search="local")
+    again = make_candidate(S, st, seed=local[2].seed, index=2, patch_search="local")
+    np.testing.assert_array_equal(again.tile, local[2].tile)
     moved = make_candidate(S, st, patch_origin=(40, 50), index=7)
     assert moved.patch_origin == (40, 50) and moved.index == 7 and moved.seed is None
     settled = make_candidate(S, st, patch_origin=(40, 50), neighbourhood=3)
@@ -252,7 +257,7 @@ def test_candidates_default_to_that_ring():
         h, w = c.mask.shape
         r, col = c.loop[:, 0], c.loop[:, 1]
         depth = np.minimum.reduce([r, col, h - 1 - r, w - 1 - col])
-        assert depth.min() >= 2 and depth.max() <= ring_px - 1, (depth.min(), depth.max())
+        assert depth.min() >= MARGIN and depth.max() <= ring_px - 1, (depth.min(), depth.max())
     kw = dict(patch_origin=(30, 40))
     default = make_candidate(S, st, **kw)
     np.testing.assert_array_equal(default.tile, make_candidate(S, st, patch_overlap=12, **kw).tile)

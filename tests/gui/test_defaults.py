@@ -35,14 +35,16 @@ def _preview_grid_score(source, template, patch_overlap) -> float:
 
 
 def test_default_patch_ring_shows_less_grid_than_the_template_overlap():
-    """The editor's "auto" ring (the engine default: w_T 16 -> 8 px) halves the grid."""
+    """The editor's "auto" ring (the engine default: w_T 16 -> 8 px) shows less grid. (It
+    used to halve it; since the candidates' cuts are drawn toward the outer margin (issue 10)
+    a wide ring shows little more grid than the narrow one.)"""
     source = load_image(sample_path("cobblestones")).pixels
     d = params.DEFAULTS
     seam = SeamSpec(blend=d["blend"])
     template = make_seamless(source, (187, 94, 102, 126), overlap=16, seam=seam)  # w_T 16
     default = _preview_grid_score(source, template, d["patch_overlap"] or None)
     w_t = _preview_grid_score(source, template, template.overlap)
-    assert default < 0.75 * w_t, (default, w_t)
+    assert default < w_t, (default, w_t)
 
 
 def test_editor_patch_ring_defaults_to_auto_which_is_the_engine_default(qtbot):
