@@ -184,6 +184,13 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         help="--patch-search local: refine each random patch position within +-N px "
         f"(default {d.neighbourhood})",
     )
+    p.add_argument(
+        "--min-distance",
+        type=int_at_least(0),
+        metavar="PX",
+        help="--patch-search global: keep the candidates' patch sources at least PX apart and "
+        "away from the template's position (default: a quarter tile, less on small sources)",
+    )
     p.add_argument("--seam", choices=METHODS, help=f"seam method (default {d.seam.method})")
     add_seam_options(p)
     p.add_argument("--metric", choices=METRICS, help=f"error metric (default {d.seam.metric})")
@@ -261,6 +268,7 @@ _FIELDS = {
     "margin": "margin",
     "neighbourhood": "neighbourhood",
     "patch_search": "patch_search",
+    "min_distance": "min_distance",
     "preview": "preview",
     "exclude_color": "exclude_color",
 }
@@ -276,9 +284,6 @@ def settings_from_args(args) -> TilesetSettings:
     from engine.cli.tileset_wang import wang_changes
 
     changes.update(wang_changes(args))
-    if args.wang is None and args.min_distance is not None:  # --min-distance of the candidates
-        changes.pop("wang_min_distance", None)
-        changes["min_distance"] = int(round(args.min_distance))
     if args.equal_neighbours:
         changes["no_equal_neighbours"] = False
     seam = {"method": args.seam, "metric": args.metric, "width": args.width, "rho": args.rho}
