@@ -25,6 +25,7 @@ from quilt_gui import commands, params
 from quilt_gui.model import Source, safe_name
 from quilt_gui.quilting_doc import QuiltingDocument
 from quilt_gui.tileset_doc import TileSetDocument
+from quilt_gui.wang_doc import WangDocument
 
 
 class Document(QObject):
@@ -52,6 +53,7 @@ class Document(QObject):
         self.undo_stack.cleanChanged.connect(self._on_clean_changed)
         self.tileset = TileSetDocument(self, self.undo_stack)
         self.quilting = QuiltingDocument(self, self.undo_stack)
+        self.wang = WangDocument(self, self.undo_stack)
 
     # ------------------------------------------------------------------ state
     @property
@@ -127,6 +129,7 @@ class Document(QObject):
         self.source_changed.emit()
         self.maps_changed.emit()
         self.tileset.clear()
+        self.wang.clear()
         self.path_changed.emit()
         self.apply_painted(None)
         self.quilting.start(None)

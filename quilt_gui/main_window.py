@@ -30,6 +30,7 @@ from quilt_gui.files import ProjectFiles
 from quilt_gui.imaging import pixel_text
 from quilt_gui.pipeline import Pipeline
 from quilt_gui.theme import apply_theme
+from quilt_gui.wang_runner import WangRunner
 from quilt_gui.widgets.candidate_dialog import CandidateDialog
 from quilt_gui.widgets.canvas import ImageCanvas
 from quilt_gui.widgets.gallery import CandidateView
@@ -41,6 +42,7 @@ from quilt_gui.widgets.quilt_view import QuiltView
 from quilt_gui.widgets.source_view import SourceView
 from quilt_gui.widgets.status import JobStatus, MessageBar
 from quilt_gui.widgets.tile_view import REPEATS, TileView
+from quilt_gui.widgets.wang_view import WangView
 from quilt_gui.widgets.wrap_view import WrapView
 from resources import SAMPLE_NAMES
 
@@ -82,6 +84,7 @@ class MainWindow(QMainWindow):
         self.doc.params = params.coerce_all(settings.get("parameters"))  # the last used options
         self.jobs = jobs.manager()
         self.pipeline = Pipeline(self.doc, self.jobs, self)
+        self.wang_runner = WangRunner(self.doc, self.pipeline, self.jobs, self)
         self.files = ProjectFiles(self.doc, self.jobs, self)
         self.messages: list[tuple[str, str]] = []  # (level, text) log, newest last
         self._dialogs: dict[int, CandidateDialog] = {}
@@ -250,6 +253,11 @@ class MainWindow(QMainWindow):
         self.tabs.setTabToolTip(
             2, "The seamless tile (or the preview) repeated without end, to pan across its edges"
         )
+        self.wang_view = WangView(doc, self.wang_runner)
+        self.tabs.addTab(self.wang_view, "Wang tiles")
+        self.tabs.setTabToolTip(
+            3, "A Wang tile set: tiles whose edges vary, any two with matching colours join"
+        )
         self.quilt_view = QuiltView(doc, (self.act_quilt, self.act_load_target, self.act_transfer))
         self.tabs.addTab(self.quilt_view, "Quilting")
         central = QWidget()
@@ -365,6 +373,8 @@ class MainWindow(QMainWindow):
     def _connect(self) -> None:
         doc = self.doc
         self.pipeline.message.connect(self.show_message)
+        self.wang_runner.message.connect(self.show_message)
+        self.wang_view.export_requested.connect(partial(self.export_dialog, wang=True))
         self.files.message.connect(self.show_message)
         self.files.image_opened.connect(self._on_image_opened)
         self.pipeline.seam_updated.connect(self._on_seam_updated)
@@ -376,6 +386,8 @@ class MainWindow(QMainWindow):
         doc.tileset.candidates_reset.connect(self._update_actions)
         doc.tileset.candidate_inserted.connect(self._update_actions)
         doc.tileset.picks_changed.connect(self._update_actions)
+        doc.wang.reset.connect(self._update_actions)
+        doc.wang.layout_changed.connect(self._update_actions)
         self.gallery.open_requested.connect(self.open_candidate)
         self.gallery.reroll_requested.connect(self.reroll_candidate)
         self.gallery.current_changed.connect(self._on_gallery_current)
@@ -400,6 +412,9 @@ class MainWindow(QMainWindow):
             self.quilt_view.target,
             self.quilt_view.output,
             self.quilt_view.inspector,
+            self.wang_view.source,
+            self.wang_view.tiles,
+            self.wang_view.preview,
         ]
 
     # ------------------------------------------------------------------ messages
@@ -448,10 +463,17 @@ class MainWindow(QMainWindow):
             self.files.open_path(files[0])
 
     # ------------------------------------------------------------------ export
-    def export_dialog(self) -> None:
+    def export_dialog(self, *_args, wang: bool | None = None) -> None:
+        """The export dialog of the tile set (``wang``: the Wang set; None: the Wang set when
+        its tab is in front)."""
         from quilt_gui.widgets.export_dialog import ExportDialog
 
-        if not self.doc.tileset.candidates:
+        if wang is None:
+            wang = self.tabs.currentWidget() is self.wang_view
+        if wang and not self.doc.wang.complete:
+            self.show_message("warning", "Nothing to export yet: generate the Wang set first.")
+            return
+        if not wang and not self.doc.tileset.candidates:
             self.show_message(
                 "warning", "Nothing to export yet: generate candidates and pick the tiles to keep."
             )
@@ -461,7 +483,7 @@ class MainWindow(QMainWindow):
             dlg = ExportDialog(self.doc, self.jobs, self)
             dlg.message.connect(self.show_message)
             self._export_dialog = dlg
-        dlg.refresh()
+        dlg.refresh(wang=wang)
         dlg.show()
         dlg.raise_()
 
@@ -509,9 +531,10 @@ class MainWindow(QMainWindow):
     @Slot(int)
     def _on_tab_changed(self, _index: int) -> None:
         quilting = self.tabs.currentWidget() is self.quilt_view
+        wang = self.tabs.currentWidget() is self.wang_view
         self.params_panel.show_groups(QUILT_GROUPS if quilting else TILESET_GROUPS)
         for key in ("overlaps", "tile", "gallery"):
-            self.docks[key].setVisible(not quilting)
+            self.docks[key].setVisible(not quilting and not wang)
         self._show_criteria()
 
     # ------------------------------------------------------------------ view actions
@@ -621,7 +644,7 @@ class MainWindow(QMainWindow):
         ):
             a.setEnabled(has)
         self.act_generate.setEnabled(has and self.doc.tileset.seamless is not None)
-        self.act_export.setEnabled(bool(self.doc.tileset.candidates))
+        self.act_export.setEnabled(bool(self.doc.tileset.candidates) or self.doc.wang.complete)
         self.act_reroll_layout.setEnabled(bool(self.doc.tileset.picks))
         n = len(self.doc.tileset.candidates)
         title = f"Candidates — {len(self.doc.tileset.picks)} of {n} picked" if n else "Candidates"

@@ -1,7 +1,8 @@
 """The document as a project file's :class:`engine.project.Project`, and back.
 
 :func:`to_project` reads every part of the document (the source, the parameters, the tile
-set's template, candidates, picks and layout, the painted exclusion); :func:`apply_project`
+set's template, candidates, picks and layout, the Wang set, the painted exclusion);
+:func:`apply_project`
 replaces the whole document by a project (the undo history starts empty).
 """
 
@@ -37,6 +38,7 @@ def to_project(doc) -> Project:
     preview = None
     if ts.preview is not None and layout is not None:
         preview = {names[0]: ts.preview}
+    wang, wang_tiles = doc.wang.to_project(names)
     return Project(
         sources=dict(doc.source.maps),
         name=doc.name,
@@ -54,6 +56,8 @@ def to_project(doc) -> Project:
         waypoints={k: [tuple(p) for p in v] for k, v in ts.waypoints.items()},
         preview=preview,
         extra={"editor": "quilt-studio", **mask_to_json(doc.exclude_painted)},
+        wang=wang,
+        wang_tiles=wang_tiles,
     )
 
 
@@ -82,6 +86,7 @@ def apply_project(doc, project: Project, path: str | None) -> None:
     doc.apply_painted(mask_from_json(project.extra, source.shape))
     doc.params_changed.emit(frozenset(doc.params))
     ts.emit_all()
+    doc.wang.apply_project(project.wang, project.wang_tiles)
     doc.path_changed.emit()
     doc.mark_saved()
 

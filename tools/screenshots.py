@@ -5,8 +5,8 @@ Run under Xvfb so real window-system rendering is used:
     xvfb-run -s "-screen 0 1600x1000x24" python tools/screenshots.py
 
 Writes docs/template.png, docs/template_400.png, docs/candidates.png, docs/candidate.png,
-docs/preview.png, docs/quilting.png, docs/quilting_inspect.png, docs/export.png and
-docs/exclusion.png.
+docs/preview.png, docs/quilting.png, docs/quilting_inspect.png, docs/wang.png,
+docs/wang_tiles.png, docs/export.png and docs/exclusion.png.
 """
 
 from __future__ import annotations
@@ -99,6 +99,23 @@ def main() -> int:
     w.quilt_view.select(min(57, len(doc.quilting.blocks) - 1))
     w.message_bar.dismiss()
     shot(w, "quilting_inspect.png")
+
+    # -- Wang tab: edge samples on the source, the 16 tiles with their edge colours and cuts,
+    # a random valid layout with the grid
+    w.tabs.setCurrentWidget(w.wang_view)
+    wv = w.wang_view
+    wv.tile_size.setValue(128)
+    wv.generate_button.click()
+    wait_until(lambda: not w.jobs.busy())
+    wv.select_sample("h", 1)
+    wv.grid_box.setChecked(True)
+    w.message_bar.dismiss()
+    wv.tiles.fit()
+    wv.preview.fit()
+    shot(w, "wang.png")
+    wv.tiles.set_zoom(2.0)
+    wv.tiles.center_on_pixel(128, 128)
+    shot(wv.tiles.viewport(), "wang_tiles.png")
 
     # -- export dialog
     w.tabs.setCurrentWidget(w.source_view)

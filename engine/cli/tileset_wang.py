@@ -195,7 +195,7 @@ def run_wang(args, settings, rect=None) -> int:
             "seed": s.seed,
             "settings": settings.to_dict(),
             "resolved": s.to_dict(),
-            "wang": wang_record(ws),
+            "wang": ws.record(),
             "tiles": tiles,
             "layout": {"csv": "layout.csv", "json": "layout.json"},
             "preview": {"file": preview["main"], "maps": preview},
@@ -223,27 +223,12 @@ def run_wang(args, settings, rect=None) -> int:
     return 0
 
 
-def wang_record(ws) -> dict:
-    """The set-level record of a :class:`engine.tiles.wang.WangSet` (manifest and project)."""
-    return {
-        "colours": ws.colours,
-        "tile_size": ws.tile_size,
-        "variants": ws.variants,
-        "band": ws.band,
-        "samples": [
-            {"axis": s.axis, "colour": s.colour, "origin": list(s.origin), "error": s.error}
-            for s in ws.samples
-        ],
-        "parameters": ws.parameters,
-    }
-
-
 def project_arguments(result, S, maps, depth, args, weights) -> dict:
     """The keyword arguments of :func:`engine.project.project_from_tileset` for a Wang set."""
     from engine.cli.tileset import MAIN_MAP, _map_weights
 
     s, ws = result.settings, result.wang
-    record = wang_record(ws)
+    record = ws.record()
     record["layout"] = result.layout.tolist()
     return dict(
         sources={MAIN_MAP: S, **maps},

@@ -70,6 +70,8 @@ __all__ = [
     "from_candidate",
     "iter_wang_set",
     "make_wang_tile",
+    "samples_from_record",
+    "wang_record",
     "wang_set",
 ]
 
@@ -241,6 +243,7 @@ class WangTile(Item):
             params={
                 "wang": self.wang,
                 "variant": self.variant,
+                "index": self.index,
                 "junction": list(self.junction),
                 "cuts": cuts,
             },
@@ -256,7 +259,7 @@ def from_candidate(c) -> WangTile:
         paths["patch"] = np.asarray(c.loop, dtype=np.intp)
     junction = p.get("junction") or (0, 0)
     return WangTile(
-        index=int(c.index),
+        index=int(p.get("index", c.index)),
         signature=tuple(int(p["wang"][k]) for k in "nesw"),
         variant=int(p.get("variant", 0)),
         tile=c.tile,
@@ -299,11 +302,42 @@ class WangSet:
     def signatures(self) -> list[tuple[int, int, int, int]]:
         return [t.signature for t in self.tiles]
 
+    def record(self) -> dict:
+        """The set's record for manifests and projects (:func:`wang_record`)."""
+        return wang_record(self.samples, self.parameters)
+
     def arrangement(self, variant: int = 0) -> np.ndarray:
         """The K² x K² index matrix of :func:`canonical_signatures` (a valid tiling that also
         wraps) for one variant."""
         n = self.colours**2
         return (variant * n * n + np.arange(n * n)).reshape(n, n)
+
+
+def wang_record(samples, parameters: dict) -> dict:
+    """A Wang set as plain JSON (manifest, project): colours, tile size, variants, band, the
+    samples and every parameter of the run; :func:`samples_from_record` reads the samples
+    back."""
+    return {
+        "colours": int(parameters["colours"]),
+        "tile_size": int(parameters["tile_size"]),
+        "variants": int(parameters.get("variants", 1)),
+        "band": parameters.get("band"),
+        "samples": [
+            {"axis": s.axis, "colour": int(s.colour), "origin": [int(v) for v in s.origin],
+             "error": float(s.error)}
+            for s in samples
+        ],
+        "parameters": dict(parameters),
+    }  # fmt: skip
+
+
+def samples_from_record(record: dict) -> list[WangSample]:
+    """The :class:`WangSample` list of a :func:`wang_record`."""
+    return [
+        WangSample(s["axis"], int(s["colour"]), (int(s["origin"][0]), int(s["origin"][1])),
+                   float(s.get("error", 0.0)))
+        for s in record["samples"]
+    ]  # fmt: skip
 
 
 # --------------------------------------------------------------------------- seeds

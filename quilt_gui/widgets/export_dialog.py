@@ -79,6 +79,7 @@ class ExportDialog(QDialog):
         self.doc = doc
         self.jobs = manager
         self.manifest: dict | None = None
+        self.wang = False  # exporting the Wang set (its tab) rather than the picked candidates
         self.folder = QLineEdit()
         self.folder.setToolTip(
             "The bundle is written into this folder (created; it must be "
@@ -148,28 +149,41 @@ class ExportDialog(QDialog):
         lay.addWidget(self.buttons)
         self.resize(560, 0)
 
-    def refresh(self) -> None:
-        """Defaults from the document and the last export folder."""
+    def refresh(self, *, wang: bool = False) -> None:
+        """Defaults from the document and the last export folder; ``wang``: export the Wang
+        set (with Tiled's Wang set and Godot's terrain set) instead of the picked candidates."""
         doc = self.doc
+        self.wang = bool(wang)
+        self.setWindowTitle("Export Wang tile set" if self.wang else "Export tile set")
         self.name.setText(doc.name)
         base = settings.get("last_export_dir") or str(Path.home())
-        self.folder.setText(str(Path(base) / f"{doc.name}_export"))
-        n = len(doc.tileset.picks) or len(doc.tileset.candidates)
-        what = "picked" if doc.tileset.picks else "(none picked: all)"
+        suffix = "_wang_export" if self.wang else "_export"
+        self.folder.setText(str(Path(base) / f"{doc.name}{suffix}"))
         maps = list(doc.source.maps) if doc.source else []
-        size = ""
-        if doc.tileset.candidates:
-            h, w = doc.tileset.candidates[0].tile.shape[:2]
-            size = f", {w}×{h} px"
-        lay = (
-            ""
-            if doc.tileset.layout is None
-            else f", preview layout {doc.tileset.layout.shape[0]}×{doc.tileset.layout.shape[1]}"
-        )
         depth = doc.source.bit_depth if doc.source else 8
-        self.summary.setText(
-            f"<b>{n}</b> tiles {what}{size}; maps: {', '.join(maps)}; source {depth}-bit{lay}."
-        )
+        if self.wang:
+            w = doc.wang
+            size = w.tile_list()[0].tile.shape[0] if w.tiles else 0
+            self.summary.setText(
+                f"<b>{len(w.tiles)}</b> Wang tiles ({w.colours} colours per edge direction), "
+                f"{size}×{size} px; maps: {', '.join(maps)}; source {depth}-bit; Tiled Wang "
+                "set and Godot terrain set included."
+            )
+        else:
+            n = len(doc.tileset.picks) or len(doc.tileset.candidates)
+            what = "picked" if doc.tileset.picks else "(none picked: all)"
+            size = ""
+            if doc.tileset.candidates:
+                h, w_ = doc.tileset.candidates[0].tile.shape[:2]
+                size = f", {w_}×{h} px"
+            lay = (
+                ""
+                if doc.tileset.layout is None
+                else f", preview layout {doc.tileset.layout.shape[0]}×{doc.tileset.layout.shape[1]}"
+            )
+            self.summary.setText(
+                f"<b>{n}</b> tiles {what}{size}; maps: {', '.join(maps)}; source {depth}-bit{lay}."
+            )
         self.normal.setEnabled("normal" in (doc.source.kinds.values() if doc.source else ()))
         self.status.setText("")
         self.export_button.setDefault(True)
@@ -209,6 +223,8 @@ class ExportDialog(QDialog):
             return None
         try:
             project = project_io.to_project(self.doc)
+            if self.wang:
+                project.candidates, project.picks, project.layout = [], [], None
         except ValueError as exc:
             self._fail(str(exc))
             return None
@@ -225,6 +241,7 @@ class ExportDialog(QDialog):
             pass_cancel=False,
             on_done=self._on_done,
             on_error=self._on_error,
+            wang=self.wang,
             **self.options(),
         )
 

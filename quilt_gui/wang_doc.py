@@ -1,0 +1,189 @@
+"""The Wang workflow's part of the document: the set's options, edge samples, tiles, layout.
+
+A Wang set (:mod:`engine.tiles.wang`) is made by a job that streams its samples, then its
+tiles; they are applied here directly (not undo steps). Moving or re-rolling an edge sample is
+an undo step (:class:`SetWangSample`); the runner (:mod:`quilt_gui.wang_runner`) then rebuilds
+the tiles that use it. Re-rolling the preview's layout is one too (:class:`SetWangLayout`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from PySide6.QtCore import QObject, Signal
+from PySide6.QtGui import QUndoCommand
+
+from engine.tiles.wang import (
+    AXES,
+    canonical_signatures,
+    from_candidate,
+    samples_from_record,
+    wang_record,
+)
+
+__all__ = ["DEFAULT_OPTIONS", "SetWangLayout", "SetWangSample", "WangDocument"]
+
+#: the editor's Wang options (engine.tiles.wang.iter_wang_set names) and their defaults
+DEFAULT_OPTIONS = {"colours": 2, "tile_size": 128, "variants": 1, "interior": "patch", "seed": 0}
+
+
+class WangDocument(QObject):
+    """Options, samples, tiles and preview layout of a Wang set made from ``root``'s source."""
+
+    reset = Signal()  # a new set is being made (or cleared): everything redraws
+    samples_changed = Signal()
+    sample_moved = Signal(str, int)  # axis, colour: a user edit, its tiles are stale
+    tile_changed = Signal(int)  # tile index
+    layout_changed = Signal()
+    selection_changed = Signal()
+
+    def __init__(self, root, undo_stack) -> None:
+        super().__init__(root)
+        self.root = root
+        self.undo_stack = undo_stack
+        self.options = dict(DEFAULT_OPTIONS)
+        self.samples: list | None = None  # engine WangSample, h colours then v colours
+        self.tiles: dict[int, object] = {}  # index -> engine WangTile
+        self.layout: np.ndarray | None = None
+        self.layout_seed = 0
+        self.selected: tuple[str, int] | None = None  # (axis, colour) of the chosen sample
+        self.notes: tuple[str, ...] = ()
+        self.parameters: dict = {}  # the engine's parameters of the last run
+
+    # ------------------------------------------------------------------ state
+    @property
+    def colours(self) -> int:
+        return int(self.options["colours"])
+
+    @property
+    def count(self) -> int:
+        return int(self.options["variants"]) * self.colours**4
+
+    @property
+    def complete(self) -> bool:
+        return self.samples is not None and sorted(self.tiles) == list(range(self.count))
+
+    def tile_list(self) -> list:
+        return [self.tiles[k] for k in sorted(self.tiles)]
+
+    def signature(self, index: int) -> tuple[int, int, int, int]:
+        sigs = canonical_signatures(self.colours)
+        return sigs[index % len(sigs)]
+
+    def sample(self, axis: str, colour: int):
+        return self.samples[AXES.index(axis) * self.colours + colour]
+
+    def users(self, axis: str, colour: int) -> list[int]:
+        """Indices of the tiles that show sample (axis, colour) on one of their edges."""
+        sides = (0, 2) if axis == "h" else (1, 3)
+        return [k for k in range(self.count) if any(self.signature(k)[s] == colour for s in sides)]
+
+    # ------------------------------------------------------------------ results (not undo steps)
+    def clear(self) -> None:
+        self.start(self.options)
+
+    def start(self, options: dict) -> None:
+        """A new set with ``options``: samples, tiles and layout forgotten."""
+        self.options = {**DEFAULT_OPTIONS, **options}
+        self.samples, self.tiles, self.layout = None, {}, None
+        self.selected, self.notes = None, ()
+        self.reset.emit()
+        self.selection_changed.emit()
+
+    def apply_samples(self, samples) -> None:
+        self.samples = list(samples)
+        self.samples_changed.emit()
+
+    def set_tile(self, tile) -> None:
+        self.tiles[int(tile.index)] = tile
+        self.tile_changed.emit(int(tile.index))
+        self.root.mark_dirty()
+
+    def select(self, key: tuple[str, int] | None) -> None:
+        if key != self.selected:
+            self.selected = key
+            self.selection_changed.emit()
+
+    # ------------------------------------------------------------------ project files
+    def to_project(self, names: list[str]) -> tuple[dict | None, list]:
+        """(record, tiles) of :attr:`engine.project.Project.wang` / ``wang_tiles``; nothing
+        when there is no set, or when a tile lacks one of the source's maps ``names`` (made
+        before the map was attached: generate again)."""
+        tiles = self.tile_list()
+        if self.samples is None or not tiles:
+            return None, []
+        if any(set(t.maps) != set(names[1:]) for t in tiles):
+            return None, []
+        params = {**self.parameters, **self.options}
+        record = wang_record(self.samples, params)
+        record.update(
+            options=dict(self.options),
+            layout=None if self.layout is None else self.layout.tolist(),
+            layout_seed=self.layout_seed,
+        )
+        return record, [t.to_candidate() for t in tiles]
+
+    def apply_project(self, record: dict | None, tiles) -> None:
+        """Take the Wang set a project kept (as :meth:`to_project` wrote it, or the CLI)."""
+        if record is None:
+            self.start(self.options)
+            return
+        params = record.get("parameters", {})
+        opts = {k: params[k] for k in DEFAULT_OPTIONS if k in params}
+        opts.update(record.get("options") or {})
+        opts.setdefault("seed", params.get("seed", 0))
+        self.start(opts)
+        self.parameters = dict(params)
+        self.apply_samples(samples_from_record(record))
+        for c in tiles:
+            t = from_candidate(c)
+            self.tiles[t.index] = t
+            self.tile_changed.emit(t.index)
+        layout = record.get("layout")
+        self.apply_layout(layout, int(record.get("layout_seed", 0)))
+
+    # ------------------------------------------------------------------ user edits (undoable)
+    def set_sample(self, sample, *, text: str = "Move edge sample") -> None:
+        """Replace one edge sample (its tiles are rebuilt); one undo step."""
+        self.undo_stack.push(SetWangSample(self, sample, text))
+
+    def apply_sample(self, sample) -> None:
+        i = AXES.index(sample.axis) * self.colours + sample.colour
+        self.samples[i] = sample
+        self.samples_changed.emit()
+        self.sample_moved.emit(sample.axis, int(sample.colour))
+
+    def set_layout(self, layout, seed: int, *, text: str = "Re-roll Wang layout") -> None:
+        self.undo_stack.push(SetWangLayout(self, layout, seed, text))
+
+    def apply_layout(self, layout, seed: int) -> None:
+        self.layout = None if layout is None else np.asarray(layout, dtype=np.int64)
+        self.layout_seed = int(seed)
+        self.layout_changed.emit()
+
+
+class SetWangSample(QUndoCommand):
+    def __init__(self, doc: WangDocument, sample, text: str) -> None:
+        super().__init__(text)
+        self.doc = doc
+        self.new = sample
+        self.old = doc.sample(sample.axis, sample.colour)
+
+    def redo(self) -> None:
+        self.doc.apply_sample(self.new)
+
+    def undo(self) -> None:
+        self.doc.apply_sample(self.old)
+
+
+class SetWangLayout(QUndoCommand):
+    def __init__(self, doc: WangDocument, layout, seed: int, text: str) -> None:
+        super().__init__(text)
+        self.doc = doc
+        self.new = (layout, seed)
+        self.old = (doc.layout, doc.layout_seed)
+
+    def redo(self) -> None:
+        self.doc.apply_layout(*self.new)
+
+    def undo(self) -> None:
+        self.doc.apply_layout(*self.old)

@@ -1,0 +1,190 @@
+"""The engine runs of the Wang workflow: make a set, rebuild the tiles of a moved sample,
+re-roll a sample or the preview's layout. Jobs stream into :attr:`Document.wang`."""
+
+from __future__ import annotations
+
+import numpy as np
+from PySide6.QtCore import QObject, Signal, Slot
+
+from engine.tiles.wang import WangSample, WangSamples, WangTile, choose_sample, iter_wang_set
+from engine.tiles.wang_layout import wang_layout
+from quilt_gui import jobs, params
+from quilt_gui.jobs import error_text
+from quilt_gui.pipeline import excluding
+
+__all__ = ["WangRunner"]
+
+PREVIEW = (8, 8)  # the preview layout's cells (rows, cols)
+
+
+class WangRunner(QObject):
+    """Starts the Wang jobs for ``doc`` (a :class:`quilt_gui.document.Document`)."""
+
+    message = Signal(str, str)  # level, text
+
+    def __init__(self, doc, pipeline, manager: jobs.JobManager | None = None, parent=None):
+        super().__init__(parent)
+        self.doc = doc
+        self.pipeline = pipeline
+        self.jobs = manager or jobs.manager()
+        self.stale: set[int] = set()  # tiles whose samples moved since they were made
+        self._reroll_seed = 1000
+        doc.wang.sample_moved.connect(self._on_sample_moved)
+        doc.source_changed.connect(self._on_source_changed)
+
+    # ------------------------------------------------------------------ options
+    def engine_options(self) -> dict:
+        """Keyword options of :func:`engine.tiles.wang.iter_wang_set` (with ``exclusion``
+        for :func:`quilt_gui.pipeline.excluding`): the set's own options, the cut of the
+        Parameters panel, the material maps and their weights, the exclusion."""
+        o = self.doc.wang.options
+        src = self.doc.source
+        return dict(
+            tile_size=int(o["tile_size"]),
+            colours=int(o["colours"]),
+            variants=int(o["variants"]),
+            interior=o["interior"],
+            seam=params.tileset_settings(self.doc.params).seam,
+            maps=src.extra_maps or None,
+            weights=self.doc.tileset.engine_weights(),
+            exclusion=self.pipeline.exclusion(),
+        )
+
+    def _ready(self) -> bool:
+        if self.doc.source is None:
+            self.message.emit("warning", "Open a source image first.")
+            return False
+        return True
+
+    # ------------------------------------------------------------------ the whole set
+    def generate(self, options: dict | None = None) -> jobs.Job | None:
+        """Make a new set with ``options`` (colours, tile_size, variants, interior, seed)."""
+        if not self._ready():
+            return None
+        w = self.doc.wang
+        self.jobs.abort_matching("wang")
+        w.start({**w.options, **(options or {})})
+        self.stale = set()
+        try:
+            opts = self.engine_options()
+        except (TypeError, ValueError) as exc:
+            self.message.emit("error", f"Wang set: {exc}")
+            return None
+        return self.jobs.start(
+            "wang",
+            excluding(iter_wang_set),
+            self.doc.source.main,
+            label=f"Making {w.count} Wang tiles",
+            rng=int(w.options["seed"]),
+            workers=2,
+            on_event=self._on_event,
+            on_done=self._on_done,
+            on_error=self._on_error,
+            **opts,
+        )
+
+    def _on_event(self, event) -> None:
+        if isinstance(event, WangSamples):
+            self.doc.wang.apply_samples(event.samples)
+        elif isinstance(event, WangTile):
+            self.stale.discard(int(event.index))
+            self.doc.wang.set_tile(event)
+
+    def _on_done(self, result) -> None:
+        w = self.doc.wang
+        w.notes = tuple(result.notes)
+        w.parameters = dict(result.parameters)
+        for note in result.notes:
+            self.message.emit("warning", f"Wang set: {note}")
+        if w.complete and w.layout is None:
+            seed = int(w.options["seed"])
+            w.apply_layout(self._layout(seed), seed)
+
+    def _on_error(self, exc) -> None:
+        self.message.emit("error", f"Wang set failed: {error_text(exc)}")
+
+    # ------------------------------------------------------------------ samples
+    def move_sample(self, axis: str, colour: int, origin) -> bool:
+        """Put sample (axis, colour) at ``origin`` (row, col); False when it does not fit."""
+        from engine.tiles.wang import _Setup
+
+        w = self.doc.wang
+        size = int(w.options["tile_size"])
+        try:
+            origin = _Setup(self.doc.source.main, tile_size=size).check_origin(axis, origin)
+        except (TypeError, ValueError) as exc:
+            self.message.emit("warning", f"The edge sample cannot go there: {exc}")
+            return False
+        if tuple(origin) != tuple(w.sample(axis, colour).origin):
+            w.set_sample(WangSample(axis, int(colour), tuple(origin)))
+        return True
+
+    def reroll_sample(self, axis: str, colour: int) -> jobs.Job | None:
+        """Choose sample (axis, colour) again (a new draw among the best matches)."""
+        w = self.doc.wang
+        if not self._ready() or w.samples is None:
+            return None
+        self._reroll_seed += 1
+        opts = self.engine_options()
+        keep = ("tile_size", "colours", "seam", "maps", "weights", "exclusion")
+        return self.jobs.start(
+            "wang-sample",
+            excluding(choose_sample),
+            self.doc.source.main,
+            list(w.samples),
+            axis,
+            int(colour),
+            label="Choosing an edge sample",
+            rng=self._reroll_seed,
+            pass_cancel=False,
+            on_done=lambda s: w.set_sample(s, text="Re-roll edge sample"),
+            on_error=self._on_error,
+            **{k: v for k, v in opts.items() if k in keep},
+        )
+
+    @Slot(str, int)
+    def _on_sample_moved(self, axis: str, colour: int) -> None:
+        self.stale |= set(self.doc.wang.users(axis, colour))
+        self.rebuild()
+
+    def rebuild(self) -> jobs.Job | None:
+        """Make the stale tiles again with the current samples (supersedes a running
+        rebuild: its tiles stay stale until this one delivers them)."""
+        w = self.doc.wang
+        if not self.stale or w.samples is None or self.doc.source is None:
+            return None
+        todo = sorted(self.stale)
+        avoid = [t.patch_origin for k, t in w.tiles.items() if k not in self.stale]
+        return self.jobs.start(
+            "wang-rebuild",
+            excluding(iter_wang_set),
+            self.doc.source.main,
+            label=f"Rebuilding {len(todo)} Wang tiles",
+            samples=list(w.samples),
+            tiles=todo,
+            avoid=[a for a in avoid if a is not None],
+            rng=int(w.options["seed"]),
+            workers=2,
+            on_event=self._on_event,
+            on_error=self._on_error,
+            **self.engine_options(),
+        )
+
+    # ------------------------------------------------------------------ preview layout
+    def _layout(self, seed: int) -> np.ndarray:
+        sigs = [self.doc.wang.tiles[k].signature for k in sorted(self.doc.wang.tiles)]
+        return wang_layout(sigs, *PREVIEW, rng=seed, no_equal_neighbours=True)
+
+    def reroll_layout(self) -> None:
+        w = self.doc.wang
+        if not w.complete:
+            self.message.emit("warning", "Make the Wang set first (Generate).")
+            return
+        seed = w.layout_seed + 1
+        w.set_layout(self._layout(seed), seed)
+
+    @Slot()
+    def _on_source_changed(self) -> None:
+        self.jobs.abort_matching("wang")
+        self.stale = set()
+        self.doc.wang.clear()

@@ -1,0 +1,121 @@
+"""The Wang tab: generate a set, drag an edge sample (its tiles rebuilt), undo, re-roll,
+preview, save and reopen, export."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+from PySide6.QtCore import QPoint, Qt
+
+from engine.tiles.wang_layout import layout_mismatches
+from tests.gui.helpers import make_window, open_sample
+
+
+def wait_wang(qtbot, win, timeout=30_000):
+    qtbot.waitUntil(lambda: not win.jobs.busy(), timeout=timeout)
+
+
+def generate(qtbot, win, **options):
+    win.tabs.setCurrentWidget(win.wang_view)
+    view = win.wang_view
+    view.tile_size.setValue(options.get("tile_size", 48))
+    view.colours.setValue(options.get("colours", 2))
+    view.generate_button.click()
+    wait_wang(qtbot, win)
+    return view
+
+
+def test_generate_streams_a_complete_set_with_a_valid_preview(qtbot):
+    win = make_window(qtbot)
+    open_sample(qtbot, win, "cobblestones")
+    view = generate(qtbot, win)
+    w = win.doc.wang
+    assert w.complete and len(w.tiles) == 16 and len(w.samples) == 4
+    assert len(view.samples) == 4  # one diamond per edge sample on the source
+    img = view.tiles.array
+    assert img.shape[:2] == (4 * 48, 4 * 48)  # the canonical 4x4 arrangement
+    sigs = [t.signature for t in w.tile_list()]
+    assert w.layout.shape == (8, 8) and layout_mismatches(sigs, w.layout) == 0
+    assert view.preview.array.shape[:2] == (8 * 48, 8 * 48)
+    old = w.layout.copy()
+    view.reroll_layout_button.click()
+    assert not np.array_equal(old, w.layout) and layout_mismatches(sigs, w.layout) == 0
+    win.doc.undo_stack.undo()
+    np.testing.assert_array_equal(w.layout, old)
+    view.grid_box.setChecked(True)
+    assert len(view._grid_items) == 14
+
+
+def test_dragging_a_sample_rebuilds_its_tiles_and_undo_restores_it(qtbot):
+    win = make_window(qtbot)
+    open_sample(qtbot, win, "cobblestones")
+    view = generate(qtbot, win)
+    w = win.doc.wang
+    before = {k: t.tile.copy() for k, t in w.tiles.items()}
+    item = view.samples[("h", 1)]
+    old = w.sample("h", 1).origin
+    canvas = view.source
+    canvas.set_zoom(1.0)
+    canvas.centerOn(item.polygon().boundingRect().center())
+    a = canvas.mapFromScene(item.polygon().boundingRect().center())
+    b = a + QPoint(9, 7)
+    qtbot.mousePress(canvas.viewport(), Qt.MouseButton.LeftButton, pos=a)
+    for k in range(1, 5):
+        qtbot.mouseMove(canvas.viewport(), a + (b - a) * (k / 4))
+    qtbot.mouseRelease(canvas.viewport(), Qt.MouseButton.LeftButton, pos=b)
+    wait_wang(qtbot, win)
+    new = w.sample("h", 1).origin
+    assert new != old and w.selected == ("h", 1)
+    users = set(w.users("h", 1))
+    changed = {k for k, t in w.tiles.items() if not np.array_equal(t.tile, before[k])}
+    assert changed == users  # exactly the tiles that show the sample were rebuilt
+    y, x = new
+    for k in users:  # and they show it: a north edge is the sample's source row
+        t = w.tiles[k]
+        if t.signature[0] == 1:
+            np.testing.assert_array_equal(t.tile[0], win.doc.source.main[y, x : x + 48])
+    win.doc.undo_stack.undo()
+    wait_wang(qtbot, win)
+    assert w.sample("h", 1).origin == old
+    for k in users:
+        np.testing.assert_array_equal(w.tiles[k].tile, before[k])
+
+
+def test_reroll_a_sample_save_reopen_and_export(qtbot, tmp_path):
+    win = make_window(qtbot)
+    open_sample(qtbot, win, "gravel")
+    view = generate(qtbot, win)
+    w = win.doc.wang
+    view.select_sample("v", 0)
+    old = w.sample("v", 0).origin
+    view.reroll_sample_button.click()
+    wait_wang(qtbot, win)
+    assert w.sample("v", 0).origin != old and w.complete
+    path = tmp_path / "w.quiltproj"
+    assert win.files.save_to(str(path), wait=True)
+    from engine.project import load_project
+
+    p = load_project(path)
+    assert p.wang["colours"] == 2 and len(p.wang_tiles) == 16
+    win2 = make_window(qtbot)
+    with qtbot.waitSignal(win2.doc.source_changed, timeout=10_000):
+        win2.files.open_path(str(path), confirm=False)
+    wait_wang(qtbot, win2)
+    w2 = win2.doc.wang
+    assert w2.complete and w2.samples == w.samples
+    np.testing.assert_array_equal(w2.layout, w.layout)
+    for k in w.tiles:  # kept at the source's 8 bits
+        np.testing.assert_allclose(w2.tiles[k].tile, w.tiles[k].tile, atol=0.51 / 255)
+    win2.tabs.setCurrentWidget(win2.wang_view)
+    assert win2.wang_view.tiles.array is not None
+    win2.export_dialog()
+    dlg = win2._export_dialog
+    assert dlg.wang and "Wang" in dlg.windowTitle()
+    dlg.folder.setText(str(tmp_path / "bundle"))
+    dlg.export()
+    qtbot.waitUntil(lambda: dlg.manifest is not None, timeout=30_000)
+    name = dlg.manifest["name"]
+    man = json.loads((tmp_path / "bundle" / f"{name}.json").read_text())
+    assert man["wang"]["colours"] == 2 and len(man["tiles"]) == 16
+    assert "<wangset" in (tmp_path / "bundle" / f"{name}.tsx").read_text()
