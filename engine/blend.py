@@ -35,7 +35,7 @@ from scipy import ndimage
 from skimage.util import img_as_float32
 
 from engine._validate import as_error_map, choice, positive_int
-from engine.seams.spec import BLEND_MODES
+from engine.seams.spec import BLEND_MODES, SeamSpec
 
 __all__ = [
     "BLEND_MODES",
@@ -145,9 +145,10 @@ def blend_weights(
     seam,
     error,
     *,
-    mode: str = "none",
-    width: float = 4,
-    rho: int = 3,
+    spec: SeamSpec | None = None,
+    mode: str | None = None,
+    width: float | None = None,
+    rho: int | None = None,
     cyclic: bool = False,
 ) -> np.ndarray:
     """Weight of R1 (float32, (h, w)) for a canonical seam; see the module docstring.
@@ -158,6 +159,8 @@ def blend_weights(
         The cut (``mask`` True on R1's side, path included).
     error : (h, w) array
         The error map the seam was searched on (adaptive mode reads it).
+    spec : engine.seams.SeamSpec, optional
+        Its ``blend``, ``width`` and ``rho`` (then ``mode``, ``width``, ``rho`` are not given).
     mode : {"none", "feather", "adaptive"}
         Hard cut, fixed ramp of ``width`` pixels, or ρ-adaptive half-widths (§1.3).
     width : float
@@ -167,6 +170,13 @@ def blend_weights(
     cyclic : bool
         Rows 0 and h - 1 are neighbours (a cyclic seam): smoothing and ramp wrap around.
     """
+    if spec is not None:
+        if (mode, width, rho) != (None, None, None):
+            raise TypeError("give either spec= or mode/width/rho, not both")
+        mode, width, rho = spec.blend, spec.width, spec.rho
+    mode = "none" if mode is None else mode
+    width = 4 if width is None else width
+    rho = 3 if rho is None else rho
     choice(mode, "mode", BLEND_MODES)
     mask = np.asarray(seam.mask, dtype=bool)
     e = as_error_map(error)

@@ -42,3 +42,20 @@ def check(cancel: CancelToken | None) -> None:
     """Raise :class:`Cancelled` when ``cancel`` is set."""
     if cancel is not None and cancel.cancelled:
         raise Cancelled("cancelled")
+
+
+class AnyCancel:
+    """Cancelled when any of the tokens is (duck-types :class:`CancelToken`)."""
+
+    __slots__ = ("tokens",)
+
+    def __init__(self, *tokens):
+        self.tokens = tuple(t for t in tokens if t is not None)
+
+    @property
+    def cancelled(self) -> bool:
+        return any(t.cancelled for t in self.tokens)
+
+    def raise_if_cancelled(self) -> None:
+        if self.cancelled:
+            raise Cancelled("cancelled")

@@ -28,6 +28,7 @@ from scipy import ndimage
 from engine._validate import as_error_map, as_image, choice, positive_int
 from engine.blend import (
     adaptive_half_widths,
+    blend_weights,
     clamped_half_widths,
     composite,
     cut_columns,
@@ -37,7 +38,7 @@ from engine.cancel import check
 from engine.errormap import error_map
 from engine.seams._result import Seam
 from engine.seams.graph import graph_path
-from engine.seams.search import MINIMAX_METRIC
+from engine.seams.search import MINIMAX_METRIC, find_seam
 from engine.seams.spec import SeamSpec, as_seam_spec
 
 ORIENTATIONS = ("right", "left", "bottom", "top")
@@ -211,8 +212,10 @@ def stitch(
         except (TypeError, ValueError):
             raise ValueError(f"waypoints must be (row, col) pairs, got {waypoints!r}") from None
         wps = [tuple(p) for p in map_points(wp, orientation, err.shape).tolist()]
-    found = spec.find(ce, start=start, end=end, waypoints=wps, cyclic=cyclic, cancel=cancel)
-    alpha_c = spec.blend_weights(found, ce, cyclic=bool(cyclic))
+    found = find_seam(
+        ce, seam=spec, start=start, end=end, waypoints=wps, cyclic=cyclic, cancel=cancel
+    )
+    alpha_c = blend_weights(found, ce, spec=spec, cyclic=bool(cyclic))
     alpha = np.ascontiguousarray(from_canonical(alpha_c, orientation))
     mask = np.ascontiguousarray(from_canonical(np.asarray(found.mask), orientation))
     path = map_points(np.asarray(found.path), orientation, err.shape, inverse=True)
@@ -387,7 +390,7 @@ def _strip_path(strip: np.ndarray, spec: SeamSpec, start, cancel) -> np.ndarray:
         c0 = int(np.argmin(cost[0])) if start is None else start
         cols = _trace_down(step, 0, c0)
         return np.column_stack([np.arange(strip.shape[0]), cols])
-    return np.asarray(spec.find(strip, start=start, cancel=cancel).path)
+    return np.asarray(find_seam(strip, seam=spec, start=start, cancel=cancel).path)
 
 
 def l_cut(
@@ -621,7 +624,9 @@ def patch_cut(
         check(cancel)
         ce = np.ascontiguousarray(ce)
         # the path on the (biased) search map; the blend widths from the error itself
-        side = spec.find(np.ascontiguousarray(search[name][0]), start=start, end=end, cancel=cancel)
+        side = find_seam(
+            np.ascontiguousarray(search[name][0]), seam=spec, start=start, end=end, cancel=cancel
+        )
         sides[name] = side
         p = np.asarray(side.path)
         rows, cols = to_window(p)

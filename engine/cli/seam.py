@@ -82,10 +82,11 @@ def _point(text: str) -> tuple[int, int]:
 def run(args) -> int:
     import numpy as np
 
-    from engine.blend import composite
+    from engine.blend import blend_weights, composite
     from engine.budget import check_memory, seam_bytes
     from engine.errormap import error_map
     from engine.io import check_output, load_image, save_image, to_rgb
+    from engine.seams import find_seam
 
     if args.o_max is not None and args.method != "oscillating":
         raise ValueError(f"--o-max applies to --method oscillating only, not {args.method}")
@@ -121,14 +122,14 @@ def run(args) -> int:
     err = error_map(r1, r2, metric=spec.metric)
     # a fresh process loads (or compiles) the method's numba kernels on first use, ~0.2 s:
     # do that on a tiny map so the time printed is the search's own
-    spec.find(np.ones((3, 3))).mask  # noqa: B018
+    find_seam(np.ones((3, 3)), seam=spec).mask  # noqa: B018
     t0 = time.perf_counter()
-    seam = spec.find(err, start=args.start, end=args.end, waypoints=tuple(args.waypoint))
+    seam = find_seam(err, seam=spec, start=args.start, end=args.end, waypoints=tuple(args.waypoint))
     elapsed = time.perf_counter() - t0
     if args.save_mask:
         save_image(args.save_mask, seam.mask.astype(np.float32))
     if args.save_composite:
-        alpha = spec.blend_weights(seam, err)
+        alpha = blend_weights(seam, err, spec=spec)
         save_image(args.save_composite, composite(alpha, r1, r2), bit_depth=depth)
     top = float(err.max())
     if args.save_error:

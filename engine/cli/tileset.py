@@ -22,33 +22,35 @@ stderr, one line per step.
 from __future__ import annotations
 
 import argparse
-import csv
-import io
 import json
-import os
 import re
 import sys
-import time
 from pathlib import Path
 
-from engine._fs import replace_folder, write_bytes_atomically
 from engine.cli import SUBCOMMANDS
 from engine.cli._args import (
     add_exclusion,
     add_seam_options,
-    excluded_pixels,
     int_at_least,
     non_negative_float,
     thread_count,
 )
-from engine.cli.export import add_project_option, save_project_option
+from engine.cli.export import add_project_option
+from engine.cli.tileset_output import (
+    FORMAT,
+    MAIN_MAP,
+    VERSION,
+    Reporter,
+    check_out,
+    csv_text,
+    load_inputs,
+    map_weights,
+    write_images,
+    write_set,
+    write_text,
+)
 from engine.seams.spec import BLEND_MODES, METHODS, METRICS
 from engine.settings import TilesetSettings
-
-FORMAT = "quilt-studio-tileset"
-VERSION = 2  # 2: "settings" (TilesetSettings.to_dict()) replaces "parameters"
-MAIN_MAP = "albedo"  # the source's map name in a project file
-WRITE_ACTION = "write the tile set to"
 
 
 # ---------------------------------------------------------------- argument types
@@ -328,14 +330,6 @@ def read_settings(path) -> TilesetSettings:
 
 
 # ---------------------------------------------------------------- running
-class _Reporter:
-    """Progress lines on stderr."""
-
-    def __init__(self):
-        self.t0 = time.perf_counter()
-
-    def __call__(self, text: str) -> None:
-        print(f"[{time.perf_counter() - self.t0:7.2f}s] {text}", file=sys.stderr, flush=True)
 
 
 def _parse_rect(text: str):
@@ -364,76 +358,13 @@ def run(args) -> int:
         bad = [k for k in args.pick if k >= settings.candidates]
         raise ValueError(f"--pick {bad} out of range: --candidates is {settings.candidates}")
     rect = _parse_rect(args.rect) if args.rect else None
-    _check_out(args)
+    check_out(args)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         code = work(args, settings, rect)
     for text in dict.fromkeys(str(w.message) for w in caught):  # each once, in order
         print(f"quilt-studio tileset: warning: {text}", file=sys.stderr)
     return code
-
-
-def _inputs(args) -> list:
-    return [args.source, *(p for _, p in args.map), args.exclude_mask]
-
-
-def _project_inside(args) -> str | None:
-    """The file name of ``--project`` if it goes into the ``--out`` folder, else None."""
-    project = getattr(args, "project", None)
-    if not project:
-        return None
-    out = Path(os.path.abspath(args.out))
-    p = Path(os.path.abspath(project))
-    if p.parent == out:
-        return p.name
-    if out in p.parents:
-        raise ValueError(
-            f"--project {project}: a project inside --out goes directly in that folder, not in "
-            "a subfolder of it"
-        )
-    return None
-
-
-def _check_out(args) -> None:
-    """Refuse, before any work, an --out folder the set cannot replace as a whole (holding
-    other files or an input, the current folder) or cannot be written next to."""
-    from engine._fs import OutputError, check_folder, check_writable
-
-    out = Path(args.out)
-    _project_inside(args)
-    try:
-        check_folder(out, owned=tileset_files, inputs=_inputs(args), action=WRITE_ACTION)
-        check_writable(Path(os.path.abspath(out)).parent, name=f"--out {out}")
-    except OutputError as exc:
-        raise ValueError(str(exc)) from None
-
-
-def tileset_files(folder: Path) -> set[str]:
-    """The files the tile-set manifest in ``folder`` says an earlier run wrote there."""
-    path = Path(folder) / "manifest.json"
-    try:
-        if path.stat().st_size > 64 * 2**20:
-            return set()
-        doc = json.loads(path.read_text("utf-8"))
-    except (OSError, ValueError, RecursionError):
-        return set()
-    if not isinstance(doc, dict) or doc.get("format") != FORMAT:
-        return set()
-    names = ["manifest.json", *_names(doc.get("files"))]
-    names += _names(doc.get("layout"))
-    for key in ("template", "preview"):
-        names += _names(
-            (doc.get(key) or {}).get("maps") if isinstance(doc.get(key), dict) else None
-        )
-    for tile in doc.get("tiles") or []:
-        names += _names(tile.get("maps") if isinstance(tile, dict) else None)
-    return {n for n in names if re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9._-]*", n)}
-
-
-def _names(v) -> list[str]:
-    if isinstance(v, dict):
-        v = list(v.values())
-    return [n for n in v if isinstance(n, str)] if isinstance(v, list) else []
 
 
 def _check_sizes(args, settings: TilesetSettings, S, rect, maps) -> TilesetSettings:
@@ -501,38 +432,11 @@ def _events(say, n: int):
     return on_event
 
 
-def load_inputs(args, settings: TilesetSettings, say):
-    """The source, its bit depth, the material maps, the seam weights and the excluded
-    pixels the flags name: ``(S, depth, maps, weights, excluded)``."""
-    from engine.io import load_image
-
-    loaded = load_image(args.source)
-    S, depth = loaded.pixels, loaded.bit_depth
-    H, W = S.shape[:2]
-    say(f"source {args.source}: {W}x{H}, {S.shape[2]} channel(s), {depth}-bit")
-    maps = {}
-    for name, path in args.map:
-        if name in maps or name == "main":
-            raise ValueError(f"--map {name}: duplicate or reserved map name")
-        maps[name] = load_image(path).pixels
-    weights = dict(args.weight) or None
-    given = argparse.Namespace(exclude_color=settings.exclude_color, exclude_mask=args.exclude_mask)
-    excluded = excluded_pixels(given, S, "source")
-    if excluded is not None:
-        say(f"excluded: {int(excluded.sum())} of {H * W} source pixels")
-        if excluded.all():
-            raise ValueError(
-                f"--exclude-color / --exclude-mask exclude every pixel of {args.source}: "
-                "no tile can be taken from it"
-            )
-    return S, depth, maps, weights, excluded
-
-
 def _run(args, settings: TilesetSettings, rect) -> int:
     from engine.events import drain
     from engine.tiles.pipeline import iter_tileset
 
-    say = _Reporter()
+    say = Reporter()
     S, depth, maps, weights, excluded = load_inputs(args, settings, say)
     H, W = S.shape[:2]
     settings = _check_sizes(args, settings, S, rect, maps)
@@ -586,27 +490,6 @@ def _run(args, settings: TilesetSettings, rect) -> int:
     return 0
 
 
-def write_set(args, write, project: dict) -> None:
-    """Write the --out folder as a whole: ``write(tmp)`` writes the images and layout into an
-    empty temporary folder and returns the manifest, which gets the list of every file and is
-    written last, with the project if ``--project`` goes into that folder (``project``: the
-    keyword arguments of :func:`engine.project.project_from_tileset`). The folder is then
-    swapped in (:func:`engine._fs.replace_folder`); a project elsewhere is saved after it."""
-    inside = _project_inside(args)
-
-    def fill(tmp: Path) -> None:
-        manifest = write(tmp)
-        extra = ["manifest.json"] + ([inside] if inside else [])
-        manifest["files"] = sorted([*os.listdir(tmp), *extra])
-        _write_text(tmp / "manifest.json", json.dumps(manifest, indent=1) + "\n")
-        if inside:
-            save_project_option(args, into=tmp / inside, **project)
-
-    replace_folder(args.out, fill, owned=tileset_files, inputs=_inputs(args), action=WRITE_ACTION)
-    if project and not inside:
-        save_project_option(args, **project)
-
-
 def write_files(out: Path, result, depth: int) -> dict:
     """Write the images, layout.csv and layout.json of ``result``; the manifest's content."""
 
@@ -621,7 +504,7 @@ def write_files(out: Path, result, depth: int) -> dict:
     preview_files = write("preview", result.preview)
     cells = result.cells
     rows, cols = result.settings.preview
-    _write_text(out / "layout.csv", _csv(cells))
+    write_text(out / "layout.csv", csv_text(cells))
     layout_doc = {
         "tile_w": int(rect[2]),
         "tile_h": int(rect[3]),
@@ -630,7 +513,7 @@ def write_files(out: Path, result, depth: int) -> dict:
         "cells": cells.tolist(),
         "cells_are": "tile indices (tile_NNN.png)",
     }
-    _write_text(out / "layout.json", json.dumps(layout_doc, indent=1) + "\n")
+    write_text(out / "layout.json", json.dumps(layout_doc, indent=1) + "\n")
     return {
         "format": FORMAT,
         "version": VERSION,
@@ -652,19 +535,6 @@ def write_files(out: Path, result, depth: int) -> dict:
         "preview": {"file": preview_files["main"], "maps": preview_files},
         "warnings": list(result.warnings),
     }
-
-
-def write_images(out: Path, stem: str, images: dict, depth: int) -> dict:
-    """``stem.png`` (map ``main``) and ``stem_<map>.png`` at ``depth`` bits; {map: file name}."""
-    from engine.bitdepth import quantize
-    from engine.png import encode_png
-
-    files = {}
-    for m, img in images.items():
-        fname = f"{stem}.png" if m == "main" else f"{stem}_{m}.png"
-        write_bytes_atomically(out / fname, encode_png(quantize(img, depth, dither=False)))
-        files[m] = fname
-    return files
 
 
 def project_arguments(result, S, maps, depth, args, weights, excluded) -> dict:
@@ -691,25 +561,7 @@ def project_arguments(result, S, maps, depth, args, weights, excluded) -> dict:
         project_seeds={"candidates": s.seed, "layout": s.layout_seed},
         bit_depth=depth,
         source_paths={MAIN_MAP: str(args.source), **{k: p for k, p in args.map}},
-        map_weights=_map_weights(weights),
+        map_weights=map_weights(weights),
         preview=as_project_maps(result.preview["main"], extra_maps),
         extra=mask_to_json(excluded),
     )
-
-
-def _map_weights(weights) -> dict:
-    """The project's seam-error weights per map name: given weights leave out a map's weight
-    as 0, the source's too (``engine.materials.material_error``), so it is written out."""
-    if not weights:
-        return {}
-    return {MAIN_MAP: weights.get("main", 0.0), **{k: v for k, v in weights.items() if k != "main"}}
-
-
-def _csv(cells) -> str:
-    buf = io.StringIO()
-    csv.writer(buf, lineterminator="\n").writerows(cells.tolist())
-    return buf.getvalue()
-
-
-def _write_text(path: Path, text: str) -> None:
-    write_bytes_atomically(path, text.encode("utf-8"))

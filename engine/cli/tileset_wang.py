@@ -128,20 +128,20 @@ def _events(say, count: int):
 
 def run_wang(args, settings, rect=None) -> int:
     """Make the Wang set, write its files and (``--project``) the project."""
-    from engine.cli.tileset import (
+    from engine.cli.tileset_output import (
         FORMAT,
         VERSION,
-        _csv,
-        _Reporter,
-        _write_text,
+        Reporter,
+        csv_text,
         load_inputs,
         write_images,
         write_set,
+        write_text,
     )
     from engine.events import drain
     from engine.tiles.wang_pipeline import iter_wang_tileset, resolve_wang
 
-    say = _Reporter()
+    say = Reporter()
     S, depth, maps, weights, excluded = load_inputs(args, settings, say)
     s = resolve_wang(settings, S.shape[:2])
     count = s.wang_variants * s.wang**4
@@ -178,7 +178,7 @@ def run_wang(args, settings, rect=None) -> int:
                 }
             )
         preview = write_images(out, "preview", result.preview, depth)
-        _write_text(out / "layout.csv", _csv(result.layout))
+        write_text(out / "layout.csv", csv_text(result.layout))
         layout_doc = {
             "tile_w": ws.tile_size,
             "tile_h": ws.tile_size,
@@ -187,7 +187,7 @@ def run_wang(args, settings, rect=None) -> int:
             "cells": result.layout.tolist(),
             "cells_are": "tile indices (tile_NNN.png); every pair of touching edges has one colour",
         }
-        _write_text(out / "layout.json", json.dumps(layout_doc, indent=1) + "\n")
+        write_text(out / "layout.json", json.dumps(layout_doc, indent=1) + "\n")
         return {
             "format": FORMAT,
             "version": VERSION,
@@ -225,7 +225,7 @@ def run_wang(args, settings, rect=None) -> int:
 
 def project_arguments(result, S, maps, depth, args, weights) -> dict:
     """The keyword arguments of :func:`engine.project.project_from_tileset` for a Wang set."""
-    from engine.cli.tileset import MAIN_MAP, _map_weights
+    from engine.cli.tileset_output import MAIN_MAP, map_weights
 
     s, ws = result.settings, result.wang
     record = ws.record()
@@ -238,7 +238,7 @@ def project_arguments(result, S, maps, depth, args, weights) -> dict:
         project_seeds={"wang": s.seed, "layout": s.layout_seed},
         bit_depth=depth,
         source_paths={MAIN_MAP: str(args.source), **{k: p for k, p in args.map}},
-        map_weights=_map_weights(weights),
+        map_weights=map_weights(weights),
         wang=record,
         wang_tiles=[t.to_candidate() for t in ws.tiles],
     )

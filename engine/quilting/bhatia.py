@@ -21,7 +21,7 @@ from engine.events import Progress
 from engine.exclusion import valid_anchors
 from engine.quilting.core import Quilter
 from engine.quilting.records import BlockPlaced, BlockRecord, read_only
-from engine.seams import make_seam
+from engine.seams import find_seam, make_seam
 
 __all__ = ["bhatia_anchors", "iter_bhatia"]
 
@@ -166,11 +166,13 @@ def _bhatia_seam(q: Quilter, e: np.ndarray, own_band: np.ndarray):
     down (its line 1 then starts at the shared corner) and is turned back."""
     spec = q.seam
     if spec.method != "resistance":
-        return spec.find(e, start=0, end=0, cancel=q.cancel)
+        return find_seam(e, seam=spec, start=0, end=0, cancel=q.cancel)
     # Bhatia's step: the colour difference inside the new block
     if spec.options["variant"] != "published":
-        return spec.find(e, start=0, end=0, image=own_band, cancel=q.cancel)
-    up = spec.find(e[::-1].copy(), start=0, end=0, image=own_band[::-1].copy(), cancel=q.cancel)
+        return find_seam(e, seam=spec, start=0, end=0, image=own_band, cancel=q.cancel)
+    up = find_seam(
+        e[::-1].copy(), seam=spec, start=0, end=0, image=own_band[::-1].copy(), cancel=q.cancel
+    )
     path = np.asarray(up.path)[::-1] * (-1, 1) + (e.shape[0] - 1, 0)
     return make_seam(e, path, up.method, mask=up.mask[::-1])
 

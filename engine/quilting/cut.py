@@ -14,7 +14,7 @@ import numpy as np
 from scipy import ndimage
 
 from engine.blend import ramp_from_mask
-from engine.seams import SeamSpec
+from engine.seams import SeamSpec, find_seam
 from engine.stitch import from_canonical, l_cut, map_points, to_canonical
 
 __all__ = ["Cut", "blend_alpha", "cut_overlap", "straight_alpha"]
@@ -67,7 +67,7 @@ def cut_overlap(err, arms, *, seam: SeamSpec, cancel=None) -> Cut:
         rows, cols = _arm_window(side, k, h, w)
         orient = _ARM_ORIENTATION[side]
         strip = err[rows, cols]
-        cut = seam.find(np.ascontiguousarray(to_canonical(strip, orient)), cancel=cancel)
+        cut = find_seam(np.ascontiguousarray(to_canonical(strip, orient)), seam=seam, cancel=cancel)
         keep[rows, cols] |= from_canonical(np.asarray(cut.mask), orient)
         pts = map_points(np.asarray(cut.path), orient, strip.shape, inverse=True)
         paths.append(pts + (rows.start, cols.start))

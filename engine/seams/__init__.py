@@ -3,8 +3,8 @@
 ``find_seam(error, method=...)`` returns a :class:`Seam`; ``iter_find_seam`` streams
 :class:`SeamUpdate` snapshots (every improvement of the anytime ``oscillating`` search, a single
 final one for the others) and returns the final :class:`Seam`. A :class:`SeamSpec` (method,
-options, metric, blend) is what the workflows pass around: ``spec.find(error, ...)`` and
-``spec.iter_find(error, ...)`` search with it.
+options, metric, blend) is what the workflows pass around: ``find_seam(error, seam=spec)``
+and ``iter_find_seam(error, seam=spec)`` search with it.
 
 The error map runs top to bottom; a path starts anywhere in the top row and ends anywhere in the
 bottom row; R1 is kept on the left, R2 on the right.

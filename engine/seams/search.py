@@ -288,7 +288,8 @@ def iter_search(
 def iter_find_seam(
     error,
     *,
-    method: str = "dp",
+    seam: SeamSpec | None = None,
+    method: str | None = None,
     start: int | None = None,
     end: int | None = None,
     waypoints=(),
@@ -297,13 +298,23 @@ def iter_find_seam(
     cancel=None,
     **options,
 ):
-    """:func:`iter_search` with ``SeamSpec(method, options)``: the method by name and its
-    options (:data:`engine.seams.OPTIONS`; unknown ones raise TypeError) as keywords."""
-    if not isinstance(method, str) or method not in METHODS:
-        raise ValueError(f"method must be one of {', '.join(map(repr, METHODS))}, got {method!r}")
+    """:func:`iter_search` with ``seam`` (a :class:`SeamSpec`), or with ``SeamSpec(method,
+    options)``: the method by name (default ``"dp"``) and its options
+    (:data:`engine.seams.OPTIONS`; unknown ones raise TypeError) as keywords."""
+    if seam is not None:
+        if method is not None or options:
+            raise TypeError("give either seam=SeamSpec(...) or method= and its options, not both")
+        spec = seam
+    else:
+        method = "dp" if method is None else method
+        if not isinstance(method, str) or method not in METHODS:
+            raise ValueError(
+                f"method must be one of {', '.join(map(repr, METHODS))}, got {method!r}"
+            )
+        spec = SeamSpec(method, options)
     return iter_search(
         error,
-        SeamSpec(method, options),
+        spec,
         start=start,
         end=end,
         waypoints=waypoints,
@@ -313,9 +324,10 @@ def iter_find_seam(
     )
 
 
-def find_seam(error, *, method: str = "dp", **kwargs) -> Seam:
-    """Find a top-to-bottom seam through ``error`` (see :func:`iter_find_seam`)."""
-    return drain(iter_find_seam(error, method=method, **kwargs))
+def find_seam(error, **kwargs) -> Seam:
+    """Find a top-to-bottom seam through ``error``: ``find_seam(e, seam=spec, start=...)`` or
+    ``find_seam(e, method="oscillating", o_max=5)`` (see :func:`iter_find_seam`)."""
+    return drain(iter_find_seam(error, **kwargs))
 
 
 def warmup() -> None:

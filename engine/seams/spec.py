@@ -4,7 +4,9 @@
 cuts (:func:`engine.stitch.stitch`, :func:`engine.stitch.patch_cut`, the tile workflow,
 quilting), the command line and the editor pass it down unchanged, so an option has one name
 and one check on every floor. It serialises itself to a plain dict (:meth:`SeamSpec.to_dict`,
-:meth:`SeamSpec.from_dict`) for project files, manifests and settings.
+:meth:`SeamSpec.from_dict`) for project files, manifests and settings. It is a value only:
+``find_seam(error, seam=spec)`` searches with it, ``blend_weights(seam, error, spec=spec)``
+blends with it (this module imports neither, so every arrow points here).
 
 This module imports no numpy: the command line's parsers read its tables (:data:`METHODS`,
 :data:`OPTIONS`, :data:`METRICS`, :data:`BLEND_MODES`) without loading the engine.
@@ -215,30 +217,6 @@ class SeamSpec:
         if isinstance(values.get("width"), numbers.Integral):
             values["width"] = float(values["width"])
         return cls(**values)
-
-    # ------------------------------------------------------------------ use
-    def iter_find(self, error, **constraints):
-        """:func:`engine.seams.search.iter_search` with this spec: a generator of
-        :class:`engine.seams.SeamUpdate` whose value is the :class:`engine.seams.Seam`."""
-        from engine.seams.search import iter_search
-
-        return iter_search(error, self, **constraints)
-
-    def find(self, error, **constraints):
-        """The seam through ``error`` (constraints: ``start``, ``end``, ``waypoints``,
-        ``cyclic``, ``image``, ``cancel``; see :func:`engine.seams.find_seam`)."""
-        from engine.events import drain
-
-        return drain(self.iter_find(error, **constraints))
-
-    def blend_weights(self, seam, error, *, cyclic: bool = False):
-        """Weight of R1 after this spec's blending of ``seam``
-        (:func:`engine.blend.blend_weights`)."""
-        from engine.blend import blend_weights
-
-        return blend_weights(
-            seam, error, mode=self.blend, width=self.width, rho=self.rho, cyclic=cyclic
-        )
 
 
 def as_seam_spec(value, name: str = "seam", *, default: SeamSpec | None = None) -> SeamSpec:

@@ -42,7 +42,7 @@ import numpy as np
 from numba import njit
 
 from engine._validate import as_image, choice, non_negative_number, positive_int
-from engine.cancel import Cancelled, CancelToken, check, is_cancelled
+from engine.cancel import AnyCancel, Cancelled, CancelToken, check, is_cancelled
 from engine.candidate import CandidateTile
 from engine.errormap import colour_channels
 from engine.events import Item, Progress, drain, frozen_array
@@ -118,7 +118,8 @@ def candidate_seed(base: int, index: int) -> int:
     return int(state) & (2**63 - 1)
 
 
-def _base_seed(rng) -> int:
+def base_seed(rng) -> int:
+    """The run's base seed from ``rng`` (a seed, a Generator or None: a fresh one)."""
     if isinstance(rng, numbers.Integral) and not isinstance(rng, bool):
         if rng < 0:
             raise ValueError(f"rng must be a non-negative seed, got {rng}")
@@ -193,23 +194,6 @@ def _runs(mask: np.ndarray) -> np.ndarray:
     r0, c0 = np.nonzero(d == 1)
     _, c1 = np.nonzero(d == -1)
     return np.ascontiguousarray(np.column_stack([r0, c0, c1]), dtype=np.int64)
-
-
-class _AnyCancel:
-    """Cancelled when any of the tokens is (duck-types :class:`CancelToken`)."""
-
-    __slots__ = ("tokens",)
-
-    def __init__(self, *tokens):
-        self.tokens = tuple(t for t in tokens if t is not None)
-
-    @property
-    def cancelled(self) -> bool:
-        return any(t.cancelled for t in self.tokens)
-
-    def raise_if_cancelled(self) -> None:
-        if self.cancelled:
-            raise Cancelled("cancelled")
 
 
 # --------------------------------------------------------------------------- setup
@@ -574,7 +558,7 @@ def iter_candidates(
     )
     n = positive_int(n, "n")
     workers = positive_int(workers, "workers")
-    base = _base_seed(rng)
+    base = base_seed(rng)
     for note in setup.notes:
         warnings.warn(note, stacklevel=2)
     return _iter_candidates(setup, n, base, workers, cancel)
@@ -606,7 +590,7 @@ def _iter_candidates(setup: _Setup, n: int, base: int, workers: int, cancel):
             yield Progress(len(made), n, f"candidate {k}")
     else:
         stop = CancelToken()
-        token = _AnyCancel(cancel, stop)
+        token = AnyCancel(cancel, stop)
         pool = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="candidates")
         try:
             pending = {
@@ -712,7 +696,7 @@ def make_candidate(
         seed = None
     else:
         if seed is None:
-            seed = candidate_seed(_base_seed(rng), index)
+            seed = candidate_seed(base_seed(rng), index)
         n = 5 if neighbourhood is None else setup.n
         if setup.search == "global":
             found, note = setup.plan([seed], avoid=[tuple(int(v) for v in o) for o in avoid])

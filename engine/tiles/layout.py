@@ -19,7 +19,8 @@ from engine.index_matrix import assemble_layout
 __all__ = ["assemble", "random_layout"]
 
 
-def _weights(weights, n_tiles: int) -> np.ndarray:
+def tile_weights(weights, n_tiles: int) -> np.ndarray:
+    """Validated relative frequencies of ``n_tiles`` tiles (None: all 1)."""
     if weights is None:
         return np.ones(n_tiles)
     w = np.asarray(weights, dtype=np.float64)
@@ -57,7 +58,7 @@ def random_layout(
     n = positive_int(n_tiles, "n_tiles")
     rows = positive_int(rows, "rows")
     cols = positive_int(cols, "cols")
-    w = _weights(weights, n)
+    w = tile_weights(weights, n)
     gen = as_rng(rng)
     p = w / w.sum()
     if not no_equal_neighbours:

@@ -21,11 +21,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from engine._validate import as_image, choice
+from engine.blend import blend_weights
 from engine.cancel import check
 from engine.events import Progress, Snapshot, drain, frozen_array
 from engine.materials import apply_cut, material_error
 from engine.seams._result import Seam
-from engine.seams.search import SeamUpdate
+from engine.seams.search import SeamUpdate, iter_find_seam
 from engine.seams.spec import CYCLIC_METHODS, SeamSpec, as_seam_spec
 from engine.tiles.template import Template, check_rect, flat_warning
 
@@ -182,10 +183,14 @@ def iter_seam(error, spec: SeamSpec, *, cyclic=False, waypoints=(), cancel=None)
             kw["start"] = v
         if e.shape[0] - 1 not in pinned:
             kw["end"] = v
-        return (yield from spec.iter_find(error, waypoints=tuple(waypoints), cancel=cancel, **kw))
+        return (
+            yield from iter_find_seam(
+                error, seam=spec, waypoints=tuple(waypoints), cancel=cancel, **kw
+            )
+        )
     return (
-        yield from spec.iter_find(
-            error, waypoints=tuple(waypoints), cyclic=bool(cyclic), cancel=cancel
+        yield from iter_find_seam(
+            error, seam=spec, waypoints=tuple(waypoints), cyclic=bool(cyclic), cancel=cancel
         )
     )
 
@@ -362,7 +367,7 @@ def _iter_make_seamless(S, extra, rect, wT, spec: SeamSpec, wps, wts, cancel, no
 
 def _alpha(seam: Seam, error: np.ndarray, spec: SeamSpec, cyclic: bool = False) -> np.ndarray:
     """Canonical weight of R1 with the outer column pinned to R1 and the inner one to R2."""
-    alpha = np.array(spec.blend_weights(seam, error, cyclic=cyclic), dtype=np.float32)
+    alpha = np.array(blend_weights(seam, error, spec=spec, cyclic=cyclic), dtype=np.float32)
     alpha[:, 0] = 1.0
     alpha[:, -1] = 0.0
     return alpha

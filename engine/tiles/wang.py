@@ -43,7 +43,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from engine._validate import as_image, choice, positive_int
-from engine.cancel import Cancelled, CancelToken, check, is_cancelled
+from engine.cancel import AnyCancel, Cancelled, CancelToken, check, is_cancelled
 from engine.events import Item, Progress, drain, frozen_array
 from engine.exclusion import valid_anchors
 from engine.matching import ZERO_ERROR_FRACTION, SampleSpectrum, error_floor
@@ -51,7 +51,7 @@ from engine.matching import select_within_tolerance as _select
 from engine.materials import apply_cut
 from engine.seams.spec import as_seam_spec
 from engine.stitch import PATCH_SEAM, patch_cut
-from engine.tiles.candidates import _AnyCancel, _base_seed, default_patch_overlap
+from engine.tiles.candidates import base_seed, default_patch_overlap
 from engine.tiles.seamless import MAIN, as_maps, check_weights, seam_error
 from engine.tiles.template import default_overlap, excluded_mask, flat_warning
 from engine.tiles.wang_cut import CUTS, frame_cut, frame_reach, ramp_reach
@@ -848,7 +848,7 @@ def iter_wang_set(
     indices = _check_indices(tiles, count)
     avoid = [(int(y), int(x)) for y, x in avoid]
     workers = positive_int(workers, "workers")
-    base = _base_seed(rng)
+    base = base_seed(rng)
     for note in setup.notes:
         warnings.warn(note, stacklevel=2)
     return _iter_wang_set(setup, given, indices, avoid, base, workers, cancel)
@@ -867,7 +867,7 @@ def _iter_wang_set(setup: _Setup, samples, indices, avoid, base, workers, cancel
     yield WangSamples(tuple(samples))
     made: dict[int, WangTile] = {}
     stop = CancelToken()
-    token = _AnyCancel(cancel, stop)
+    token = AnyCancel(cancel, stop)
     pool = (
         ThreadPoolExecutor(max_workers=workers, thread_name_prefix="wang") if workers > 1 else None
     )

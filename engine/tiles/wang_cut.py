@@ -36,9 +36,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from engine.blend import adaptive_half_widths, clamped_half_widths, cut_columns
+from engine.blend import adaptive_half_widths, blend_weights, clamped_half_widths, cut_columns
 from engine.cancel import check
 from engine.materials import apply_cut
+from engine.seams.search import find_seam
 from engine.seams.spec import SeamSpec
 
 __all__ = ["CUTS", "Frame", "frame_cut", "frame_reach", "ramp_reach"]
@@ -170,7 +171,7 @@ def _cut_alpha(seam, e, inside, band: int, T: int, spec: SeamSpec) -> np.ndarray
     filled = np.where(inside, e, e[inside].mean() if inside.any() else 0.0)
     cols = cut_columns(seam.mask)
     if spec.blend == "none" or cols is None:
-        alpha = spec.blend_weights(seam, filled)
+        alpha = blend_weights(seam, filled, spec=spec)
     else:
         b = (
             np.full(n, spec.width / 2.0)
@@ -240,7 +241,7 @@ def frame_cut(errors: dict, *, band: int, seam: SeamSpec, cancel=None) -> Frame:
         n = T - 1 - jr if fr else jr
         end_col = T - 2 - jc if fc else jc
         e = np.ascontiguousarray(sheared[:n])
-        cut = seam.find(e, start=band - 1, end=end_col - n + band, cancel=cancel)
+        cut = find_seam(e, seam=seam, start=band - 1, end=end_col - n + band, cancel=cancel)
         alpha = _cut_alpha(cut, e, inside[:n], band, T, seam)
         alphas_f[name] = _unshear(alpha, n, band, T, np.float32(1), np.float32(0))
         masks_f[name] = _unshear(np.asarray(cut.mask), n, band, T, True, False)

@@ -13,7 +13,7 @@ import numpy as np
 
 from engine._validate import as_rng, positive_int
 from engine.export.wang import check_signatures, layout_mismatches
-from engine.tiles.layout import _weights
+from engine.tiles.layout import tile_weights
 
 __all__ = ["check_signatures", "layout_mismatches", "wang_layout"]
 
@@ -59,7 +59,7 @@ def wang_layout(
     n = sig.shape[0]
     rows = positive_int(rows, "rows")
     cols = positive_int(cols, "cols")
-    w = _weights(weights, n)
+    w = tile_weights(weights, n)
     gen = as_rng(rng)
     out = np.empty((rows, cols), np.int64)
     u = gen.random((rows, cols))

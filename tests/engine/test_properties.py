@@ -60,7 +60,7 @@ def test_the_optima_are_ordered_as_their_path_models(e):
 @given(error_maps, st.integers(0, 8))
 def test_a_pinned_start_is_kept(e, col):
     start = col % e.shape[1]
-    path = np.asarray(SeamSpec("dp").find(e, start=start).path)
+    path = np.asarray(find_seam(e, seam=SeamSpec("dp"), start=start).path)
     assert path[0, 1] == start
 
 

@@ -121,11 +121,11 @@ def test_replace_keeps_the_options_the_new_method_takes():
 def test_find_searches_with_the_spec_like_find_seam():
     e = np.random.default_rng(0).random((20, 9))
     spec = SeamSpec("oscillating", {"o_max": 2, "init": "argmin"})
-    a = spec.find(e, start=3)
+    a = find_seam(e, seam=spec, start=3)
     b = find_seam(e, method="oscillating", o_max=2, init="argmin", start=3)
     np.testing.assert_array_equal(a.path, b.path)
     with pytest.raises(TypeError, match="image"):  # a per-call input of 'resistance' only
-        SeamSpec("dp").find(e, image=np.zeros((20, 9)))
+        find_seam(e, seam=SeamSpec("dp"), image=np.zeros((20, 9)))
 
 
 def test_as_seam_spec_default_type_and_straight():
