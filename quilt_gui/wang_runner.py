@@ -106,12 +106,12 @@ class WangRunner(QObject):
     # ------------------------------------------------------------------ samples
     def move_sample(self, axis: str, colour: int, origin) -> bool:
         """Put sample (axis, colour) at ``origin`` (row, col); False when it does not fit."""
-        from engine.tiles.wang import _Setup
+        from engine.tiles.wang import WangSetup
 
         w = self.doc.wang
         size = int(w.options["tile_size"])
         try:
-            origin = _Setup(self.doc.source.main, tile_size=size).check_origin(axis, origin)
+            origin = WangSetup(self.doc.source.main, tile_size=size).check_origin(axis, origin)
         except (TypeError, ValueError) as exc:
             self.message.emit("warning", f"The edge sample cannot go there: {exc}")
             return False

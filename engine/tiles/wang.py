@@ -354,7 +354,7 @@ def _nonneg_float(value, name: str) -> float:
     return float(value)
 
 
-class _Setup:
+class WangSetup:
     """Validated inputs and the matcher's spectra, shared by every tile of a run."""
 
     def __init__(self, source, *, tile_size, **options):
@@ -741,7 +741,7 @@ def _window_coords(role: str, rows, cols, T: int, reach: int):
 
 
 # --------------------------------------------------------------------------- API
-def _check_samples(setup: _Setup, samples) -> list[WangSample]:
+def _check_samples(setup: WangSetup, samples) -> list[WangSample]:
     K = setup.K
     try:
         samples = list(samples)
@@ -842,7 +842,7 @@ def iter_wang_set(
     Yields :class:`Progress`, one :class:`WangSamples` and the :class:`WangTile` items as they
     finish (any order; each has its ``index``).
     """
-    setup = _Setup(source, tile_size=tile_size, **options)
+    setup = WangSetup(source, tile_size=tile_size, **options)
     given = None if samples is None else _check_samples(setup, samples)
     count = setup.variants * setup.K**4
     indices = _check_indices(tiles, count)
@@ -854,7 +854,7 @@ def iter_wang_set(
     return _iter_wang_set(setup, given, indices, avoid, base, workers, cancel)
 
 
-def _iter_wang_set(setup: _Setup, samples, indices, avoid, base, workers, cancel):
+def _iter_wang_set(setup: WangSetup, samples, indices, avoid, base, workers, cancel):
     n = len(indices)
     yield Progress(0, n, "Wang tiles")
     notes_before = len(setup.notes)
@@ -957,7 +957,7 @@ def _collect(done, finishing: dict, made: dict, n: int):
         yield Progress(len(made), n, f"Wang tile {k}")
 
 
-def _result(setup: _Setup, samples, tiles, extra) -> WangSet:
+def _result(setup: WangSetup, samples, tiles, extra) -> WangSet:
     return WangSet(
         colours=setup.K,
         tile_size=setup.T,
@@ -979,7 +979,7 @@ def choose_sample(source, samples, axis: str, colour: int, *, tile_size: int, rn
     """Choose edge sample ``colour`` of ``axis`` again (a re-roll): the best match for the
     other axis's samples within tolerance, away from the others. ``samples`` is the current
     list (h colours then v colours); the others stay. Options as :func:`iter_wang_set`."""
-    setup = _Setup(source, tile_size=tile_size, **options)
+    setup = WangSetup(source, tile_size=tile_size, **options)
     current = _check_samples(setup, samples)
     choice(axis, "axis", AXES)
     colour = positive_int(colour, "colour", minimum=0)
@@ -1007,7 +1007,7 @@ def make_wang_tile(
     """Make tile ``index`` of a set with these ``samples``: its interior from ``patch_origin``
     (row, col) when given, else drawn from ``seed`` away from ``avoid`` (other tiles'
     interior windows). Options as :func:`iter_wang_set`."""
-    setup = _Setup(source, tile_size=tile_size, **options)
+    setup = WangSetup(source, tile_size=tile_size, **options)
     current = _check_samples(setup, samples)
     count = setup.variants * setup.K**4
     (index,) = _check_indices([index], count)

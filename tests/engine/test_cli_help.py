@@ -52,5 +52,5 @@ def test_a_subcommands_help_loads_only_its_own_command(name):
     assert heavy == []  # their parsers read the engine's light tables
     own = {f"engine.cli.{name}", "engine.cli._args"}
     if name == "tileset":
-        own |= {"engine.cli.export", "engine.cli.tileset_wang"}  # --project, --wang
+        own |= {"engine.cli.export", "engine.cli.tileset_output", "engine.cli.tileset_wang"}
     assert set(cli) <= own, cli
