@@ -60,7 +60,10 @@ __all__ = [
     "lattice_db",
     "luminance",
     "ring_tone",
+    "QUALITY_LIMITS",
+    "quality_warnings",
     "template_share",
+    "tileset_quality",
     "detail_ratio",
     "grid_border_ratio",
     "grid_score",
@@ -736,3 +739,54 @@ def lattice(
         floors.append(10 * np.log10(hf / mf))
     v, f = float(np.mean(vals)), float(np.mean(floors))
     return Lattice(v, f, v - f)
+
+
+#: Issue 10's acceptance limits of a tile set, by figure of :func:`tileset_quality`.
+QUALITY_LIMITS = {"frame": 1.15, "ring_tone": 1.3, "duplicates": 0, "lattice": 1.5}
+
+
+def tileset_quality(tiles, source, *, template, ring: int, margin: int, rng=0) -> dict:
+    """Every interior figure of a candidate set as plain numbers: ``frame`` (and
+    ``frame_low``, ``frame_distance``), ``ring_tone``, ``duplicates``, ``lattice`` (dB above
+    its floor; ``lattice_floor``), ``template_share`` (mean over the tiles). ``ring`` is w_P
+    (frame up to 2·w_P, ring tone over w_P), ``margin`` the border the tiles share."""
+    fr = frame(tiles, source, limit=2 * ring, rng=rng)
+    lat = lattice(tiles, source, template=template, margin=margin, rng=rng)
+    return {
+        "frame": fr.value,
+        "frame_low": fr.low,
+        "frame_distance": fr.distance,
+        "ring_tone": ring_tone(tiles, source, width=ring, rng=rng),
+        "duplicates": duplicates(tiles, template).count,
+        "lattice": lat.above,
+        "lattice_floor": lat.floor,
+        "template_share": float(template_share(tiles, template).mean()),
+    }
+
+
+def quality_warnings(q: dict) -> list[str]:
+    """What :func:`tileset_quality`'s figures mean for a person, in words (empty: none of
+    issue 10's limits is exceeded)."""
+    out = []
+    if q["frame"] > QUALITY_LIMITS["frame"]:
+        out.append(
+            f"the tiles show a frame (frame {q['frame']:.2f} > {QUALITY_LIMITS['frame']}): try "
+            "Flatten lighting, a wider patch search or a smaller patch ring"
+        )
+    if q["ring_tone"] > QUALITY_LIMITS["ring_tone"]:
+        out.append(
+            f"the shared ring differs in tone from the patches (ring tone {q['ring_tone']:.2f} > "
+            f"{QUALITY_LIMITS['ring_tone']}): try Flatten lighting or another template position"
+        )
+    if q["duplicates"] > QUALITY_LIMITS["duplicates"]:
+        out.append(
+            f"{q['duplicates']} candidate(s) repeat the template or each other: use a larger "
+            "source, smaller tiles or fewer candidates"
+        )
+    if q["lattice"] > QUALITY_LIMITS["lattice"]:
+        out.append(
+            f"a layout shows a lattice at the tile period ({q['lattice']:+.1f} dB above the floor "
+            "of a shared border): structured textures may need smaller patch rings, larger "
+            "tiles or a Wang set"
+        )
+    return out

@@ -127,7 +127,8 @@ class TilesetSettings:
     w_P (None: :func:`engine.tiles.default_patch_overlap`), ``margin`` (None: 1, at most
     w_P - 1), ``patch_search`` ("global": the best ring matches over the whole source, kept
     ``min_distance`` apart (None: :func:`engine.tiles.default_min_distance`); "local": the
-    paper's random position refined within ``neighbourhood``). Preview: ``preview`` (rows,
+    paper's random position refined within ``neighbourhood``). ``flatten``: Flatten lighting
+    of the source (albedo only) before everything (:mod:`engine.tone`). Preview: ``preview`` (rows,
     cols), ``no_equal_neighbours``, ``layout_seed`` (None: ``seed``). ``exclude_color``: a
     colour range (lo, hi) no tile or patch may contain.
 
@@ -154,6 +155,7 @@ class TilesetSettings:
     neighbourhood: int = setting(5, at_least(0))
     patch_search: str = setting("global", patch_search_mode)
     min_distance: int | None = setting(None, optional(at_least(0)))
+    flatten: bool = setting(False, boolean)
     preview: tuple[int, int] = setting((8, 8), as_size)
     no_equal_neighbours: bool = setting(True, boolean)
     layout_seed: int | None = setting(None, optional(at_least(0)))

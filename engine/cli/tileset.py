@@ -193,6 +193,14 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         help="--patch-search global: keep the candidates' patch sources at least PX apart and "
         "away from the template's position (default: a quarter tile, less on small sources)",
     )
+    p.add_argument(
+        "--flatten",
+        action="store_true",
+        default=None,
+        help="Flatten lighting: divide out the source's low-frequency illumination (a smooth "
+        "field at the scale of the largest tile, mean colour kept) before the search; the "
+        "albedo only, never the --map material maps",
+    )
     p.add_argument("--seam", choices=METHODS, help=f"seam method (default {d.seam.method})")
     add_seam_options(p)
     p.add_argument("--metric", choices=METRICS, help=f"error metric (default {d.seam.metric})")
@@ -271,6 +279,7 @@ _FIELDS = {
     "neighbourhood": "neighbourhood",
     "patch_search": "patch_search",
     "min_distance": "min_distance",
+    "flatten": "flatten",
     "preview": "preview",
     "exclude_color": "exclude_color",
 }
@@ -461,9 +470,12 @@ def _run(args, settings: TilesetSettings, rect) -> int:
         f"seamless tile {result.rect[2]}x{result.rect[3]} (overlap {result.overlap}): seam "
         f"criterion h {st.criterion['horizontal']:.2f} v {st.criterion['vertical']:.2f}"
     )
+    quality = _quality_summary(S, result, say)
 
     def write(tmp: Path) -> dict:
         manifest = write_files(tmp, result, depth)
+        manifest["quality"] = quality
+        manifest["warnings"] = manifest["warnings"] + quality["warnings"]
         manifest.update(
             settings=settings.to_dict(),
             source={
@@ -488,6 +500,47 @@ def _run(args, settings: TilesetSettings, rect) -> int:
     write_set(args, write, project)
     say(f"wrote template, {len(result.candidates)} tiles, manifest, layout and preview to {out}")
     return 0
+
+
+def _quality_summary(S, result, say) -> dict:
+    """The set's figures (issue 10: interior metrics beside the joint ones) on stderr, with
+    warnings in words; returned for the manifest."""
+    import warnings
+
+    from engine.metrics import (
+        detail_ratio,
+        quality_warnings,
+        tileset_quality,
+        wrap_border_ratio,
+    )
+
+    st, s = result.seamless, result.settings
+    if s.flatten:  # the tiles come from the flattened source: compare with it
+        from engine.tone import flatten_lighting, flatten_scale
+
+        S = flatten_lighting(S, scale=flatten_scale(s.tile_max))
+    q = {"wrap": wrap_border_ratio(st.tile), "detail": None}
+    try:
+        q["detail"] = detail_ratio(st.tile, S)
+    except ValueError:  # a flat source (already warned about): no figures to give
+        q["warnings"] = []
+        return q
+    if result.candidates:
+        q.update(
+            tileset_quality(
+                result.candidates, S, template=st.tile, ring=s.patch_overlap, margin=s.margin
+            )
+        )
+        say(
+            f"quality: {len(result.candidates)} candidates, frame {q['frame']:.2f} "
+            f"(1 = none), ring tone {q['ring_tone']:.2f}, duplicates {q['duplicates']}, "
+            f"lattice {q['lattice']:+.1f} dB above its floor, template share "
+            f"{q['template_share']:.0%}; template wrap {q['wrap']:.2f}, detail {q['detail']:.2f}"
+        )
+    q["warnings"] = quality_warnings(q) if result.candidates else []
+    for text in q["warnings"]:
+        warnings.warn(text, stacklevel=2)
+    return q
 
 
 def write_files(out: Path, result, depth: int) -> dict:

@@ -70,7 +70,7 @@ MARGIN = 1  # px every candidate keeps from the template (default of ``margin``)
 PATCH_SEARCHES = ("global", "local")
 TOLERANCE = 0.25  # global search: draw within (1 + TOLERANCE) x the best remaining ring match
 QUALITY = 2.0  # global search: never use a ring match worse than (1 + QUALITY) x the best
-OUTWARD = 2.0  # bias of the closed cut toward the outer margin, in units of the mean error
+OUTWARD = 0.5  # bias of the closed cut toward the outer margin, in units of the mean error
 PATCH_RING_FLOOR = 8  # px: narrower rings leave the closed cut no room (default_patch_overlap)
 
 

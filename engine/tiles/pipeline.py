@@ -116,6 +116,11 @@ def iter_tileset(
 def _iter_tileset(source, s, rect, maps, weights, excluded, picks, workers, cancel):
     H, W = np.shape(source)[:2]
     notes: list[str] = []
+    if s.flatten:  # the albedo only: material maps are never relit
+        from engine.tone import flatten_lighting, flatten_scale
+
+        scale = flatten_scale(s.tile_range((H, W))[1])  # the largest tile side
+        source = flatten_lighting(source, scale=scale)
     if rect is not None:
         overlap = s.overlap or default_overlap((rect[3], rect[2]))
         cost = template_cost(
