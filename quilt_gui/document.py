@@ -7,7 +7,10 @@ quilting / transfer workflow's :attr:`Document.quilting` (:mod:`quilt_gui.quilti
 each has its own signals. Views subscribe to the signals of the part they show.
 
 Every user edit goes through a method that pushes a :mod:`quilt_gui.commands`
-QUndoCommand, whose ``redo``/``undo`` call the ``apply_*`` methods. The document holds no
+QUndoCommand, whose ``redo``/``undo`` call the ``apply_*`` methods. Each workflow has its own
+history (``tileset.undo_stack``, ``quilting.undo_stack``, in :attr:`Document.undo_group`):
+Undo on one tab never changes the other's parameters; an edit both share (the painted
+exclusion, a seam option) goes to the history of the tab in front. The document holds no
 widgets and builds no QImages. Its serialization is :mod:`quilt_gui.project_io`.
 """
 
@@ -19,10 +22,11 @@ from typing import Any
 
 import numpy as np
 from PySide6.QtCore import QObject, Signal, Slot
-from PySide6.QtGui import QUndoStack
+from PySide6.QtGui import QUndoGroup, QUndoStack
 
 from quilt_gui import commands, params
 from quilt_gui.model import Source, safe_name
+from quilt_gui.param_table import QUILTING_GROUPS, TILESET_GROUPS
 from quilt_gui.quilting_doc import QuiltingDocument
 from quilt_gui.tileset_doc import TileSetDocument
 from quilt_gui.wang_doc import WangDocument
@@ -40,7 +44,7 @@ class Document(QObject):
 
     def __init__(self, parent=None) -> None:
         super().__init__(parent)
-        self.undo_stack = QUndoStack(self)
+        self.undo_group = QUndoGroup(self)
         self.source: Source | None = None
         self.name = "tileset"
         self.params: dict[str, Any] = dict(params.DEFAULTS)
@@ -50,10 +54,13 @@ class Document(QObject):
         self.exclude_painted: np.ndarray | None = None
         self._dirty = False  # changes that are not undo steps (streamed results)
         self._was_modified = False
-        self.undo_stack.cleanChanged.connect(self._on_clean_changed)
-        self.tileset = TileSetDocument(self, self.undo_stack)
-        self.quilting = QuiltingDocument(self, self.undo_stack)
-        self.wang = WangDocument(self, self.undo_stack)
+        self.tileset = TileSetDocument(self, QUndoStack(self))
+        self.quilting = QuiltingDocument(self, QUndoStack(self))
+        self.wang = WangDocument(self, QUndoStack(self))
+        for stack in self.stacks:
+            self.undo_group.addStack(stack)
+            stack.cleanChanged.connect(self._on_clean_changed)
+        self.undo_group.setActiveStack(self.tileset.undo_stack)
 
     # ------------------------------------------------------------------ state
     @property
@@ -61,8 +68,34 @@ class Document(QObject):
         return self.source is not None
 
     @property
+    def stacks(self) -> tuple[QUndoStack, ...]:
+        """The histories of the tile set, quilting and the Wang tiles."""
+        return self.tileset.undo_stack, self.quilting.undo_stack, self.wang.undo_stack
+
+    @property
+    def undo_stack(self) -> QUndoStack:
+        """The history Undo acts on: the workflow in front."""
+        return self.undo_group.activeStack()
+
+    def set_workflow(self, name: str) -> None:
+        """``"tileset"``, ``"quilting"`` or ``"wang"`` is in front (its history is the active
+        one)."""
+        part = {"quilting": self.quilting, "wang": self.wang}.get(name, self.tileset)
+        self.undo_group.setActiveStack(part.undo_stack)
+
+    def _stack_for(self, keys) -> QUndoStack:
+        """The history of an edit of parameters ``keys``: their workflow's, or the active one
+        for parameters both workflows use."""
+        groups = {params.BY_KEY[k].group for k in keys}
+        if groups <= set(QUILTING_GROUPS):
+            return self.quilting.undo_stack
+        if groups <= set(TILESET_GROUPS):
+            return self.tileset.undo_stack
+        return self.undo_stack
+
+    @property
     def modified(self) -> bool:
-        return self._dirty or not self.undo_stack.isClean()
+        return self._dirty or not all(s.isClean() for s in self.stacks)
 
     def mark_dirty(self) -> None:
         self._dirty = True
@@ -70,7 +103,8 @@ class Document(QObject):
 
     def mark_saved(self, path: str | None = None) -> None:
         self._dirty = False
-        self.undo_stack.setClean()
+        for stack in self.stacks:
+            stack.setClean()
         if path is not None and path != self.project_path:
             self.project_path = path
             self.path_changed.emit()
@@ -98,13 +132,14 @@ class Document(QObject):
         if self.params.get(key) == value:
             return
         text = text or f"Change {p.label}"
-        self.undo_stack.push(commands.SetParams(self, {key: value}, merge_id=merge_id, text=text))
+        command = commands.SetParams(self, {key: value}, merge_id=merge_id, text=text)
+        self._stack_for([key]).push(command)
 
     def set_params(self, values: dict, *, text: str = "Change parameters") -> None:
         values = {k: params.BY_KEY[k].coerce(v) for k, v in values.items()}
         values = {k: v for k, v in values.items() if self.params.get(k) != v}
         if values:
-            self.undo_stack.push(commands.SetParams(self, values, text=text))
+            self._stack_for(values).push(commands.SetParams(self, values, text=text))
 
     def apply_params(self, values: dict) -> None:
         self.params.update(values)
@@ -124,7 +159,8 @@ class Document(QObject):
         self.source = source
         self.name = safe_name(name or Path(source.path).stem or "tileset")
         self.project_path = None
-        self.undo_stack.clear()
+        for stack in self.stacks:
+            stack.clear()
         self._dirty = False
         self.source_changed.emit()
         self.maps_changed.emit()

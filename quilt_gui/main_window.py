@@ -148,10 +148,11 @@ class MainWindow(QMainWindow):
             "Write the picked tiles, atlases, manifest, Tiled and Godot files",
         )
         self.act_quit = A("&Quit", self.close, K.Quit, "Close Quilt Studio")
-        self.act_undo = self.doc.undo_stack.createUndoAction(self, "&Undo")
+        self.act_undo = self.doc.undo_group.createUndoAction(self, "&Undo")
         self.act_undo.setShortcut(QKeySequence(K.Undo))
-        self.act_redo = self.doc.undo_stack.createRedoAction(self, "&Redo")
-        self.act_redo.setShortcut(QKeySequence(K.Redo))
+        self.act_redo = self.doc.undo_group.createRedoAction(self, "&Redo")
+        redo = [QKeySequence(K.Redo), QKeySequence("Ctrl+Y")]  # Ctrl+Y: Windows-style keymaps
+        self.act_redo.setShortcuts(list({k.toString(): k for k in redo}.values()))
         self.addActions([self.act_undo, self.act_redo])
         self.act_fit = A("&Fit in window", self._zoom_fit, "Ctrl+0", "Show the whole image")
         self.act_100 = A(
@@ -470,6 +471,7 @@ class MainWindow(QMainWindow):
 
         if wang is None:
             wang = self.tabs.currentWidget() is self.wang_view
+        self.doc.set_workflow("quilting" if quilting else "wang" if wang else "tileset")
         if wang and not self.doc.wang.complete:
             self.show_message("warning", "Nothing to export yet: generate the Wang set first.")
             return
@@ -532,6 +534,7 @@ class MainWindow(QMainWindow):
     def _on_tab_changed(self, _index: int) -> None:
         quilting = self.tabs.currentWidget() is self.quilt_view
         wang = self.tabs.currentWidget() is self.wang_view
+        self.doc.set_workflow("quilting" if quilting else "wang" if wang else "tileset")
         self.params_panel.show_groups(QUILT_GROUPS if quilting else TILESET_GROUPS)
         for key in ("overlaps", "tile", "gallery"):
             self.docks[key].setVisible(not quilting and not wang)

@@ -23,6 +23,9 @@ QUILT_SELECTIONS = ("best", "sampled", "random", "bhatia")
 QUILT_SEAMS = ("straight", *METHODS)
 BASIC = "Basic"
 ADVANCED = "Advanced"
+#: the parameter groups of each workflow (the others, exclusion and seam options, are shared)
+TILESET_GROUPS = ("Tile", "Seams", "Candidates", "Preview")
+QUILTING_GROUPS = ("Quilting", "Transfer")
 
 _METHOD_LABELS = {
     "straight": "No cut (straight)",

@@ -130,7 +130,11 @@ class ShadeItem(QGraphicsRectItem):
 
 
 class ImageCanvas(QGraphicsView):
-    """The source (or any image) with wheel zoom about the cursor and drag to pan."""
+    """The source (or any image) with wheel zoom about the cursor and drag to pan.
+
+    Space+drag and middle-drag pan in every canvas, as in image editors; a plain drag pans
+    too unless the canvas gives it another job (the source view draws the tile rectangle).
+    """
 
     zoom_changed = Signal(float)
     hovered = Signal(object)  # (row, col) inside the image, or None
@@ -158,6 +162,8 @@ class ImageCanvas(QGraphicsView):
         self.fitted = False  # showing the whole image, not zoomed by the user: refit on resize
         self._fit_size = None  # the view's size at the last fit
         self._press_pos = None
+        self._pan_from = None  # (view pos, scroll values) while Space/middle-panning
+        self.space_down = False
         self._apply_zoom_hints()
 
     # ------------------------------------------------------------------ image
@@ -285,11 +291,49 @@ class ImageCanvas(QGraphicsView):
         if self._fit_pending:
             self.fit()
 
+    def pan_starts(self, event) -> bool:
+        """A press that pans: the middle button, or the left one with Space held."""
+        b = event.button()
+        return b == Qt.MouseButton.MiddleButton or (
+            b == Qt.MouseButton.LeftButton and self.space_down
+        )
+
     def mousePressEvent(self, event) -> None:  # noqa: N802 - Qt API
+        if self.pan_starts(event):
+            bars = (self.horizontalScrollBar().value(), self.verticalScrollBar().value())
+            self._pan_from = (event.position(), bars, event.button())
+            self.viewport().setCursor(Qt.CursorShape.ClosedHandCursor)
+            event.accept()
+            return
         self._press_pos = event.position() if event.button() == Qt.MouseButton.LeftButton else None
         super().mousePressEvent(event)
 
+    def keyPressEvent(self, event) -> None:  # noqa: N802 - Qt API
+        if event.key() == Qt.Key.Key_Space and not event.isAutoRepeat():
+            self.space_down = True
+            self.viewport().setCursor(Qt.CursorShape.OpenHandCursor)
+            event.accept()
+            return
+        super().keyPressEvent(event)
+
+    def keyReleaseEvent(self, event) -> None:  # noqa: N802 - Qt API
+        if event.key() == Qt.Key.Key_Space and not event.isAutoRepeat():
+            self.space_down = False
+            self.viewport().unsetCursor()
+            event.accept()
+            return
+        super().keyReleaseEvent(event)
+
     def mouseReleaseEvent(self, event) -> None:  # noqa: N802 - Qt API
+        if self._pan_from is not None:
+            if event.button() == self._pan_from[2]:
+                self._pan_from = None
+                if self.space_down:
+                    self.viewport().setCursor(Qt.CursorShape.OpenHandCursor)
+                else:
+                    self.viewport().unsetCursor()
+            event.accept()
+            return
         super().mouseReleaseEvent(event)
         start, self._press_pos = self._press_pos, None
         if start is None or event.button() != Qt.MouseButton.LeftButton:
@@ -301,6 +345,13 @@ class ImageCanvas(QGraphicsView):
                 self.pixel_clicked.emit(px, event.modifiers())
 
     def mouseMoveEvent(self, event) -> None:  # noqa: N802 - Qt API
+        if self._pan_from is not None:
+            start, (h, v), _ = self._pan_from
+            d = event.position() - start
+            self.horizontalScrollBar().setValue(h - round(d.x()))
+            self.verticalScrollBar().setValue(v - round(d.y()))
+            event.accept()
+            return
         super().mouseMoveEvent(event)
         self.hovered.emit(self.pixel_at(event.position()))
 

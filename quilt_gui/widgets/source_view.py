@@ -15,6 +15,7 @@ from PySide6.QtCore import QRectF, Qt, Signal, Slot
 from PySide6.QtGui import QBrush, QColor, QPen
 from PySide6.QtWidgets import QGraphicsEllipseItem, QGraphicsItem
 
+from quilt_gui import params
 from quilt_gui.commands import new_merge_id
 from quilt_gui.document import Document
 from quilt_gui.pipeline import Pipeline
@@ -31,6 +32,7 @@ REGION_COLORS = {"R_L": "#3fc1ff", "R_R": "#3fc1ff", "R_T": "#ff5fd2", "R_B": "#
 # both stand out on the heat map (black, purple, red, orange, pale yellow)
 SEAM_COLORS = {"horizontal": "#7dff5f", "vertical": "#4de8ff"}
 WAYPOINT_COLOR = "#ffffff"
+MIN_DRAWN = 8  # a drag shorter than this (px of the image) draws nothing
 
 
 def region_rects(rect, overlap: int) -> dict[str, tuple[int, int, int, int]]:
@@ -92,6 +94,8 @@ class SourceView(ImageCanvas):
         self._waypoint_items: list[WaypointItem] = []
         self.heat_visible = True
         self._nudge_merge: int | None = None
+        self._drawing: tuple | None = None  # (first pixel, merge id) while a drag draws
+        self.setDragMode(self.DragMode.NoDrag)  # a plain drag draws; Space/middle-drag pans
         self.rect_item.edited.connect(self._on_rect_edited)
         self.patch_item.drag_finished.connect(self._on_patch_dropped)
         self.zoom_changed.connect(self._on_zoom)
@@ -297,7 +301,52 @@ class SourceView(ImageCanvas):
                     self.doc.tileset.add_waypoint(which, pt)
                 event.accept()
                 return
+        if self._starts_drawing(event, px):
+            self._drawing = (px, new_merge_id())
+            event.accept()
+            return
         super().mousePressEvent(event)
+
+    def _starts_drawing(self, event, px) -> bool:
+        """A plain left press on the image, not on a rectangle: draw the tile rectangle."""
+        if (
+            px is None
+            or event.button() != Qt.MouseButton.LeftButton
+            or event.modifiers() != Qt.KeyboardModifier.NoModifier
+            or self.space_down
+        ):
+            return False
+        item = self.itemAt(event.position().toPoint())
+        while item is not None and not isinstance(item, EditableRect):
+            item = item.parentItem()
+        return item is None or not (item.isVisible() and item.isEnabled())
+
+    def mouseMoveEvent(self, event) -> None:  # noqa: N802 - Qt API
+        if self._drawing is None:
+            super().mouseMoveEvent(event)
+            return
+        (r0, c0), merge_id = self._drawing
+        p = self.mapToScene(event.position().toPoint())
+        H, W = self.doc.source.shape
+        r1 = min(max(int(np.floor(p.y())), 0), H - 1)
+        c1 = min(max(int(np.floor(p.x())), 0), W - 1)
+        w, h = abs(c1 - c0) + 1, abs(r1 - r0) + 1
+        if self.doc.params["tile_size"] != params.ANY:  # square tiles unless Any size
+            w = h = max(w, h)
+        x = c0 if c1 >= c0 else c0 - w + 1
+        y = r0 if r1 >= r0 else r0 - h + 1
+        if max(w, h) >= MIN_DRAWN:
+            text = "Draw tile rectangle"
+            self.doc.tileset.set_template_rect((x, y, w, h), merge_id=merge_id, text=text)
+        self.hovered.emit((r1, c1))
+        event.accept()
+
+    def mouseReleaseEvent(self, event) -> None:  # noqa: N802 - Qt API
+        if self._drawing is not None and event.button() == Qt.MouseButton.LeftButton:
+            self._drawing = None
+            event.accept()
+            return
+        super().mouseReleaseEvent(event)
 
 
 def nearest_waypoint(points, pt, radius: float = 3.0):
