@@ -151,7 +151,8 @@ class MainWindow(QMainWindow):
         self.act_undo = self.doc.undo_group.createUndoAction(self, "&Undo")
         self.act_undo.setShortcut(QKeySequence(K.Undo))
         self.act_redo = self.doc.undo_group.createRedoAction(self, "&Redo")
-        redo = [QKeySequence(K.Redo), QKeySequence("Ctrl+Y")]  # Ctrl+Y: Windows-style keymaps
+        # whatever the platform's keymap: Ctrl+Y (Windows style) and Ctrl+Shift+Z (macOS, KDE)
+        redo = [QKeySequence(K.Redo), QKeySequence("Ctrl+Y"), QKeySequence("Ctrl+Shift+Z")]
         self.act_redo.setShortcuts(list({k.toString(): k for k in redo}.values()))
         self.addActions([self.act_undo, self.act_redo])
         self.act_fit = A("&Fit in window", self._zoom_fit, "Ctrl+0", "Show the whole image")
