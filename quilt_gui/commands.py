@@ -202,6 +202,24 @@ class SetPainted(_Swap):
         super().__init__(doc, mask, doc.exclude_painted, text)
 
 
+class SetHealMask(_Swap):
+    """The region of the source painted to heal."""
+
+    APPLY = "apply_heal_mask"
+
+    def __init__(self, doc, mask, text: str) -> None:
+        super().__init__(doc, mask, doc.heal_mask, text)
+
+
+class SetSourceMaps(_Swap):
+    """The source's pixels (every material map), e.g. healed."""
+
+    APPLY = "apply_source_maps"
+
+    def __init__(self, doc, maps: dict, text: str) -> None:
+        super().__init__(doc, dict(maps), dict(doc.source.maps), text)
+
+
 class SetMapWeights(_Swap):
     """The seam-error weights of the material maps (one step per change)."""
 

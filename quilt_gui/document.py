@@ -39,6 +39,8 @@ class Document(QObject):
     maps_changed = Signal()
     params_changed = Signal(object)  # frozenset of changed keys
     exclusion_changed = Signal()  # the painted exclusion mask
+    heal_mask_changed = Signal()  # the region painted to heal
+    pixels_changed = Signal()  # the source's pixels changed (healed), not its size or maps
     modified_changed = Signal(bool)
     path_changed = Signal()
 
@@ -52,6 +54,7 @@ class Document(QObject):
         # (H, W) bool: source pixels the template search, the candidates and quilting never
         # use (with the exclude_color range); saved in the project's extra["exclude_painted"]
         self.exclude_painted: np.ndarray | None = None
+        self.heal_mask: np.ndarray | None = None  # (H, W) bool: the region to heal (not saved)
         self._dirty = False  # changes that are not undo steps (streamed results)
         self._was_modified = False
         self.tileset = TileSetDocument(self, QUndoStack(self))
@@ -153,6 +156,29 @@ class Document(QObject):
         self.exclude_painted = mask
         self.exclusion_changed.emit()
 
+    def set_heal_mask(self, mask: np.ndarray | None, *, text: str = "Paint region to heal") -> None:
+        """Replace the region to heal (one undo step)."""
+        self.undo_stack.push(commands.SetHealMask(self, mask, text))
+
+    def apply_heal_mask(self, mask: np.ndarray | None) -> None:
+        self.heal_mask = mask
+        self.heal_mask_changed.emit()
+
+    def heal(self, maps: dict[str, np.ndarray]) -> None:
+        """The source's maps replaced by their healed pixels and the region cleared: one undo
+        step (the template search, the candidates and quilting use the healed source)."""
+        st = self.undo_stack
+        st.beginMacro("Heal")
+        st.push(commands.SetSourceMaps(self, maps, "Heal"))
+        st.push(commands.SetHealMask(self, None, "Heal"))
+        st.endMacro()
+
+    def apply_source_maps(self, maps: dict[str, np.ndarray]) -> None:
+        """New pixels for the source's maps (same names and size)."""
+        self.source = replace(self.source, maps=dict(maps))
+        self.pixels_changed.emit()
+        self.maps_changed.emit()
+
     # ------------------------------------------------------------------ whole-document changes
     def set_source(self, source: Source, *, name: str | None = None) -> None:
         """Start over on a new source (clears results and the undo history)."""
@@ -168,6 +194,7 @@ class Document(QObject):
         self.wang.clear()
         self.path_changed.emit()
         self.apply_painted(None)
+        self.apply_heal_mask(None)
         self.quilting.start(None)
         self._emit_modified()
 

@@ -27,6 +27,7 @@ from PySide6.QtWidgets import (
 from quilt_gui import jobs, params, settings, window_geometry
 from quilt_gui.document import Document
 from quilt_gui.files import ProjectFiles
+from quilt_gui.heal_tool import HealTool
 from quilt_gui.imaging import pixel_text
 from quilt_gui.pipeline import Pipeline
 from quilt_gui.theme import apply_theme
@@ -219,6 +220,22 @@ class MainWindow(QMainWindow):
             None,
             "Forget the source pixels painted as never to use",
         )
+        self.act_heal_brush = A(
+            "Heal &brush",
+            None,
+            "J",
+            "Paint the region to heal on the source (drag; right-drag erases)",
+            checkable=True,
+        )
+        self.act_heal = A(
+            "&Heal painted region",
+            None,
+            "Ctrl+Shift+H",
+            "Fill the painted region from the rest of the source (quilted, seams cut)",
+        )
+        self.act_clear_heal = A(
+            "Clear region to heal", None, None, "Forget the region painted to heal"
+        )
         self.act_repeats = {
             n: A(
                 f"Seamless tile {n}×{n}",
@@ -245,6 +262,10 @@ class MainWindow(QMainWindow):
     def _make_views(self) -> None:
         doc = self.doc
         self.source_view = SourceView(doc, self.pipeline)
+        self.heal_tool = HealTool(doc, self.pipeline, self.source_view, self)
+        self.act_heal_brush.toggled.connect(self.heal_tool.set_brush)
+        self.act_heal.triggered.connect(self.heal_tool.run)
+        self.act_clear_heal.triggered.connect(self.heal_tool.clear)
         self.preview_view = PreviewView(doc, self.act_reroll_layout, self.act_preview_grid)
         self.tabs = QTabWidget()
         self.tabs.setDocumentMode(True)
@@ -277,6 +298,7 @@ class MainWindow(QMainWindow):
                 "Quilting": [self.act_quilt],
                 "Transfer": [self.act_load_target, self.act_transfer],
                 "Exclusion": [self.act_clear_painted],
+                "Heal": [self.act_heal_brush, self.act_heal],
             },
         )
         self.params_panel.show_groups(TILESET_GROUPS)
@@ -350,6 +372,8 @@ class MainWindow(QMainWindow):
         m = mb.addMenu("&Tile set")
         m.addActions([self.act_find, self.act_generate, self.act_reroll_layout])
         m.addSeparator()
+        m.addActions([self.act_heal_brush, self.act_heal, self.act_clear_heal])
+        m.addSeparator()
         m.addAction(self.act_cancel)
         m = mb.addMenu("&Quilting")
         m.addActions([self.act_quilt, self.act_load_target, self.act_transfer])
@@ -377,6 +401,7 @@ class MainWindow(QMainWindow):
         self.pipeline.message.connect(self.show_message)
         self.wang_runner.message.connect(self.show_message)
         self.wang_view.export_requested.connect(partial(self.export_dialog, wang=True))
+        self.heal_tool.message.connect(self.show_message)
         self.files.message.connect(self.show_message)
         self.files.image_opened.connect(self._on_image_opened)
         self.pipeline.seam_updated.connect(self._on_seam_updated)

@@ -28,15 +28,21 @@ MOUSE = frozenset(
 )
 
 
-class ExclusionPainter(QObject):
-    """Paints the document's exclusion on ``canvas`` and shows it as a red overlay."""
+class MaskBrush(QObject):
+    """A brush that paints a (H, W) bool mask of the source on ``canvas``, shown as a
+    translucent ``color`` overlay; one stroke is one undo step. Subclasses say which presses
+    start a stroke (:meth:`wants`), which mask is painted (:meth:`current_mask`) and where a
+    finished stroke goes (:meth:`commit`)."""
+
+    COLOR = (255, 40, 40, 150)
+    Z = 15
 
     def __init__(self, doc: Document, canvas: ImageCanvas) -> None:
         super().__init__(canvas)
         self.doc = doc
         self.canvas = canvas
         self.overlay = ImageItem()
-        self.overlay.setZValue(15)
+        self.overlay.setZValue(self.Z)
         self.overlay.hide()
         canvas.add_item(self.overlay)
         self._stroke: np.ndarray | None = None  # the mask being painted
@@ -45,48 +51,35 @@ class ExclusionPainter(QObject):
         self._viewport = canvas.viewport()
         self._viewport.installEventFilter(self)
         doc.source_changed.connect(self.refresh)
-        doc.exclusion_changed.connect(self.refresh)
-        doc.params_changed.connect(self._on_params_changed)
-        self.refresh()
 
-    @Slot(object)
-    def _on_params_changed(self, keys) -> None:
-        if keys & EXCLUSION_KEYS:
-            self.refresh()
+    # ------------------------------------------------------------------ subclass hooks
+    def wants(self, event) -> bool:
+        """Does this press start a stroke? (right button: erase)"""
+        raise NotImplementedError
 
+    def current_mask(self) -> np.ndarray | None:
+        raise NotImplementedError
+
+    def commit(self, mask: np.ndarray | None, painting: bool) -> None:
+        raise NotImplementedError
+
+    def shown_mask(self, painted: np.ndarray | None) -> np.ndarray | None:
+        """What the overlay shows, given the painted mask (or the stroke)."""
+        return painted
+
+    # ------------------------------------------------------------------ drawing
     @Slot()
     def refresh(self) -> None:
-        """Redraw the overlay: the colour range and the painted mask (or the stroke)."""
-        src = self.doc.source
-        p = self.doc.params
-        painted = self._stroke if self._stroke is not None else self.doc.exclude_painted
-        mask = (
-            None
-            if src is None
-            else excluded_mask(src.main, p["exclude_color"], p["exclude_tolerance"], painted)
-        )
+        """Redraw the overlay (the stroke while one is painted)."""
+        painted = self._stroke if self._stroke is not None else self.current_mask()
+        mask = None if self.doc.source is None else self.shown_mask(painted)
         if mask is None or not mask.any():
             self.overlay.hide()
             return
         rgba = np.zeros(mask.shape + (4,), np.uint8)
-        rgba[mask] = (255, 40, 40, 150)
+        rgba[mask] = self.COLOR
         self.overlay.set_array(rgba)
 
-    def pick_colour(self, px: tuple[int, int]) -> None:
-        """Exclude the colour of source pixel ``px`` (row, col): one undo step."""
-        r, c = px
-        rgb = to_rgb(self.doc.source.main[r : r + 1, c : c + 1])[0, 0]
-        color = "#" + "".join(f"{int(round(float(v) * 255)):02x}" for v in rgb)
-        values = {"exclude_color": color}
-        if self.doc.params["exclude_tolerance"] <= 0:
-            values["exclude_tolerance"] = PICK_TOLERANCE
-        self.doc.set_params(values, text="Exclude a colour")
-
-    def clear_painted(self) -> None:
-        if self.doc.exclude_painted is not None:
-            self.doc.set_painted(None, text="Clear painted exclusion")
-
-    # ------------------------------------------------------------------ mouse
     def eventFilter(self, obj, event) -> bool:  # noqa: N802 - Qt API
         kind = event.type()
         if kind not in MOUSE or obj is not self._viewport or self.doc.source is None:
@@ -101,23 +94,17 @@ class ExclusionPainter(QObject):
             return True
         if kind == QEvent.Type.MouseButtonRelease and self._stroke is not None:
             stroke, self._stroke, self._last = self._stroke, None, None
-            text = "Paint exclusion" if self._value else "Erase exclusion"
-            self.doc.set_painted(stroke if stroke.any() else None, text=text)
+            self.commit(stroke if stroke.any() else None, self._value)
             return True
         return False
 
     def _press(self, event) -> bool:
-        mods = event.modifiers()
-        if not mods & Qt.KeyboardModifier.ShiftModifier:
+        if not self.wants(event):
             return False
         px = self.canvas.pixel_at(event.position())
         if px is None:
             return False
-        if mods & Qt.KeyboardModifier.ControlModifier:
-            if event.button() == Qt.MouseButton.LeftButton:
-                self.pick_colour(px)
-            return True
-        current = self.doc.exclude_painted
+        current = self.current_mask()
         self._stroke = np.zeros(self.doc.source.shape, bool) if current is None else current.copy()
         self._value = event.button() != Qt.MouseButton.RightButton
         self._last = px
@@ -137,3 +124,57 @@ class ExclusionPainter(QObject):
             disk = (yy - cy) ** 2 + (xx - cx) ** 2 <= r * r
             self._stroke[r0:r1, c0:c1][disk] = self._value
         self.refresh()
+
+
+class ExclusionPainter(MaskBrush):
+    """Paints the document's exclusion on ``canvas`` (Shift+drag, Shift+right-drag erases,
+    Ctrl+Shift+click picks a colour) and shows it, with the colour range, in red."""
+
+    def __init__(self, doc: Document, canvas: ImageCanvas) -> None:
+        super().__init__(doc, canvas)
+        doc.exclusion_changed.connect(self.refresh)
+        doc.params_changed.connect(self._on_params_changed)
+        self.refresh()
+
+    @Slot(object)
+    def _on_params_changed(self, keys) -> None:
+        if keys & EXCLUSION_KEYS:
+            self.refresh()
+
+    def current_mask(self) -> np.ndarray | None:
+        return self.doc.exclude_painted
+
+    def shown_mask(self, painted):
+        p = self.doc.params
+        return excluded_mask(
+            self.doc.source.main, p["exclude_color"], p["exclude_tolerance"], painted
+        )
+
+    def wants(self, event) -> bool:
+        return bool(event.modifiers() & Qt.KeyboardModifier.ShiftModifier)
+
+    def _press(self, event) -> bool:
+        mods = event.modifiers()
+        if mods & Qt.KeyboardModifier.ShiftModifier and mods & Qt.KeyboardModifier.ControlModifier:
+            px = self.canvas.pixel_at(event.position())  # Ctrl+Shift+click: a colour
+            if px is not None and event.button() == Qt.MouseButton.LeftButton:
+                self.pick_colour(px)
+            return px is not None
+        return super()._press(event)
+
+    def commit(self, mask, painting: bool) -> None:
+        self.doc.set_painted(mask, text="Paint exclusion" if painting else "Erase exclusion")
+
+    def pick_colour(self, px: tuple[int, int]) -> None:
+        """Exclude the colour of source pixel ``px`` (row, col): one undo step."""
+        r, c = px
+        rgb = to_rgb(self.doc.source.main[r : r + 1, c : c + 1])[0, 0]
+        color = "#" + "".join(f"{int(round(float(v) * 255)):02x}" for v in rgb)
+        values = {"exclude_color": color}
+        if self.doc.params["exclude_tolerance"] <= 0:
+            values["exclude_tolerance"] = PICK_TOLERANCE
+        self.doc.set_params(values, text="Exclude a colour")
+
+    def clear_painted(self) -> None:
+        if self.doc.exclude_painted is not None:
+            self.doc.set_painted(None, text="Clear painted exclusion")

@@ -59,7 +59,10 @@ TILESET_GROUPS = (
     "Candidates",
     "Preview",
     "Exclusion",
+    "Heal",
 )
+#: group titles on screen, where they differ from the group's name
+GROUP_TITLES = {"Exclusion": "Pixels never to use", "Heal": "Heal the source"}
 QUILT_GROUPS = ("Quilting", "Exclusion", "Seam options", "Transfer")
 VIEWS = (BASIC, ADVANCED)
 
@@ -83,8 +86,12 @@ class ParamsPanel(QWidget):
         body = QWidget()
         lay = QVBoxLayout(body)
         lay.setContentsMargins(6, 6, 6, 6)
-        for group in params.GROUPS:
-            box = QGroupBox(group)
+        names = list(params.GROUPS)
+        for group in actions or {}:  # groups of actions alone (Heal), after the exclusion
+            if group not in names:
+                names.insert(names.index("Exclusion") + 1, group)
+        for group in names:
+            box = QGroupBox(GROUP_TITLES.get(group, group))
             form = QFormLayout(box)
             form.setFieldGrowthPolicy(QFormLayout.FieldGrowthPolicy.AllNonFixedFieldsGrow)
             form.setLabelAlignment(Qt.AlignmentFlag.AlignRight)

@@ -146,6 +146,7 @@ class QuiltView(QWidget):
         self.output.pixel_clicked.connect(self._on_output_clicked)
         self.sample.pixel_clicked.connect(self._on_sample_clicked)
         doc.source_changed.connect(self._on_source_changed)
+        doc.pixels_changed.connect(self._on_pixels_changed)
         doc.quilting.reset.connect(self._on_reset)
         doc.quilting.block_placed.connect(self._on_block_placed)
         doc.quilting.finished.connect(self._on_finished)
@@ -159,6 +160,10 @@ class QuiltView(QWidget):
         src = self.doc.source
         self.sample.set_image(None if src is None else src.main, fit=True)
         self._on_reset()
+
+    @Slot()
+    def _on_pixels_changed(self) -> None:
+        self.sample.set_image(self.doc.source.main)
 
     @Slot()
     def _on_reset(self) -> None:

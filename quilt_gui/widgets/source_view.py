@@ -100,6 +100,7 @@ class SourceView(ImageCanvas):
         self.patch_item.drag_finished.connect(self._on_patch_dropped)
         self.zoom_changed.connect(self._on_zoom)
         doc.source_changed.connect(self._on_source_changed)
+        doc.pixels_changed.connect(self._on_pixels_changed)
         doc.tileset.template_changed.connect(self._on_template_changed)
         doc.params_changed.connect(self._on_params_changed)
         doc.tileset.seamless_changed.connect(self._on_seamless_changed)
@@ -120,6 +121,11 @@ class SourceView(ImageCanvas):
             self.patch_item.bounds = src.shape
         self.show_patch(None)
         self._on_template_changed()
+
+    @Slot()
+    def _on_pixels_changed(self) -> None:
+        """New pixels (healed), same size: redraw, keep the zoom and the overlays."""
+        self.set_image(self.doc.source.main)
 
     @Slot(bool)
     def _on_searching(self, searching: bool) -> None:

@@ -1,0 +1,60 @@
+"""Heal in the editor (issue 13 item 15): paint a region, Heal, undo; the healed source is what
+the template search uses."""
+
+from __future__ import annotations
+
+import numpy as np
+from PIL import Image
+from PySide6.QtCore import Qt
+
+from tests.engine.helpers import smooth_texture
+from tests.gui.helpers import drag, make_window, wait_idle
+
+LOGO = (1.0, 0.0, 1.0)  # magenta: found nowhere in the texture
+
+
+def magenta(img) -> np.ndarray:
+    return (img[..., 0] > 0.8) & (img[..., 2] > 0.8) & (img[..., 1] < 0.2)
+
+
+def test_paint_heal_undo_and_the_healed_source_feeds_the_template_search(qtbot, tmp_path):
+    tex = (smooth_texture((160, 176), 3, seed=5, sigma=1.5) * 0.7).astype(np.float32)
+    tex[70:90, 80:100] = LOGO
+    path = tmp_path / "logo.png"
+    Image.fromarray((tex * 255 + 0.5).astype(np.uint8)).save(path)
+    w = make_window(qtbot)
+    with qtbot.waitSignal(w.doc.source_changed, timeout=10_000):
+        w.files.open_path(str(path), confirm=False)
+    wait_idle(qtbot, w)
+    doc, v = w.doc, w.source_view
+    original = doc.source.main.copy()
+    assert magenta(original).sum() == 400
+    v.set_zoom(2.0)
+    v.center_on_pixel(80, 90)
+    w.doc.set_param("brush", 15)
+    w.act_heal_brush.trigger()  # the Heal brush: a plain drag paints the region
+    steps = doc.undo_stack.count()
+    a, b = v.view_pos_of_pixel(80, 72).toPoint(), v.view_pos_of_pixel(80, 108).toPoint()
+    drag(qtbot, v, a, b, modifier=Qt.KeyboardModifier.NoModifier)
+    mask = doc.heal_mask
+    assert mask is not None and mask[magenta(original)].all() and mask.sum() < 2000
+    assert doc.tileset.template_rect is None  # painting did not draw a rectangle
+    assert doc.undo_stack.count() == steps + 1 and w.heal_tool.brush.overlay.isVisible()
+    w.act_heal.trigger()
+    wait_idle(qtbot, w)
+    healed = doc.source.main
+    assert not magenta(healed).any()
+    np.testing.assert_array_equal(healed[~mask], original[~mask])  # only the region changed
+    assert doc.heal_mask is None and "Healed" in w.last_message()
+    assert doc.undo_stack.undoText() == "Heal" and doc.modified
+    w.act_undo.trigger()  # one step brings back the source and the region
+    assert magenta(doc.source.main).sum() == 400 and doc.heal_mask is not None
+    w.act_redo.trigger()
+    assert not magenta(doc.source.main).any()
+    w.act_heal_brush.trigger()  # off
+    w.doc.set_param("tile_size", "64")
+    w.act_find.trigger()  # the search and the seamless tile use the healed source
+    wait_idle(qtbot, w)
+    x, y, tw, th = doc.tileset.template_rect
+    assert not magenta(np.asarray(doc.tileset.seamless.tile)).any()
+    np.testing.assert_array_equal(w.source_view.array, doc.source.main)  # shown healed
