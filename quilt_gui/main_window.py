@@ -497,7 +497,6 @@ class MainWindow(QMainWindow):
 
         if wang is None:
             wang = self.tabs.currentWidget() is self.wang_view
-        self.doc.set_workflow("quilting" if quilting else "wang" if wang else "tileset")
         if wang and not self.doc.wang.complete:
             self.show_message("warning", "Nothing to export yet: generate the Wang set first.")
             return
