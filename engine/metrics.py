@@ -581,7 +581,9 @@ class Duplicates:
 
 def duplicates(tiles, template=None, *, level: float = DUPLICATE_LEVEL) -> Duplicates:
     """Tiles equal to ``template`` or to each other: mean absolute luminance difference below
-    ``level`` (default 1/255)."""
+    ``level`` (default 1/255). No tiles: none."""
+    if len(tiles) == 0:
+        return Duplicates((), ())
     stack = _tile_stack(tiles).astype(np.float32)
     lev = non_negative_number(level, "level")
     of_t: list[int] = []

@@ -70,6 +70,7 @@ MARGIN = 1  # px every candidate keeps from the template (default of ``margin``)
 PATCH_SEARCHES = ("global", "local")
 TOLERANCE = 0.25  # global search: draw within (1 + TOLERANCE) x the best remaining ring match
 QUALITY = 2.0  # global search: never use a ring match worse than (1 + QUALITY) x the best
+SAME_CONTENT = 2.0 / 255  # patch windows closer than this (mean abs luminance) are the same
 OUTWARD = 0.5  # bias of the closed cut toward the outer margin, in units of the mean error
 PATCH_RING_FLOOR = 8  # px: narrower rings leave the closed cut no room (default_patch_overlap)
 
@@ -302,6 +303,7 @@ class _Setup:
                 "so candidates may not connect to each other"
             )
         flat = flat_warning(self.S)
+        self.flat = bool(flat)  # every window is the same: no content check (warned)
         if flat:
             self.notes.append(flat)
         # ring band for the position refinement (offsets margin .. ring-1)
@@ -348,28 +350,58 @@ class _Setup:
             self._keep_away(allowed, o)
         zero = ZERO_ERROR_FRACTION * error_floor(self.Sc)
         origins: list[tuple[int, int]] = []
+        # content already used: the template's window and every chosen patch (luminance);
+        # a window this close to one of them would make a duplicate candidate
+        seen = [self._luminance(self.U[MAIN])] + [self._window(o) for o in avoid]
+        same = 0
         if allowed.any():
             limit = max(float(e[allowed].min()), zero) * (1 + self.quality)
-            for seed in seeds:
+            gen_seeds = iter(seeds)
+            seed = next(gen_seeds, None)
+            tries = 0
+            while seed is not None:
                 ok = allowed & (e <= limit)
                 if not ok.any():
                     break
                 pool = np.flatnonzero(
                     ok & (e <= max(float(e[ok].min()), zero) * (1 + self.tolerance))
                 )
-                k = int(pool[np.random.default_rng(seed).integers(pool.size)])
-                origin = divmod(k, e.shape[1])
-                origins.append((int(origin[0]), int(origin[1])))
+                rng = np.random.default_rng([seed, tries] if tries else seed)
+                k = int(pool[rng.integers(pool.size)])
+                origin = (int(k // e.shape[1]), int(k % e.shape[1]))
+                window = self._window(origin)
                 self._keep_away(allowed, origin)
+                if not self.flat and any(np.abs(window - w).mean() < SAME_CONTENT for w in seen):
+                    same += 1  # same content as the template or an earlier patch: redraw
+                    tries += 1
+                    continue
+                origins.append(origin)
+                seen.append(window)
+                seed, tries = next(gen_seeds, None), 0
         note = None
         if len(origins) < len(seeds):
             note = (
                 f"made {len(origins)} of {len(seeds)} candidates: the source has no more patch "
                 f"positions at least {self.min_distance} px from the template's and from each "
                 f"other whose ring matches the template within {1 + self.quality:g}x the best "
-                "match (a larger source, smaller tiles or a smaller minimum distance give more)"
+                "match"
+                + (
+                    f" and whose content differs from the others ({same} were alike)"
+                    if same
+                    else ""
+                )
+                + " (a larger source, smaller tiles or a smaller minimum distance give more)"
             )
         return origins, note
+
+    def _luminance(self, window: np.ndarray) -> np.ndarray:
+        from engine.metrics import luminance
+
+        return luminance(window).astype(np.float32)
+
+    def _window(self, origin) -> np.ndarray:
+        y, x = origin
+        return self._luminance(self.S[y : y + self.ph, x : x + self.pw])
 
     def random_origin(self, gen: np.random.Generator) -> tuple[int, int]:
         H, W = self.S.shape[:2]

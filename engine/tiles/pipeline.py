@@ -171,6 +171,9 @@ def _iter_tileset(source, s, rect, maps, weights, excluded, picks, workers, canc
         ),
         notes,
     )
+    if not cands:
+        why = [n for n in notes if n.startswith("made 0")]
+        raise ValueError(why[0] if why else "no candidate was made")
     chosen = list(picks) if picks is not None else [c.index for c in cands]
     made = {c.index for c in cands}
     missing = [k for k in chosen if k not in made]

@@ -125,3 +125,16 @@ def test_global_search_validation(wall):
         candidates(S, st, 2, tolerance=-1)
     with pytest.raises(TypeError, match="min_distance"):
         candidates(S, st, 2, min_distance=2.5)
+
+
+def test_flat_regions_give_no_duplicates_either():
+    """Distinct positions in a flat region have the same content: they are redrawn."""
+    rng = np.random.default_rng(0)
+    S = np.full((160, 200, 3), 0.5, np.float32)
+    S += rng.normal(0, 0.2 / 255, S.shape).astype(np.float32)  # flat to the eye
+    S[:, 120:] = smooth_texture((160, 80), 3, 2, 1.5)
+    st = make_seamless(S, (10, 20, 48, 48), overlap=6)  # in the flat part
+    with pytest.warns(UserWarning, match="alike"):
+        cands = candidates(S, st, 20, rng=1, workers=1)
+    assert len(cands) < 20  # fewer, said why, rather than repeats
+    assert duplicates(cands, st.tile).count == 0
