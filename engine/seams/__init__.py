@@ -68,7 +68,6 @@ _EXPORTS = {
     "SeamUpdate": "engine.seams.search",
     "find_seam": "engine.seams.search",
     "iter_find_seam": "engine.seams.search",
-    "iter_search": "engine.seams.search",
     "warmup": "engine.seams.search",
 }
 

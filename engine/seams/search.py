@@ -34,7 +34,6 @@ __all__ = [
     "SeamUpdate",
     "find_seam",
     "iter_find_seam",
-    "iter_search",
     "warmup",
 ]
 
@@ -218,26 +217,31 @@ def _iter_anytime(e, pins, cyclic, opts, cancel):
 
 
 # ----------------------------------------------------------------------------- public API
-def iter_search(
+def iter_find_seam(
     error,
-    seam: SeamSpec,
     *,
+    seam: SeamSpec | None = None,
+    method: str | None = None,
     start: int | None = None,
     end: int | None = None,
     waypoints=(),
     cyclic: bool = False,
     image=None,
     cancel=None,
+    **options,
 ):
-    """Validate the call eagerly (``seam`` validated itself), then return a generator of
-    :class:`SeamUpdate` returning the :class:`Seam`.
+    """Validate the call eagerly, then return a generator of :class:`SeamUpdate` returning the
+    :class:`Seam`.
 
     Parameters
     ----------
     error : (h, w) array_like
         Non-negative, finite error map (R1 left, R2 right; the path runs top to bottom).
-    seam : SeamSpec
-        The method and its options (its metric and blend concern the caller).
+    seam : SeamSpec, optional
+        The method and its options (its metric and blend concern the caller)...
+    method, **options
+        ... or the method by name (default ``"dp"``) and its options as keywords
+        (:data:`engine.seams.OPTIONS`; unknown ones raise TypeError), not both.
     start, end : int, optional
         Fixed column of the path in row 0 / row h-1.
     waypoints : iterable of (row, col)
@@ -258,7 +262,17 @@ def iter_search(
         ``oscillating``: the initial path (``init``) and every improvement as they come,
         then the best one again with ``final=True``; other methods: one final update.
     """
-    seam = as_seam_spec(seam)
+    if seam is not None:
+        if method is not None or options:
+            raise TypeError("give either seam=SeamSpec(...) or method= and its options, not both")
+        seam = as_seam_spec(seam)
+    else:
+        method = "dp" if method is None else method
+        if not isinstance(method, str) or method not in METHODS:
+            raise ValueError(
+                f"method must be one of {', '.join(map(repr, METHODS))}, got {method!r}"
+            )
+        seam = SeamSpec(method, options)
     method = seam.method
     e = np.ascontiguousarray(as_error_map(error))
     if not e.flags.writeable:  # numba compiles read-only arrays separately: avoid a recompile
@@ -283,45 +297,6 @@ def iter_search(
         # streamed seams are built lazily from the map: keep a private copy
         return _iter_anytime(e.copy(), pins, cyclic, opts, cancel)
     return _iter_single(e, method, pins, cyclic, opts, image, cancel)
-
-
-def iter_find_seam(
-    error,
-    *,
-    seam: SeamSpec | None = None,
-    method: str | None = None,
-    start: int | None = None,
-    end: int | None = None,
-    waypoints=(),
-    cyclic: bool = False,
-    image=None,
-    cancel=None,
-    **options,
-):
-    """:func:`iter_search` with ``seam`` (a :class:`SeamSpec`), or with ``SeamSpec(method,
-    options)``: the method by name (default ``"dp"``) and its options
-    (:data:`engine.seams.OPTIONS`; unknown ones raise TypeError) as keywords."""
-    if seam is not None:
-        if method is not None or options:
-            raise TypeError("give either seam=SeamSpec(...) or method= and its options, not both")
-        spec = seam
-    else:
-        method = "dp" if method is None else method
-        if not isinstance(method, str) or method not in METHODS:
-            raise ValueError(
-                f"method must be one of {', '.join(map(repr, METHODS))}, got {method!r}"
-            )
-        spec = SeamSpec(method, options)
-    return iter_search(
-        error,
-        spec,
-        start=start,
-        end=end,
-        waypoints=waypoints,
-        cyclic=cyclic,
-        image=image,
-        cancel=cancel,
-    )
 
 
 def find_seam(error, **kwargs) -> Seam:

@@ -1,5 +1,6 @@
 """``quilt-studio --help`` lists every sub-command and starts fast: it loads no numpy, numba,
-scipy or Qt; a sub-command loads only its own module of the command line."""
+scipy or Qt; a sub-command loads only its own module of the command line; the tables the
+parsers read (seam methods, tile-set settings) load without numpy."""
 
 import json
 import subprocess
@@ -54,3 +55,10 @@ def test_a_subcommands_help_loads_only_its_own_command(name):
     if name == "tileset":
         own |= {"engine.cli.export", "engine.cli.tileset_output", "engine.cli.tileset_wang"}
     assert set(cli) <= own, cli
+
+
+@pytest.mark.parametrize("module", ["engine.seams.spec", "engine.settings", "engine.cli"])
+def test_the_tables_the_parsers_read_load_without_numpy(module):
+    code = f"import sys, json, {module}; print(json.dumps(sorted(sys.modules)))"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert not {m.split(".")[0] for m in json.loads(out.stdout)} & set(HEAVY)

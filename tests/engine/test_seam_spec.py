@@ -1,8 +1,6 @@
 """SeamSpec: one frozen value for method, options, metric and blend, validated once."""
 
 import json
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -136,13 +134,3 @@ def test_as_seam_spec_default_type_and_straight():
         as_seam_spec("dp")
     with pytest.raises(ValueError, match="straight"):
         as_seam_spec(SeamSpec("straight"))
-
-
-def test_the_spec_module_loads_without_numpy():
-    """The command line's parsers read its tables before any engine work."""
-    code = (
-        "import sys; import engine.seams.spec; "
-        "print(sorted(m for m in ('numpy', 'numba', 'scipy') if m in sys.modules))"
-    )
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    assert out.stdout.strip() == "[]"

@@ -2,8 +2,6 @@
 
 import inspect
 import json
-import subprocess
-import sys
 
 import pytest
 from hypothesis import given
@@ -118,15 +116,6 @@ def test_resolve_fills_in_what_comes_from_the_source():
 def test_unreadable_values_of_a_project_fall_back_to_their_defaults():
     s = settings_from_parameters({"tileset": {"candidates": -3, "seed": 9, "bogus": 1}})
     assert s.candidates == 30 and s.seed == 9
-
-
-def test_settings_load_without_numpy():
-    code = (
-        "import sys; import engine.settings; "
-        "print(sorted(m for m in ('numpy', 'numba', 'scipy') if m in sys.modules))"
-    )
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    assert out.stdout.strip() == "[]"
 
 
 def test_the_cli_runs_the_settings_of_an_earlier_run_again(tmp_path):

@@ -181,6 +181,11 @@ def test_editor_project_keeps_its_settings_and_own_parameters(qtbot, tmp_path):
     assert {k: other.doc.params[k] for k in changes} == changes
 
 
+#: version-1 CLI keys the editor spells the same way
+SAME_NAMES = ("tile_min", "tile_max", "overlap", "patch_overlap", "margin", "neighbourhood")
+SAME_NAMES += ("rho", "width", "no_equal_neighbours")
+
+
 def test_projects_of_the_previous_version_open_with_their_options(tmp_path):
     """Version-1 files kept the options as flat keys, spelled differently by the CLI and the
     editor; both are read."""
@@ -238,20 +243,12 @@ def test_projects_of_the_previous_version_open_with_their_options(tmp_path):
                 "metric": "ssd",
                 "blend": "feather",
                 "template_blend": "none",
-                "rho": 4,
-                "width": 5,
                 "n_candidates": 12,
                 "seed": 8,
                 "layout_seed": 8,
                 "preview_rows": 5,
                 "preview_cols": 7,
-                "no_equal_neighbours": False,
-                "tile_min": 96,
-                "tile_max": 128,
-                "overlap": 10,
-                "patch_overlap": 7,
-                "margin": 1,
-                "neighbourhood": 3,
+                **{k: old_cli[k] for k in SAME_NAMES},
             }
         else:
             expect = {
