@@ -44,6 +44,7 @@ import numpy as np
 
 from engine._validate import as_image, choice, positive_int
 from engine.cancel import AnyCancel, Cancelled, CancelToken, check, is_cancelled
+from engine.errormap import colour_channels
 from engine.events import Item, Progress, drain, frozen_array
 from engine.exclusion import valid_anchors
 from engine.matching import ZERO_ERROR_FRACTION, SampleSpectrum, error_floor
@@ -79,7 +80,8 @@ AXES = ("h", "v")  # "h": colours of the north/south edges, "v": of the east/wes
 INTERIORS = ("patch", "diamonds")
 PATCH_LABEL = 4  # label of the interior patch's pixels (0..3: N, E, S, W; wang_cut.LABELS)
 ROLE_AXIS = {"n": "h", "s": "h", "e": "v", "w": "v"}
-RING_MATCH = 1.0
+#: samples and interiors come from the source's windows at least this detailed (quantile)
+DETAIL_QUANTILE = 0.25
 
 #: Options of :func:`iter_wang_set` and their defaults.
 WANG_DEFAULTS = {
@@ -420,14 +422,17 @@ class WangSetup:
         self.zero_level = ZERO_ERROR_FRACTION * error_floor(self.S) * self.S.shape[2]
         self.bands = _band_pixels(T, self.band)
         self._calm: dict[str, np.ndarray] = {}
+        self._detail: dict[tuple[int, int], np.ndarray] = {}
         r, c = np.mgrid[0:T, 0:T]
         d = np.minimum.reduce([r, c, T - 1 - r, T - 1 - c])
         self.outward = _nonneg_float(outward, "outward")
+        # outward bias of the interior's cut (as the candidates'): 0 at the margin, `outward`
+        # x the mean error at the ring's inner edge, added to the map the cut is searched on
         span = max(1, self.ring - 1 - self.margin)
-        self.outward_weight = 1.0 + self.outward * np.clip((d - self.margin) / span, 0, 1)
-        # the interior is matched where its cut will run: the ring, weighted like the cut
         ring = (d >= self.margin) & (d < self.ring)
-        self.ring_mask = np.where(ring, RING_MATCH / self.outward_weight, 0).astype(np.float32)
+        self.depth = np.where(d < self.ring, np.clip((d - self.margin) / span, 0, 1), 0.0)
+        # the interior is matched where its cut will run: the ring, the outer part first
+        self.ring_mask = np.where(ring, 1 / (1 + self.outward * self.depth), 0).astype(np.float32)
 
     # ---- geometry
     def window_shape(self, axis: str) -> tuple[int, int]:
@@ -512,6 +517,27 @@ class WangSetup:
                 rx = (gx + dx - px) ** 2
                 allowed[rows] &= ry[rows, None] + rx[None, :] >= d2
 
+    def detailed(self, shape: tuple[int, int]) -> np.ndarray:
+        """Window anchors of ``shape`` whose detail (mean squared Laplacian of the luminance)
+        is at least :data:`DETAIL_QUANTILE` of the source's windows: a matcher alone
+        favours flat regions (they match anything calm), and flat samples or interiors
+        read as blurred patches in a layout."""
+        if shape not in self._detail:
+            lum = colour_channels(self.S).mean(axis=2, dtype=np.float64)
+            lap = np.zeros_like(lum)
+            lap[1:-1, 1:-1] = (
+                lum[:-2, 1:-1]
+                + lum[2:, 1:-1]
+                + lum[1:-1, :-2]
+                + lum[1:-1, 2:]
+                - 4 * lum[1:-1, 1:-1]
+            )
+            sat = np.pad(np.cumsum(np.cumsum(lap * lap, axis=0), axis=1), ((1, 0), (1, 0)))
+            h, w = shape
+            energy = sat[h:, w:] - sat[:-h, w:] - sat[h:, :-w] + sat[:-h, :-w]
+            self._detail[shape] = energy >= np.quantile(energy, DETAIL_QUANTILE)
+        return self._detail[shape]
+
     def calm_joint(self, axis: str) -> np.ndarray:
         """Window anchors whose joint (the source's own step across the tile edge the sample
         lies on) is no rougher than the median, relative to the steps of the sample's whole
@@ -555,7 +581,7 @@ class WangSetup:
                 f"no {ww}x{wh} edge sample fits outside the excluded region: paint a smaller "
                 "exclusion or use a smaller tile_size"
             )
-        allowed &= self.calm_joint(axis)
+        allowed &= self.calm_joint(axis) & self.detailed((wh, ww))
         h, T = self.reach, self.T
         offs = [(h, 0), (h - T, 0)] if axis == "h" else [(0, h), (0, h - T)]
         dist = self.min_distance
@@ -618,6 +644,7 @@ class WangSetup:
         samples and from ``avoid`` (earlier tiles' windows)."""
         T = self.T
         allowed = np.ones(errors.shape, bool)
+        allowed &= self.detailed((T, T))
         if self.excluded is not None:
             allowed &= valid_anchors(self.excluded, (T, T))
         if not allowed.any():
@@ -658,7 +685,8 @@ class WangSetup:
         if origin is not None:
             y, x = origin
             q = {k: v[y : y + T, x : x + T] for k, v in self.stack.items()}
-            err = seam_error(q, framed, self.weights, self.seam.metric) * self.outward_weight
+            err = seam_error(q, framed, self.weights, self.seam.metric)
+            bias = self.outward * float(err.mean()) * self.depth if self.outward else None
             cut = patch_cut(
                 q[MAIN],
                 framed[MAIN],
@@ -666,6 +694,7 @@ class WangSetup:
                 margin=self.margin,
                 seam=self.seam,
                 error=err,
+                bias=bias,
                 cancel=cancel,
             )
             check(cancel)
