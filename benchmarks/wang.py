@@ -130,11 +130,11 @@ def _textures(which: str):
 
 
 def _fit(S, tile: int) -> int:
-    from engine.tiles.wang import _Setup
+    from engine.tiles.wang import WangSetup
 
     while tile >= 16:
         try:
-            _Setup(S, tile_size=tile)
+            WangSetup(S, tile_size=tile)
             return tile
         except ValueError:
             tile = tile * 3 // 4

@@ -11,8 +11,6 @@ from __future__ import annotations
 import ast
 from pathlib import Path
 
-import pytest
-
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGES = ("engine", "quilt_gui")
 MAX_LINES = 800
@@ -116,11 +114,6 @@ def test_no_import_circles():
     assert cycles == [], "import circles:\n" + "\n".join(" <-> ".join(c) for c in cycles)
 
 
-#: files over the limit when this test was added, each with a NOTES.md line for its owner; the
-#: xfail below fails (strict) once one is split, so the entry is removed with it
-KNOWN_LONG = {"engine/tiles/wang.py"}
-
-
 def _long_files() -> dict[str, int]:
     return {
         str(p.relative_to(ROOT)): n
@@ -130,13 +123,8 @@ def _long_files() -> dict[str, int]:
 
 
 def test_no_file_over_800_lines():
-    long = {k: n for k, n in _long_files().items() if k not in KNOWN_LONG}
+    long = _long_files()
     assert long == {}, f"files over {MAX_LINES} lines: {long}"
-
-
-@pytest.mark.xfail(reason="engine/tiles/wang.py is over 800 lines (wang splits it; NOTES.md)")
-def test_the_known_long_files_are_split():
-    assert not set(_long_files()) & KNOWN_LONG
 
 
 def _private(name: str | None) -> bool:

@@ -1,0 +1,456 @@
+"""The validated inputs of a Wang set run and its steps (:mod:`engine.tiles.wang`): choosing
+the edge samples with the quilting matcher, cutting a tile's frame between its four edge
+layers, choosing and stitching its interior."""
+
+from __future__ import annotations
+
+import numbers
+
+import numpy as np
+
+from engine._validate import as_image, choice, positive_int
+from engine.cancel import check
+from engine.errormap import colour_channels
+from engine.events import frozen_array
+from engine.exclusion import valid_anchors
+from engine.matching import ZERO_ERROR_FRACTION, SampleSpectrum, error_floor
+from engine.matching import select_within_tolerance as _select
+from engine.materials import apply_cut
+from engine.seams.spec import as_seam_spec
+from engine.stitch import PATCH_SEAM, patch_cut
+from engine.tiles.candidates import default_patch_overlap
+from engine.tiles.seamless import MAIN, as_maps, check_weights, seam_error
+from engine.tiles.template import default_overlap, excluded_mask, flat_warning
+from engine.tiles.wang_cut import CUTS, frame_cut, frame_reach, ramp_reach
+from engine.tiles.wang_types import (
+    AXES,
+    DETAIL_QUANTILE,
+    INTERIORS,
+    PATCH_LABEL,
+    ROLE_AXIS,
+    WANG_DEFAULTS,
+    WangSample,
+    WangTile,
+    wang_seed,
+)
+
+__all__ = ["WangSetup"]
+
+
+def _nonneg_float(value, name: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not value >= 0:
+        raise ValueError(f"{name} must be a number >= 0, got {value!r}")
+    return float(value)
+
+
+class WangSetup:
+    """Validated inputs and the matcher's spectra, shared by every tile of a run."""
+
+    def __init__(self, source, *, tile_size, **options):
+        opts = {**WANG_DEFAULTS, **options}
+        colours, band, variants = opts.pop("colours"), opts.pop("band"), opts.pop("variants")
+        interior, patch_overlap = opts.pop("interior"), opts.pop("patch_overlap")
+        margin, outward = opts.pop("margin"), opts.pop("outward")
+        min_distance, tolerance = opts.pop("min_distance"), opts.pop("tolerance")
+        seam = opts.pop("seam")
+        excluded, maps, weights = opts.pop("excluded"), opts.pop("maps"), opts.pop("weights")
+        if opts:
+            raise TypeError(f"unexpected option(s): {', '.join(sorted(opts))}")
+        self.S = as_image(source, "source")
+        H, W = self.S.shape[:2]
+        self.K = positive_int(colours, "colours")
+        self.T = T = positive_int(tile_size, "tile_size", minimum=8)
+        self.band = positive_int(
+            max(2, default_overlap(T)) if band is None else band, "band", minimum=1
+        )
+        if 4 * self.band > T:
+            raise ValueError(f"band {self.band} is too wide for {T} px tiles (at most {T // 4})")
+        self.variants = positive_int(variants, "variants")
+        self.interior = choice(interior, "interior", INTERIORS)
+        if self.interior == "diamonds" and self.variants > 1:
+            raise ValueError(
+                "variants > 1 needs interior='patch' (without a patch every variant of a "
+                "signature would be the same tile)"
+            )
+        self.seam = as_seam_spec(seam, default=PATCH_SEAM)
+        self.reach = frame_reach(T, self.band, ramp_reach(self.seam))
+        if min(H, W) < max(T, 2 * self.reach):
+            need = 2 * self.reach
+            raise ValueError(
+                f"the {W}x{H} source is too small for {T} px Wang tiles: each edge sample "
+                f"needs {need}x{T} px (use a smaller tile_size or band)"
+            )
+        self.ring = positive_int(
+            default_patch_overlap(default_overlap(T)) if patch_overlap is None else patch_overlap,
+            "patch_overlap",
+            minimum=2,
+        )
+        self.margin = positive_int(margin, "margin", minimum=1)
+        if self.margin >= self.ring:
+            raise ValueError(
+                f"margin must be smaller than patch_overlap, got margin={self.margin}, "
+                f"patch_overlap={self.ring}"
+            )
+        if 2 * self.ring > T:
+            raise ValueError(f"patch_overlap {self.ring} is too wide for {T} px tiles")
+        self.min_distance = _nonneg_float(
+            T / 2 if min_distance is None else min_distance, "min_distance"
+        )
+        self.tolerance = _nonneg_float(tolerance, "tolerance")
+        extra = as_maps(maps, (H, W))
+        self.weights = check_weights(weights, extra)
+        self.stack = {MAIN: self.S, **extra}
+        self.excluded = excluded_mask(excluded, (H, W))
+        self.notes = []
+        flat = flat_warning(self.S)
+        if flat:
+            self.notes.append(flat)
+        self.spec = SampleSpectrum(self.S)
+        self.zero_level = ZERO_ERROR_FRACTION * error_floor(self.S) * self.S.shape[2]
+        self.bands = _band_pixels(T, self.band)
+        self._calm: dict[str, np.ndarray] = {}
+        self._detail: dict[tuple[int, int], np.ndarray] = {}
+        r, c = np.mgrid[0:T, 0:T]
+        d = np.minimum.reduce([r, c, T - 1 - r, T - 1 - c])
+        self.outward = _nonneg_float(outward, "outward")
+        # outward bias of the interior's cut (as the candidates'): 0 at the margin, `outward`
+        # x the mean error at the ring's inner edge, added to the map the cut is searched on
+        span = max(1, self.ring - 1 - self.margin)
+        ring = (d >= self.margin) & (d < self.ring)
+        self.depth = np.where(d < self.ring, np.clip((d - self.margin) / span, 0, 1), 0.0)
+        # the interior is matched where its cut will run: the ring, the outer part first
+        self.ring_mask = np.where(ring, 1 / (1 + self.outward * self.depth), 0).astype(np.float32)
+
+    # ---- geometry
+    def window_shape(self, axis: str) -> tuple[int, int]:
+        return (2 * self.reach, self.T) if axis == "h" else (self.T, 2 * self.reach)
+
+    def anchor_to_origin(self, axis: str, y: int, x: int) -> tuple[int, int]:
+        return (y + self.reach, x) if axis == "h" else (y, x + self.reach)
+
+    def check_origin(self, axis: str, origin) -> tuple[int, int]:
+        try:
+            oy, ox = (int(v) for v in origin)
+        except (TypeError, ValueError):
+            raise TypeError(f"a sample origin must be (row, col), got {origin!r}") from None
+        H, W = self.S.shape[:2]
+        wh, ww = self.window_shape(axis)
+        y, x = (oy - self.reach, ox) if axis == "h" else (oy, ox - self.reach)
+        if not (0 <= y <= H - wh and 0 <= x <= W - ww):
+            raise ValueError(
+                f"an {axis!r} sample at origin {(oy, ox)} reads source pixels outside the "
+                f"{W}x{H} source (its {ww}x{wh} window would start at x={x}, y={y})"
+            )
+        return oy, ox
+
+    def layer(self, sample: WangSample, role: str) -> dict[str, np.ndarray]:
+        """The sample's pixels in ``role`` as T x T maps (zero outside what the frame reads)."""
+        T, h = self.T, self.reach
+        y, x = sample.offset(role, T)
+        out = {}
+        for name, img in self.stack.items():
+            a = np.zeros((T, T, img.shape[2]), np.float32)
+            if role == "n":
+                a[:h] = img[y : y + h, x : x + T]
+            elif role == "s":
+                a[T - h :] = img[y + T - h : y + T, x : x + T]
+            elif role == "w":
+                a[:, :h] = img[y : y + T, x : x + h]
+            else:
+                a[:, T - h :] = img[y : y + T, x + T - h : x + T]
+            out[name] = a
+        return out
+
+    # ---- sample selection
+    def sample_errors(self, axis: str, others: list[WangSample]) -> np.ndarray:
+        """Band SSD of an ``axis`` sample at every window anchor against ``others`` (the
+        other axis), over the four diagonal bands of every tile where they meet."""
+        T = self.T
+        wh, ww = self.window_shape(axis)
+        C = self.S.shape[2]
+        kern = np.zeros((C, wh, ww), np.float32)
+        wts = np.zeros((wh, ww), np.float32)
+        const = 0.0
+        for o in others:
+            for name, (rows, cols) in self.bands.items():
+                a_role, b_role = CUTS[name][:2]
+                mine, theirs = (b_role, a_role) if axis == "h" else (a_role, b_role)
+                oy, ox = o.offset(theirs, T)
+                target = self.S[oy + rows, ox + cols]  # (n, C)
+                wy, wx = _window_coords(mine, rows, cols, T, self.reach)
+                np.add.at(wts, (wy, wx), 1.0)
+                np.add.at(kern, (slice(None), wy, wx), target.T)
+                const += float(np.sum(target.astype(np.float64) ** 2))
+        if not others:
+            H, W = self.S.shape[:2]
+            return np.zeros((H - wh + 1, W - ww + 1), np.float32)
+        e = self.spec.ssd_terms(kern[None], wts[None, None], np.array([const]))[0]
+        return e
+
+    def forbid_near(self, allowed: np.ndarray, offsets, points, distance: float) -> None:
+        """Clear ``allowed`` (window anchors) where an anchor plus any of ``offsets`` lies
+        within ``distance`` of any of ``points`` (source (row, col))."""
+        if distance <= 0 or not len(points):
+            return
+        ny, nx = allowed.shape
+        gy, gx = np.arange(ny), np.arange(nx)
+        d2 = distance * distance
+        for dy, dx in offsets:
+            for py, px in points:
+                ry = (gy + dy - py) ** 2
+                rows = np.flatnonzero(ry < d2)
+                if rows.size == 0:
+                    continue
+                rx = (gx + dx - px) ** 2
+                allowed[rows] &= ry[rows, None] + rx[None, :] >= d2
+
+    def detailed(self, shape: tuple[int, int]) -> np.ndarray:
+        """Window anchors of ``shape`` whose detail (mean squared Laplacian of the luminance)
+        is at least :data:`DETAIL_QUANTILE` of the source's windows: a matcher alone
+        favours flat regions (they match anything calm), and flat samples or interiors
+        read as blurred patches in a layout."""
+        if shape not in self._detail:
+            lum = colour_channels(self.S).mean(axis=2, dtype=np.float64)
+            lap = np.zeros_like(lum)
+            lap[1:-1, 1:-1] = (
+                lum[:-2, 1:-1]
+                + lum[2:, 1:-1]
+                + lum[1:-1, :-2]
+                + lum[1:-1, 2:]
+                - 4 * lum[1:-1, 1:-1]
+            )
+            sat = np.pad(np.cumsum(np.cumsum(lap * lap, axis=0), axis=1), ((1, 0), (1, 0)))
+            h, w = shape
+            energy = sat[h:, w:] - sat[:-h, w:] - sat[h:, :-w] + sat[:-h, :-w]
+            self._detail[shape] = energy >= np.quantile(energy, DETAIL_QUANTILE)
+        return self._detail[shape]
+
+    def calm_joint(self, axis: str) -> np.ndarray:
+        """Window anchors whose joint (the source's own step across the tile edge the sample
+        lies on) is no rougher than the median, relative to the steps of the sample's whole
+        window: a joint along a mortar line or a shelf edge would show at every edge of
+        that colour. (Relative to its window, so that calm regions are not preferred.)"""
+        if axis not in self._calm:
+            S = self.S if axis == "h" else self.S.transpose(1, 0, 2)
+            T, h = self.T, self.reach
+            d = np.sum(np.diff(S.astype(np.float64), axis=0) ** 2, axis=2)  # d[y] = S[y+1]-S[y]
+            run = np.cumsum(np.pad(d, ((0, 0), (1, 0))), axis=1)
+            rows = (run[:, T:] - run[:, :-T]) / T  # mean over T columns, by first column
+            # window anchor (y, x): joint between source rows y + h - 1 and y + h; the
+            # window's own steps are rows y .. y + 2h - 2
+            n = S.shape[0] - 2 * h + 1
+            joint = rows[h - 1 : h - 1 + n]
+            acc = np.cumsum(np.pad(rows, ((1, 0), (0, 0))), axis=0)
+            window = (acc[2 * h - 1 : 2 * h - 1 + n] - acc[:n]) / (2 * h - 1)
+            ratio = joint / (window + 1e-12)
+            calm = ratio <= np.median(ratio)
+            self._calm[axis] = calm if axis == "h" else calm.T
+        return self._calm[axis]
+
+    def role_anchors(self, samples: list[WangSample]) -> list[tuple[int, int]]:
+        """Source position of tile pixel (0, 0) for every role of every sample."""
+        pts = []
+        for s in samples:
+            roles = ("n", "s") if s.axis == "h" else ("w", "e")
+            pts += [s.offset(r, self.T) for r in roles]
+        return pts
+
+    def choose(self, axis, colour, others, placed, rng) -> WangSample:
+        """Sample ``colour`` of ``axis``: best matching ``others`` within tolerance, away from
+        ``placed`` (role anchors) by ``min_distance``."""
+        e = self.sample_errors(axis, others).astype(np.float64)
+        wh, ww = self.window_shape(axis)
+        allowed = np.ones(e.shape, bool)
+        if self.excluded is not None:
+            allowed &= valid_anchors(self.excluded, (wh, ww))
+        if not allowed.any():
+            raise ValueError(
+                f"no {ww}x{wh} edge sample fits outside the excluded region: paint a smaller "
+                "exclusion or use a smaller tile_size"
+            )
+        allowed &= self.calm_joint(axis) & self.detailed((wh, ww))
+        h, T = self.reach, self.T
+        offs = [(h, 0), (h - T, 0)] if axis == "h" else [(0, h), (0, h - T)]
+        dist = self.min_distance
+        while True:
+            ok = allowed.copy()
+            self.forbid_near(ok, offs, placed, dist)
+            if ok.any() or dist < 1:
+                break
+            dist /= 2
+        if not ok.any():
+            ok = allowed
+        if dist < self.min_distance:
+            self.notes.append(
+                f"the source is too small for {self.K} colours at min_distance "
+                f"{self.min_distance:g}: samples are {dist:g} px apart"
+            )
+        n_px = sum(len(r) for r, _ in self.bands.values()) * max(1, len(others))
+        k, _, _ = _select(
+            np.where(ok, e, np.inf),
+            tolerance=self.tolerance,
+            zero_level=self.zero_level * n_px,
+            rng=rng,
+        )
+        y, x = divmod(k, e.shape[1])
+        err = float(e[y, x]) / (n_px * self.S.shape[2]) if others else 0.0
+        return WangSample(axis, int(colour), self.anchor_to_origin(axis, y, x), err)
+
+    def choose_all(self, base: int, cancel) -> list[WangSample]:
+        chosen: dict[tuple[str, int], WangSample] = {}
+        order = [(axis, c) for c in range(self.K) for axis in AXES]
+        order += [("h", c) for c in range(self.K)]  # each h colour again against every v
+        for step, (axis, c) in enumerate(order):
+            check(cancel)
+            other = "v" if axis == "h" else "h"
+            others = [s for (a, _), s in chosen.items() if a == other]
+            placed = self.role_anchors([s for key, s in chosen.items() if key != (axis, c)])
+            rng = np.random.default_rng(wang_seed(base, 0, step))
+            chosen[(axis, c)] = self.choose(axis, c, others, placed, rng)
+        return [chosen[(a, c)] for a in AXES for c in range(self.K)]
+
+    # ---- tiles
+    def frame(self, samples: list[WangSample], signature, cancel):
+        check(cancel)
+        layers = {}
+        for role, colour in zip("nesw", signature, strict=True):
+            layers[role] = self.layer(samples[AXES.index(ROLE_AXIS[role]) * self.K + colour], role)
+        errors = {
+            name: seam_error(layers[a], layers[b], self.weights, self.seam.metric)
+            for name, (a, b, _, _) in CUTS.items()
+        }
+        fr = frame_cut(errors, band=self.band, seam=self.seam, cancel=cancel)
+        return fr, fr.apply(layers)
+
+    def patch_errors(self, framed: dict) -> np.ndarray:
+        u = framed[MAIN]
+        return self.spec.ssd(u[None], self.ring_mask[None])[0]
+
+    def patch_anchor(self, errors, samples, avoid, rng) -> tuple[tuple[int, int], float, float]:
+        """The interior window: within tolerance of the best ring match, away from the
+        samples and from ``avoid`` (earlier tiles' windows)."""
+        T = self.T
+        allowed = np.ones(errors.shape, bool)
+        allowed &= self.detailed((T, T))
+        if self.excluded is not None:
+            allowed &= valid_anchors(self.excluded, (T, T))
+        if not allowed.any():
+            raise ValueError(
+                f"no {T}x{T} interior patch fits outside the excluded region: paint a smaller "
+                "exclusion or use interior='diamonds'"
+            )
+        dist = self.min_distance
+        while True:
+            ok = allowed.copy()
+            self.forbid_near(ok, [(0, 0)], self.role_anchors(samples), dist)
+            self.forbid_near(ok, [(0, 0)], avoid, dist)
+            if ok.any() or dist < 1:
+                break
+            dist /= 2
+        if not ok.any():
+            ok = allowed
+        n_px = float(self.ring_mask.sum())
+        k, _, _ = _select(
+            np.where(ok, errors.astype(np.float64), np.inf),
+            tolerance=self.tolerance,
+            zero_level=self.zero_level * n_px,
+            rng=rng,
+        )
+        y, x = divmod(k, errors.shape[1])
+        return (int(y), int(x)), float(errors[y, x]) / (n_px * self.S.shape[2]), dist
+
+    def finish(self, index, signature, variant, fr, framed, origin, band_error, seed, cancel):
+        check(cancel)
+        T = self.T
+        labels = np.array(fr.labels)
+        paths = dict(fr.paths)
+        scores = {
+            "criterion": float(sum(fr.criterion.values())),
+            "peak": float(max(fr.peak.values())),
+        }
+        out = framed
+        if origin is not None:
+            y, x = origin
+            q = {k: v[y : y + T, x : x + T] for k, v in self.stack.items()}
+            err = seam_error(q, framed, self.weights, self.seam.metric)
+            bias = self.outward * float(err.mean()) * self.depth if self.outward else None
+            cut = patch_cut(
+                q[MAIN],
+                framed[MAIN],
+                ring=self.ring,
+                margin=self.margin,
+                seam=self.seam,
+                error=err,
+                bias=bias,
+                cancel=cancel,
+            )
+            check(cancel)
+            out = apply_cut(q, framed, cut.alpha)
+            labels[cut.mask] = PATCH_LABEL
+            paths["patch"] = np.asarray(cut.loop)
+            scores.update(
+                patch_criterion=float(cut.criterion),
+                patch_peak=float(cut.peak),
+                band_error=band_error,
+            )
+        fz = frozen_array
+        return WangTile(
+            index=int(index),
+            signature=tuple(int(v) for v in signature),
+            variant=int(variant),
+            tile=fz(out[MAIN]),
+            maps={k: fz(v) for k, v in out.items() if k != MAIN},
+            labels=fz(labels),
+            paths={k: fz(v) for k, v in paths.items()},
+            junction=fr.junction,
+            patch_origin=None if origin is None else (int(origin[0]), int(origin[1])),
+            scores=scores,
+            seed=seed,
+        )
+
+    def parameters(self) -> dict:
+        return {
+            "colours": self.K,
+            "tile_size": self.T,
+            "band": self.band,
+            "reach": self.reach,
+            "variants": self.variants,
+            "interior": self.interior,
+            "patch_overlap": self.ring,
+            "margin": self.margin,
+            "outward": self.outward,
+            "min_distance": self.min_distance,
+            "tolerance": self.tolerance,
+            "seam": self.seam.to_dict(),
+        }
+
+
+def _band_pixels(T: int, band: int) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Tile pixels (rows, cols) of each cut's nominal band, for matching samples: within
+    ``band`` of the cut's diagonal, upper cuts in rows 1 .. T/2 - 1, lower ones T/2 .. T-2."""
+    out = {}
+    half = T // 2
+    for name, (_, _, fr, fc) in CUTS.items():
+        r, c = np.mgrid[1 : T - half, 0:T]  # frame rows 1 .. T - 1 - T/2
+        keep = np.abs(c - r) <= band
+        r, c = r[keep], c[keep]
+        if fr:
+            r = T - 1 - r
+        if fc:
+            c = T - 1 - c
+        if not fr:
+            keep = r < half
+            r, c = r[keep], c[keep]
+        out[name] = (r.astype(np.intp), c.astype(np.intp))
+    return out
+
+
+def _window_coords(role: str, rows, cols, T: int, reach: int):
+    """Tile pixels of a sample in ``role`` -> coordinates in its selection window."""
+    if role == "n":
+        return rows + reach, cols
+    if role == "s":
+        return rows - T + reach, cols
+    if role == "w":
+        return rows, cols + reach
+    return rows, cols - T + reach

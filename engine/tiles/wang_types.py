@@ -1,0 +1,301 @@
+"""The values of a Wang tile set (:mod:`engine.tiles.wang`): edge samples, tiles, the set,
+its edge signatures in their canonical order, and the plain-JSON record manifests and projects
+keep."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from engine._validate import positive_int
+from engine.events import Item
+from engine.stitch import PATCH_SEAM
+
+__all__ = [
+    "AXES",
+    "INTERIORS",
+    "WANG_DEFAULTS",
+    "WangSample",
+    "WangSamples",
+    "WangSet",
+    "WangTile",
+    "canonical_signatures",
+    "de_bruijn",
+    "from_candidate",
+    "samples_from_record",
+    "wang_record",
+    "wang_seed",
+]
+
+AXES = ("h", "v")  # "h": colours of the north/south edges, "v": of the east/west edges
+INTERIORS = ("patch", "diamonds")
+PATCH_LABEL = 4  # label of the interior patch's pixels (0..3: N, E, S, W; wang_cut.LABELS)
+ROLE_AXIS = {"n": "h", "s": "h", "e": "v", "w": "v"}
+#: samples and interiors come from the source's windows at least this detailed (quantile)
+DETAIL_QUANTILE = 0.25
+
+#: Options of :func:`iter_wang_set` and their defaults.
+WANG_DEFAULTS = {
+    "colours": 2,
+    "band": None,
+    "variants": 1,
+    "interior": "patch",
+    "patch_overlap": None,
+    "margin": 1,
+    "outward": 1.0,
+    "min_distance": None,
+    "tolerance": 0.1,
+    "seam": PATCH_SEAM,
+    "excluded": None,
+    "maps": None,
+    "weights": None,
+}
+
+
+# --------------------------------------------------------------------------- signatures
+def de_bruijn(k: int) -> list[int]:
+    """A de Bruijn sequence B(k, 2): every ordered pair of 0..k-1 appears once cyclically.
+
+    >>> de_bruijn(2)
+    [0, 0, 1, 1]
+    """
+    k = positive_int(k, "k")
+    a = [0] * (2 * k + 1)
+    seq: list[int] = []
+
+    def db(t, p):
+        if t > 2:
+            if 2 % p == 0:
+                seq.extend(a[1 : p + 1])
+        else:
+            a[t] = a[t - p]
+            db(t + 1, p)
+            for j in range(a[t - p] + 1, k):
+                a[t] = j
+                db(t + 1, t)
+
+    db(1, 1)
+    return seq
+
+
+def canonical_signatures(k: int) -> list[tuple[int, int, int, int]]:
+    """Every edge signature (N, E, S, W) once, in the row-major order of a k² x k² grid that
+    is itself a valid Wang tiling, toroidally (Lagae's packing of a complete set): cell (i, j)
+    has N = x[i], S = x[i + 1], W = x[j], E = x[j + 1] for the de Bruijn sequence x."""
+    x = de_bruijn(k)
+    n = len(x)
+    return [(x[i], x[(j + 1) % n], x[(i + 1) % n], x[j]) for i in range(n) for j in range(n)]
+
+
+# --------------------------------------------------------------------------- results
+@dataclass(frozen=True, slots=True)
+class WangSample:
+    """One edge colour: a source position whose pixels continue across every edge of that
+    colour.
+
+    ``origin`` is the source (row, col) of tile pixel (0, 0) when the sample lies on a tile's
+    north edge (axis ``"h"``) or west edge (axis ``"v"``); on the south (east) edge it shows
+    the source ``tile`` rows (columns) above (left of) that. ``error`` is its matching error
+    when chosen (mean squared difference per band pixel and channel).
+    """
+
+    axis: str
+    colour: int
+    origin: tuple[int, int]
+    error: float = 0.0
+
+    def offset(self, role: str, tile: int) -> tuple[int, int]:
+        """Source (row, col) of tile pixel (0, 0) in ``role`` (n, e, s or w)."""
+        oy, ox = self.origin
+        return {"n": (oy, ox), "w": (oy, ox), "s": (oy - tile, ox), "e": (oy, ox - tile)}[role]
+
+    def footprint(self, tile: int, reach: int) -> tuple[int, int, int, int]:
+        """Source rectangle (x, y, w, h) the sample's layers read."""
+        oy, ox = self.origin
+        if self.axis == "h":
+            return (ox, oy - reach, tile, 2 * reach)
+        return (ox - reach, oy, 2 * reach, tile)
+
+    def diamond(self, tile: int) -> list[tuple[float, float]]:
+        """The diamond's corners (x, y) in source pixel-edge coordinates: the square rotated
+        by 45° whose diagonal is the tile edge."""
+        oy, ox = self.origin
+        t = tile / 2
+        if self.axis == "h":
+            return [(ox, oy), (ox + t, oy - t), (ox + tile, oy), (ox + t, oy + t)]
+        return [(ox, oy), (ox + t, oy + t), (ox, oy + tile), (ox - t, oy + t)]
+
+
+@dataclass(frozen=True, slots=True)
+class WangSamples(Item):
+    """The edge samples of a run (streamed before the tiles): h colours then v colours."""
+
+    samples: tuple
+
+
+@dataclass(frozen=True, slots=True)
+class WangTile(Item):
+    """One finished Wang tile.
+
+    Attributes
+    ----------
+    index : int
+        Its slot: ``variant * K**4 + position`` in :func:`canonical_signatures` order.
+    signature : (n, e, s, w)
+        The colour of each edge (h colours on n and s, v colours on e and w).
+    variant : int
+    tile : (T, T, C) float32
+    maps : dict
+        The same tile for every extra material map.
+    labels : (T, T) uint8 or None
+        Where each pixel comes from: 0 N, 1 E, 2 S, 3 W sample, 4 the interior patch (None
+        for a tile read back from a project).
+    paths : dict
+        The cuts in tile (row, col): ``nw``, ``ne``, ``sw``, ``se`` (corner to junction) and
+        ``patch`` (the closed loop, absent without an interior patch).
+    junction : (row, col)
+    patch_origin : (row, col) or None
+        The interior patch's source window (top-left), None without one.
+    scores : dict
+        ``criterion`` and ``peak`` of the corner cuts (sum, max), ``patch_criterion``,
+        ``patch_peak``, ``band_error`` (mean ring error of the patch window).
+    seed : int or None
+    """
+
+    index: int
+    signature: tuple[int, int, int, int]
+    variant: int
+    tile: np.ndarray
+    maps: dict
+    labels: np.ndarray | None
+    paths: dict
+    junction: tuple[int, int]
+    patch_origin: tuple[int, int] | None = None
+    scores: dict = field(default_factory=dict)
+    seed: int | None = None
+
+    @property
+    def wang(self) -> dict:
+        """The signature as ``{"n": c, "e": c, "s": c, "w": c}`` (the manifest's form)."""
+        return dict(zip("nesw", self.signature, strict=True))
+
+    def to_candidate(self):
+        """This tile as the project's tile type (:class:`engine.candidate.CandidateTile`): its
+        signature, variant and junction in ``params``; :func:`from_candidate` reads it back."""
+        from engine.candidate import CandidateTile
+
+        cuts = {k: np.asarray(v).tolist() for k, v in self.paths.items() if k != "patch"}
+        return CandidateTile(
+            index=self.index,
+            tile=self.tile,
+            maps=dict(self.maps),
+            patch_origin=self.patch_origin,
+            loop=self.paths.get("patch"),
+            scores={k: float(v) for k, v in self.scores.items()},
+            seed=self.seed,
+            params={
+                "wang": self.wang,
+                "variant": self.variant,
+                "index": self.index,
+                "junction": list(self.junction),
+                "cuts": cuts,
+            },
+        )
+
+
+def from_candidate(c) -> WangTile:
+    """The :class:`WangTile` a project keeps as :meth:`WangTile.to_candidate` wrote it (its
+    pixel labels are not kept: ``labels`` is None)."""
+    p = c.params
+    paths = {k: np.asarray(v, dtype=np.intp).reshape(-1, 2) for k, v in p.get("cuts", {}).items()}
+    if c.loop is not None:
+        paths["patch"] = np.asarray(c.loop, dtype=np.intp)
+    junction = p.get("junction") or (0, 0)
+    return WangTile(
+        index=int(p.get("index", c.index)),
+        signature=tuple(int(p["wang"][k]) for k in "nesw"),
+        variant=int(p.get("variant", 0)),
+        tile=c.tile,
+        maps=dict(c.maps),
+        labels=None,
+        paths=paths,
+        junction=(int(junction[0]), int(junction[1])),
+        patch_origin=None if c.patch_origin is None else tuple(c.patch_origin),
+        scores=dict(c.scores),
+        seed=c.seed,
+    )
+
+
+@dataclass(frozen=True)
+class WangSet:
+    """A Wang tile set: its samples and tiles (index order; a cancelled run holds fewer)."""
+
+    colours: int
+    tile_size: int
+    band: int
+    variants: int
+    samples: tuple[WangSample, ...]
+    tiles: tuple[WangTile, ...]
+    parameters: dict = field(default_factory=dict)
+    notes: tuple[str, ...] = ()
+
+    @property
+    def count(self) -> int:
+        """Tiles of the complete set: ``variants * colours**4``."""
+        return self.variants * self.colours**4
+
+    @property
+    def complete(self) -> bool:
+        return [t.index for t in self.tiles] == list(range(self.count))
+
+    def sample(self, axis: str, colour: int) -> WangSample:
+        return self.samples[AXES.index(axis) * self.colours + colour]
+
+    @property
+    def signatures(self) -> list[tuple[int, int, int, int]]:
+        return [t.signature for t in self.tiles]
+
+    def record(self) -> dict:
+        """The set's record for manifests and projects (:func:`wang_record`)."""
+        return wang_record(self.samples, self.parameters)
+
+    def arrangement(self, variant: int = 0) -> np.ndarray:
+        """The K² x K² index matrix of :func:`canonical_signatures` (a valid tiling that also
+        wraps) for one variant."""
+        n = self.colours**2
+        return (variant * n * n + np.arange(n * n)).reshape(n, n)
+
+
+def wang_record(samples, parameters: dict) -> dict:
+    """A Wang set as plain JSON (manifest, project): colours, tile size, variants, band, the
+    samples and every parameter of the run; :func:`samples_from_record` reads the samples
+    back."""
+    return {
+        "colours": int(parameters["colours"]),
+        "tile_size": int(parameters["tile_size"]),
+        "variants": int(parameters.get("variants", 1)),
+        "band": parameters.get("band"),
+        "samples": [
+            {"axis": s.axis, "colour": int(s.colour), "origin": [int(v) for v in s.origin],
+             "error": float(s.error)}
+            for s in samples
+        ],
+        "parameters": dict(parameters),
+    }  # fmt: skip
+
+
+def samples_from_record(record: dict) -> list[WangSample]:
+    """The :class:`WangSample` list of a :func:`wang_record`."""
+    return [
+        WangSample(s["axis"], int(s["colour"]), (int(s["origin"][0]), int(s["origin"][1])),
+                   float(s.get("error", 0.0)))
+        for s in record["samples"]
+    ]  # fmt: skip
+
+
+# --------------------------------------------------------------------------- seeds
+def wang_seed(base: int, kind: int, index: int) -> int:
+    """Seed of item ``index`` of ``kind`` (0: samples, 1: tiles) in a run seeded ``base``."""
+    state = np.random.SeedSequence([int(base), int(kind), int(index)]).generate_state(1, np.uint64)
+    return int(state[0]) & (2**63 - 1)
