@@ -75,6 +75,31 @@ OUTWARD = 0.5  # bias of the closed cut toward the outer margin, in units of the
 PATCH_RING_FLOOR = 8  # px: narrower rings leave the closed cut no room (default_patch_overlap)
 
 
+def check_ring(patch_overlap, margin, *, min_margin: int = 0) -> tuple[int, int]:
+    """(w_P, margin) validated: the ring a closed patch cut runs in (>= 2 px) and the outer
+    pixels it never touches (``min_margin`` .. w_P - 1)."""
+    ring = positive_int(patch_overlap, "patch_overlap", minimum=2)
+    m = positive_int(margin, "margin", minimum=min_margin)
+    if m >= ring:
+        raise ValueError(
+            f"margin must be smaller than patch_overlap, got margin={m}, patch_overlap={ring}"
+        )
+    return ring, m
+
+
+def stitch_patch(q, u, *, ring, margin, seam, weights, outward, depth, cancel=None):
+    """Window ``q`` ({map: image}) stitched into ``u`` along a closed cut in the ring (its
+    error the maps' weighted error, drawn toward the outer margin by ``outward`` x the mean
+    error x ``depth``): ``({map: result}, PatchCut)``. Candidates and Wang interiors."""
+    err = seam_error(q, u, weights, seam.metric)
+    bias = (outward * float(err.mean())) * depth if outward else None
+    cut = patch_cut(
+        q[MAIN], u[MAIN], ring=ring, margin=margin, seam=seam, error=err, bias=bias, cancel=cancel
+    )
+    check(cancel)
+    return apply_cut(q, u, cut.alpha), cut
+
+
 def default_patch_overlap(overlap: int) -> int:
     """The default patch ring w_P for a template overlap w_T: ``min(w_T, max(8, w_T // 2))``.
 
@@ -233,17 +258,10 @@ class _Setup:
                 f"source has {self.S.shape[2]} channels, the template tile "
                 f"{template.tile.shape[2]}: use the source the template was made from"
             )
-        self.ring = positive_int(
+        self.ring, self.margin = check_ring(
             default_patch_overlap(template.overlap) if patch_overlap is None else patch_overlap,
-            "patch_overlap",
-            minimum=2,
+            margin,
         )
-        self.margin = positive_int(margin, "margin", minimum=0)
-        if self.margin >= self.ring:
-            raise ValueError(
-                f"margin must be smaller than patch_overlap, got margin={self.margin}, "
-                f"patch_overlap={self.ring}"
-            )
         ph, pw = (th, tw) if patch_size is None else as_size(patch_size, "patch_size")
         if ph > th or pw > tw:
             raise ValueError(f"patch_size {(ph, pw)} must not exceed the tile size {(th, tw)}")
@@ -438,20 +456,17 @@ class _Setup:
         check(cancel)
         win = (slice(sy, sy + self.ph), slice(sx, sx + self.pw))
         Q = {k: v[win] for k, v in self.stack.items()}
-        err = seam_error(Q, self.U, self.weights, self.seam.metric)
-        bias = (self.outward * float(err.mean())) * self.bias if self.outward else None
-        cut = patch_cut(
-            Q[MAIN],
-            self.U[MAIN],
+        out, cut = stitch_patch(
+            Q,
+            self.U,
             ring=self.ring,
             margin=self.margin,
             seam=self.seam,
-            error=err,
-            bias=bias,
+            weights=self.weights,
+            outward=self.outward,
+            depth=self.bias,
             cancel=cancel,
         )
-        check(cancel)
-        out = apply_cut(Q, self.U, cut.alpha)
         ty, tx, ph, pw = self.ty, self.tx, self.ph, self.pw
         tiles = {}
         for k, v in self.tmaps.items():

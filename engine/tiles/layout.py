@@ -16,7 +16,7 @@ import numpy as np
 from engine._validate import as_rng, positive_int
 from engine.index_matrix import assemble_layout
 
-__all__ = ["assemble", "random_layout"]
+__all__ = ["assemble", "assemble_maps", "random_layout"]
 
 
 def tile_weights(weights, n_tiles: int) -> np.ndarray:
@@ -120,3 +120,9 @@ def assemble(tiles, layout, *, map_name: str | None = None) -> np.ndarray:
     if isinstance(layout, numbers.Integral):
         raise TypeError("layout must be a 2-D index matrix")
     return assemble_layout(arrs, layout)
+
+
+def assemble_maps(tiles, layout, names) -> dict:
+    """:func:`assemble` for every map of ``names`` (``"main"`` first: the tiles' ``tile``,
+    the others from their ``maps``): the preview of a layout per map."""
+    return {m: assemble(tiles, layout, map_name=None if m == names[0] else m) for m in names}

@@ -22,7 +22,7 @@ from engine.tiles.candidates import (
     default_patch_overlap,
     iter_candidates,
 )
-from engine.tiles.layout import assemble, random_layout
+from engine.tiles.layout import assemble_maps, random_layout
 from engine.tiles.seamless import MAIN, SeamlessTile, iter_make_seamless
 from engine.tiles.template import default_overlap, iter_find_template, template_cost
 
@@ -189,8 +189,7 @@ def _iter_tileset(source, s, rect, maps, weights, excluded, picks, workers, canc
         no_equal_neighbours=resolved.no_equal_neighbours and len(chosen) > 1,
     )
     tiles = [by_index[k] for k in chosen]
-    names = [MAIN, *seamless.maps]
-    preview = {m: assemble(tiles, ids, map_name=None if m == MAIN else m) for m in names}
+    preview = assemble_maps(tiles, ids, [MAIN, *seamless.maps])
     yield Progress(1, 1, "tile set: done")
     return TilesetResult(
         settings=resolved,

@@ -14,7 +14,7 @@ import numpy as np
 
 from engine.events import Progress
 from engine.settings import TilesetSettings
-from engine.tiles.layout import assemble
+from engine.tiles.layout import assemble_maps
 from engine.tiles.seamless import MAIN
 from engine.tiles.wang import WangSet, iter_wang_set
 from engine.tiles.wang_layout import wang_layout
@@ -114,7 +114,6 @@ def _iter(gen, s: TilesetSettings):
         rng=s.layout_seed,
         no_equal_neighbours=s.no_equal_neighbours,
     )
-    names = [MAIN, *ws.tiles[0].maps]
-    preview = {m: assemble(ws.tiles, ids, map_name=None if m == MAIN else m) for m in names}
+    preview = assemble_maps(ws.tiles, ids, [MAIN, *ws.tiles[0].maps])
     yield Progress(1, 1, "Wang tile set: done")
     return WangTilesetResult(s, ws, ids, preview, ws.notes)

@@ -15,10 +15,9 @@ from engine.events import frozen_array
 from engine.exclusion import valid_anchors
 from engine.matching import ZERO_ERROR_FRACTION, SampleSpectrum, error_floor
 from engine.matching import select_within_tolerance as _select
-from engine.materials import apply_cut
 from engine.seams.spec import as_seam_spec
-from engine.stitch import PATCH_SEAM, patch_cut
-from engine.tiles.candidates import default_patch_overlap
+from engine.stitch import PATCH_SEAM
+from engine.tiles.candidates import check_ring, default_patch_overlap, stitch_patch
 from engine.tiles.seamless import MAIN, as_maps, check_weights, seam_error
 from engine.tiles.template import default_overlap, excluded_mask, flat_warning
 from engine.tiles.wang_cut import CUTS, frame_cut, frame_reach, ramp_reach
@@ -80,17 +79,11 @@ class WangSetup:
                 f"the {W}x{H} source is too small for {T} px Wang tiles: each edge sample "
                 f"needs {need}x{T} px (use a smaller tile_size or band)"
             )
-        self.ring = positive_int(
+        self.ring, self.margin = check_ring(
             default_patch_overlap(default_overlap(T)) if patch_overlap is None else patch_overlap,
-            "patch_overlap",
-            minimum=2,
+            margin,
+            min_margin=1,
         )
-        self.margin = positive_int(margin, "margin", minimum=1)
-        if self.margin >= self.ring:
-            raise ValueError(
-                f"margin must be smaller than patch_overlap, got margin={self.margin}, "
-                f"patch_overlap={self.ring}"
-            )
         if 2 * self.ring > T:
             raise ValueError(f"patch_overlap {self.ring} is too wide for {T} px tiles")
         self.min_distance = _nonneg_float(
@@ -372,20 +365,17 @@ class WangSetup:
         if origin is not None:
             y, x = origin
             q = {k: v[y : y + T, x : x + T] for k, v in self.stack.items()}
-            err = seam_error(q, framed, self.weights, self.seam.metric)
-            bias = self.outward * float(err.mean()) * self.depth if self.outward else None
-            cut = patch_cut(
-                q[MAIN],
-                framed[MAIN],
+            out, cut = stitch_patch(
+                q,
+                framed,
                 ring=self.ring,
                 margin=self.margin,
                 seam=self.seam,
-                error=err,
-                bias=bias,
+                weights=self.weights,
+                outward=self.outward,
+                depth=self.depth,
                 cancel=cancel,
             )
-            check(cancel)
-            out = apply_cut(q, framed, cut.alpha)
             labels[cut.mask] = PATCH_LABEL
             paths["patch"] = np.asarray(cut.loop)
             scores.update(

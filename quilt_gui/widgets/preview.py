@@ -96,13 +96,20 @@ class PreviewView(QWidget):
         if not self.grid or self.doc.tileset.preview is None or lay is None or not picks:
             return
         th, tw = picks[0].tile.shape[:2]
-        rows, cols = lay.shape
-        pen = cosmetic_pen(QColor(255, 255, 255, 150), 1, Qt.PenStyle.DashLine)
-        lines = [QLineF(c * tw, 0, c * tw, rows * th) for c in range(1, cols)]
-        lines += [QLineF(0, r * th, cols * tw, r * th) for r in range(1, rows)]
-        for line in lines:
-            item = QGraphicsLineItem(line)
-            item.setPen(pen)
-            item.setZValue(10)
-            self.canvas.scene().addItem(item)
-            self._lines.append(item)
+        self._lines = grid_items(self.canvas, *lay.shape, th, tw)
+
+
+def grid_items(canvas, rows: int, cols: int, th: int, tw: int) -> list[QGraphicsLineItem]:
+    """Dashed lines along the tile borders of a rows x cols layout of th x tw tiles, added to
+    ``canvas``'s scene; returns them (to remove them later)."""
+    pen = cosmetic_pen(QColor(255, 255, 255, 150), 1, Qt.PenStyle.DashLine)
+    lines = [QLineF(c * tw, 0, c * tw, rows * th) for c in range(1, cols)]
+    lines += [QLineF(0, r * th, cols * tw, r * th) for r in range(1, rows)]
+    items = []
+    for line in lines:
+        item = QGraphicsLineItem(line)
+        item.setPen(pen)
+        item.setZValue(10)
+        canvas.scene().addItem(item)
+        items.append(item)
+    return items

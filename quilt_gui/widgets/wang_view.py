@@ -35,6 +35,7 @@ from PySide6.QtWidgets import (
 
 from engine.export.wang import PALETTE
 from quilt_gui.widgets.canvas import ImageCanvas, cosmetic_pen
+from quilt_gui.widgets.preview import grid_items
 
 __all__ = ["WangView"]
 
@@ -416,16 +417,7 @@ class WangView(QWidget):
         if not self.grid_box.isChecked() or w.layout is None or not w.complete:
             return
         T = w.tile_list()[0].tile.shape[0]
-        rows, cols = w.layout.shape
-        pen = cosmetic_pen(QColor(255, 255, 255, 150), 1, Qt.PenStyle.DashLine)
-        lines = [QLineF(c * T, 0, c * T, rows * T) for c in range(1, cols)]
-        lines += [QLineF(0, r * T, cols * T, r * T) for r in range(1, rows)]
-        for line in lines:
-            item = QGraphicsLineItem(line)
-            item.setPen(pen)
-            item.setZValue(10)
-            scene.addItem(item)
-            self._grid_items.append(item)
+        self._grid_items = grid_items(self.preview, *w.layout.shape, T, T)
 
     def _update_info(self) -> None:
         w = self.doc.wang
