@@ -766,29 +766,21 @@ def tileset_quality(tiles, source, *, template, ring: int, margin: int, rng=0) -
     }
 
 
+#: Per figure of :func:`tileset_quality`: what exceeding its limit means, in words.
+_ADVICE = {
+    "frame": "the tiles show a frame (frame {v:.2f} > {lim}): try Flatten lighting, a wider "
+    "patch search or a smaller patch ring",
+    "ring_tone": "the shared ring differs in tone from the patches (ring tone {v:.2f} > {lim}): "
+    "try Flatten lighting or another template position",
+    "duplicates": "{v} candidate(s) repeat the template or each other: use a larger source, "
+    "smaller tiles or fewer candidates",
+    "lattice": "a layout shows a lattice at the tile period ({v:+.1f} dB above the floor of a "
+    "shared border): structured textures may need smaller patch rings, larger tiles or a Wang "
+    "set",
+}
+
+
 def quality_warnings(q: dict) -> list[str]:
     """What :func:`tileset_quality`'s figures mean for a person, in words (empty: none of
     issue 10's limits is exceeded)."""
-    out = []
-    if q["frame"] > QUALITY_LIMITS["frame"]:
-        out.append(
-            f"the tiles show a frame (frame {q['frame']:.2f} > {QUALITY_LIMITS['frame']}): try "
-            "Flatten lighting, a wider patch search or a smaller patch ring"
-        )
-    if q["ring_tone"] > QUALITY_LIMITS["ring_tone"]:
-        out.append(
-            f"the shared ring differs in tone from the patches (ring tone {q['ring_tone']:.2f} > "
-            f"{QUALITY_LIMITS['ring_tone']}): try Flatten lighting or another template position"
-        )
-    if q["duplicates"] > QUALITY_LIMITS["duplicates"]:
-        out.append(
-            f"{q['duplicates']} candidate(s) repeat the template or each other: use a larger "
-            "source, smaller tiles or fewer candidates"
-        )
-    if q["lattice"] > QUALITY_LIMITS["lattice"]:
-        out.append(
-            f"a layout shows a lattice at the tile period ({q['lattice']:+.1f} dB above the floor "
-            "of a shared border): structured textures may need smaller patch rings, larger "
-            "tiles or a Wang set"
-        )
-    return out
+    return [_ADVICE[k].format(v=q[k], lim=lim) for k, lim in QUALITY_LIMITS.items() if q[k] > lim]

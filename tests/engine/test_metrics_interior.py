@@ -148,3 +148,17 @@ def test_validation(source):
         lattice(cs, source, template=cs[0], margin=1, grid=(3, 4))
     with pytest.raises(ValueError, match="no centre"):
         ring_tone(cs, source, width=16)
+
+
+def test_tileset_quality_and_its_warnings_in_words(source):
+    from engine.metrics import quality_warnings, tileset_quality
+
+    cs = crops(source, 30, 64, seed=1)
+    t = crops(source, 1, 64, seed=9)[0]
+    clean = tileset_quality(cs, source, template=t, ring=8, margin=1)
+    assert set(clean) >= {"frame", "ring_tone", "duplicates", "lattice", "template_share"}
+    assert quality_warnings(clean) == []
+    ring = edge_distance((64, 64)) == 5
+    framed = [np.where(ring[..., None], c * 0.5, c) for c in cs]
+    words = quality_warnings(tileset_quality(framed, source, template=t, ring=8, margin=1))
+    assert any(w.startswith("the tiles show a frame") for w in words)
