@@ -120,6 +120,15 @@ class ProjectFiles(QObject):
         path, _ = QFileDialog.getOpenFileName(self.parent(), caption, settings.get(key), filters)
         return path
 
+    def ask_library_path(self) -> str:
+        """A library folder made by ``quilt-studio batch`` ("" when cancelled)."""
+        path = QFileDialog.getExistingDirectory(
+            self.parent(), "Open library", settings.get("last_library_dir")
+        )
+        if path:
+            settings.set("last_library_dir", path)
+        return path
+
     def ask_save_path(self) -> str:
         start = self.doc.project_path or os.path.join(
             settings.get("last_project_dir"), self.doc.name + PROJECT_SUFFIX

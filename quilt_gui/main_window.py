@@ -36,6 +36,7 @@ from quilt_gui.widgets.candidate_dialog import CandidateDialog
 from quilt_gui.widgets.canvas import ImageCanvas
 from quilt_gui.widgets.gallery import CandidateView
 from quilt_gui.widgets.help import GettingStarted, ShortcutSheet
+from quilt_gui.widgets.library import LibraryView
 from quilt_gui.widgets.overlap_panel import OverlapPanel
 from quilt_gui.widgets.params_panel import QUILT_GROUPS, TILESET_GROUPS, ParamsPanel
 from quilt_gui.widgets.preview import PreviewView
@@ -131,6 +132,12 @@ class MainWindow(QMainWindow):
             self.files.open_dialog,
             K.Open,
             "Open a texture image or a .quiltproj project",
+        )
+        self.act_open_library = A(
+            "Open &library…",
+            self.open_library_dialog,
+            "Ctrl+Shift+L",
+            "Browse a library made by quilt-studio batch and curate its photos one by one",
         )
         self.act_attach = A(
             "Attach &material map…",
@@ -308,6 +315,7 @@ class MainWindow(QMainWindow):
             a.setChecked(n == self.tile_view.repeats)
             self.tile_view.repeat_buttons.button(n).setToolTip(a.toolTip())
         self.gallery = CandidateView(doc)
+        self.library_view = LibraryView()
         self.docks = {}
         for key, title, widget, area in (
             ("params", "Parameters", self.params_panel, Qt.DockWidgetArea.LeftDockWidgetArea),
@@ -319,12 +327,16 @@ class MainWindow(QMainWindow):
             ),
             ("tile", "Seamless tile", self.tile_view, Qt.DockWidgetArea.RightDockWidgetArea),
             ("gallery", "Candidates", self.gallery, Qt.DockWidgetArea.BottomDockWidgetArea),
+            ("library", "Library", self.library_view, Qt.DockWidgetArea.BottomDockWidgetArea),
         ):
             dock = QDockWidget(title, self)
             dock.setObjectName(f"dock_{key}")
             dock.setWidget(widget)
             self.addDockWidget(area, dock)
             self.docks[key] = dock
+        self.tabifyDockWidget(self.docks["gallery"], self.docks["library"])
+        self.docks["library"].hide()  # shown by File ▸ Open library…
+        self.docks["gallery"].raise_()
         # side docks run the full height; the gallery sits under the canvas only
         self.setCorner(Qt.Corner.BottomRightCorner, Qt.DockWidgetArea.RightDockWidgetArea)
         self.setCorner(Qt.Corner.BottomLeftCorner, Qt.DockWidgetArea.LeftDockWidgetArea)
@@ -342,6 +354,7 @@ class MainWindow(QMainWindow):
             a.triggered.connect(partial(self.files.open_sample, name))
         self.recent_menu = m.addMenu("Open &recent")
         self.recent_menu.aboutToShow.connect(self._fill_recent_menu)
+        m.addAction(self.act_open_library)
         m.addAction(self.act_attach)
         m.addSeparator()
         m.addActions([self.act_save, self.act_save_as, self.act_export])
@@ -424,6 +437,8 @@ class MainWindow(QMainWindow):
         self.tile_view.repeats_changed.connect(self._on_repeats_changed)
         self.params_panel.tile_size_edited.connect(self._on_tile_size_edited)
         self.tile_view.wrap_requested.connect(partial(self.tabs.setCurrentWidget, self.wrap_view))
+        self.library_view.open_project.connect(lambda path: self.files.open_path(path))
+        self.library_view.message.connect(self.show_message)
         for canvas in self.canvases():
             canvas.hovered.connect(partial(self._on_hover, canvas))
         self.source_view.set_heat_visible(self.act_heat.isChecked())
@@ -490,6 +505,18 @@ class MainWindow(QMainWindow):
             self.files.open_path(files[0])
 
     # ------------------------------------------------------------------ export
+    def open_library_dialog(self, *_args) -> None:
+        path = self.files.ask_library_path()
+        if path:
+            self.open_library(path)
+
+    def open_library(self, path: str):
+        """Show the library in ``path`` in the Library dock (read in the background)."""
+        dock = self.docks["library"]
+        dock.show()
+        dock.raise_()
+        return self.library_view.load(path)
+
     def export_dialog(self, *_args, wang: bool | None = None) -> None:
         """The export dialog of the tile set (``wang``: the Wang set; None: the Wang set when
         its tab is in front)."""

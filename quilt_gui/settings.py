@@ -23,6 +23,7 @@ DEFAULTS: dict[str, Any] = {
     "last_open_dir": "",
     "last_project_dir": "",
     "last_export_dir": "",
+    "last_library_dir": "",
     "window_geometry": QByteArray(),
     "window_state": QByteArray(),
     "autosave_seconds": 60,

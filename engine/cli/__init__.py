@@ -21,6 +21,7 @@ SUBCOMMANDS = {
     "transfer": "texture transfer: render TARGET with the texture of SAMPLE",
     "export": "export a project's picked tiles as a bundle (PNGs, atlases, manifest, Tiled, Godot)",
     "heal": "fill a masked region of an image from the rest of it (remove a leaf, a logo...)",
+    "batch": "make a tile set for every photo of a folder: a browsable, resumable library",
 }
 
 

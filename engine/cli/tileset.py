@@ -45,6 +45,7 @@ from engine.cli.tileset_output import (
     csv_text,
     load_inputs,
     map_weights,
+    source_name,
     write_images,
     write_set,
     write_text,
@@ -257,6 +258,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     )
     add_exclusion(p, "source")
     add_project_option(p)
+    p.add_argument("--source-name", default=None, help=argparse.SUPPRESS)  # see source_name()
     from engine.cli.tileset_wang import add_wang_options
 
     add_wang_options(p, _size)
@@ -479,7 +481,7 @@ def _run(args, settings: TilesetSettings, rect) -> int:
         manifest.update(
             settings=settings.to_dict(),
             source={
-                "path": str(args.source),
+                "path": source_name(args),
                 "width": W,
                 "height": H,
                 "channels": int(S.shape[2]),
@@ -613,7 +615,7 @@ def project_arguments(result, S, maps, depth, args, weights, excluded) -> dict:
         parameters={"tileset": s.to_dict()},
         project_seeds={"candidates": s.seed, "layout": s.layout_seed},
         bit_depth=depth,
-        source_paths={MAIN_MAP: str(args.source), **{k: p for k, p in args.map}},
+        source_paths={MAIN_MAP: source_name(args), **{k: p for k, p in args.map}},
         map_weights=map_weights(weights),
         preview=as_project_maps(result.preview["main"], extra_maps),
         extra=mask_to_json(excluded),

@@ -36,6 +36,12 @@ class Reporter:
         print(f"[{time.perf_counter() - self.t0:7.2f}s] {text}", file=sys.stderr, flush=True)
 
 
+def source_name(args) -> str:
+    """The source's path as the manifest and the project record it: SOURCE, or the hidden
+    ``--source-name`` when SOURCE is a temporary copy (``quilt-studio batch`` on a cluster)."""
+    return getattr(args, "source_name", None) or str(args.source)
+
+
 def inputs(args) -> list:
     return [args.source, *(p for _, p in args.map), args.exclude_mask]
 

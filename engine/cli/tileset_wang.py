@@ -134,6 +134,7 @@ def run_wang(args, settings, rect=None) -> int:
         Reporter,
         csv_text,
         load_inputs,
+        source_name,
         write_images,
         write_set,
         write_text,
@@ -201,7 +202,7 @@ def run_wang(args, settings, rect=None) -> int:
             "preview": {"file": preview["main"], "maps": preview},
             "warnings": list(result.warnings),
             "source": {
-                "path": str(args.source),
+                "path": source_name(args),
                 "width": int(S.shape[1]),
                 "height": int(S.shape[0]),
                 "channels": int(S.shape[2]),
@@ -225,7 +226,7 @@ def run_wang(args, settings, rect=None) -> int:
 
 def project_arguments(result, S, maps, depth, args, weights) -> dict:
     """The keyword arguments of :func:`engine.project.project_from_tileset` for a Wang set."""
-    from engine.cli.tileset_output import MAIN_MAP, map_weights
+    from engine.cli.tileset_output import MAIN_MAP, map_weights, source_name
 
     s, ws = result.settings, result.wang
     record = ws.record()
@@ -237,7 +238,7 @@ def project_arguments(result, S, maps, depth, args, weights) -> dict:
         parameters={"tileset": s.to_dict()},
         project_seeds={"wang": s.seed, "layout": s.layout_seed},
         bit_depth=depth,
-        source_paths={MAIN_MAP: str(args.source), **{k: p for k, p in args.map}},
+        source_paths={MAIN_MAP: source_name(args), **{k: p for k, p in args.map}},
         map_weights=map_weights(weights),
         wang=record,
         wang_tiles=[t.to_candidate() for t in ws.tiles],

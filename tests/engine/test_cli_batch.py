@@ -1,0 +1,184 @@
+"""``quilt-studio batch`` as a user runs it: worker processes, exit codes, resuming after
+``kill -9`` and Ctrl-C, and the same bytes on a Dask cluster."""
+
+from __future__ import annotations
+
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from engine.batch import find_photos
+from engine.batch.task import run_photo
+from engine.cli import main
+from tests.engine.batch_helpers import (
+    FAST,
+    SMALL,
+    photo_folders,
+    tile_bytes,
+    write_bad_photos,
+    write_photos,
+)
+
+SUMMARY = re.compile(r"(\d+) photos: (\d+) made now, (\d+) already done, (\d+) kept, (\d+) failed")
+
+
+def summary(err: str) -> tuple[int, ...]:
+    """(photos, made now, already done, kept, failed) from the batch's last summary line."""
+    return tuple(int(v) for v in SUMMARY.findall(err)[-1])
+
+
+def batch(*args, capsys=None) -> tuple[int, str]:
+    code = main(["batch", *map(str, args)])
+    err = capsys.readouterr().err if capsys is not None else ""
+    return code, err
+
+
+def cli(*args, **kwargs) -> subprocess.Popen:
+    return subprocess.Popen(
+        [
+            sys.executable,
+            "-c",
+            "import sys; from engine.cli import main; sys.exit(main())",
+            "batch",
+            *map(str, args),
+        ],
+        stderr=subprocess.PIPE,
+        text=True,
+        **kwargs,
+    )
+
+
+def wait_for_done(lib: Path, n: int, proc: subprocess.Popen, timeout: float = 120) -> None:
+    t0 = time.monotonic()
+    while time.monotonic() - t0 < timeout:
+        if lib.is_dir():
+            done = [
+                d
+                for d in lib.iterdir()
+                if not d.name.startswith(".") and (d / "manifest.json").is_file()
+            ]
+            if len(done) >= n:
+                return
+        assert proc.poll() is None, proc.stderr.read()
+        time.sleep(0.02)
+    pytest.fail(f"no {n} photo(s) finished in {timeout} s")
+
+
+def test_failures_are_listed_the_rest_done_exit_3_then_resume(tmp_path, capsys):
+    write_photos(tmp_path / "in")
+    write_bad_photos(tmp_path / "in")
+    lib = tmp_path / "lib"
+    code, err = batch(tmp_path / "in", "--out", lib, *FAST, "--jobs", "2", "-v", capsys=capsys)
+    assert code == 3, err
+    assert summary(err) == (5, 3, 0, 0, 2)
+    assert re.search(r"FAILED .*corrupt\.png: .*truncated or corrupt", err)
+    assert re.search(r"FAILED .*tiny\.png: too small", err)
+    assert len(re.findall(r"^done ", err, re.M)) == 3  # -v: one line per photo
+    assert len(photo_folders(lib)) == 5
+    assert (lib / "index.html").is_file() and (lib / "index.csv").is_file()
+    stamps = {d: (lib / d / "manifest.json").stat().st_mtime_ns for d in photo_folders(lib)}
+    code, err = batch(tmp_path / "in", "--out", lib, *FAST, capsys=capsys)
+    assert code == 3 and summary(err) == (5, 0, 3, 0, 2)  # only the failed ones tried again
+    done = [d for d, b in photo_folders(lib).items() if b["status"] == "done"]
+    assert all((lib / d / "manifest.json").stat().st_mtime_ns == stamps[d] for d in done)
+    code, err = batch(tmp_path / "in" / "brick.png", "--out", lib, *FAST, capsys=capsys)
+    assert code == 0 and summary(err) == (1, 0, 1, 0, 0)
+
+
+def test_bad_arguments_exit_2(tmp_path, capsys):
+    (p,) = write_photos(tmp_path / "in", names=("brick",))
+    lib = tmp_path / "lib"
+    assert batch(p, "--out", lib, "--tile-size", "32", "--tile-min", "16", capsys=capsys)[0] == 2
+    assert batch(tmp_path / "nothing*.png", "--out", lib, capsys=capsys)[0] == 2
+    assert batch(p, "--out", lib, "--scheduler", "localhost", capsys=capsys)[0] == 2
+    with pytest.raises(SystemExit) as exc:
+        batch(p, "--out", lib, "--jobs", "0")
+    assert exc.value.code == 2
+
+
+def temporaries(lib: Path) -> list[str]:
+    return [p.name for p in lib.iterdir() if p.name.startswith(".") and "tmp" in p.name]
+
+
+def test_kill_9_then_ctrl_c_each_rerun_finishes_only_the_rest(tmp_path, capsys):
+    write_photos(tmp_path / "in", names=("brick", "gravel", "lichen", "grass", "cobblestones"))
+    lib = tmp_path / "lib"
+    # 1. kill -9 halfway: complete folders or none, never a torn one
+    proc = cli(tmp_path / "in", "--out", lib, *FAST, "--jobs", "1")
+    wait_for_done(lib, 1, proc)
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    first = photo_folders(lib)  # raises on a torn folder
+    assert 1 <= len(first) < 4
+    stamps = {d: (lib / d / "manifest.json").stat().st_mtime_ns for d in first}
+    # 2. the re-run skips those, makes more, and is stopped by Ctrl-C (the process group's)
+    proc = cli(tmp_path / "in", "--out", lib, *FAST, "--jobs", "1", start_new_session=True)
+    wait_for_done(lib, len(first) + 1, proc)
+    os.killpg(proc.pid, signal.SIGINT)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130, err
+    assert "interrupted" in err
+    second = photo_folders(lib)
+    assert summary(err) == (5, len(second) - len(first), len(first), 0, 0)
+    assert len(second) < 5
+    assert temporaries(lib) == []  # the killed run's are cleaned, Ctrl-C leaves none
+    # 3. the last run finishes the rest only; nothing made before is touched
+    code, err = batch(tmp_path / "in", "--out", lib, *FAST, "--jobs", "1", capsys=capsys)
+    assert code == 0, err
+    assert summary(err) == (5, 5 - len(second), len(second), 0, 0)
+    assert len(photo_folders(lib)) == 5 and temporaries(lib) == []
+    assert all((lib / d / "manifest.json").stat().st_mtime_ns == stamps[d] for d in first)
+
+
+def test_dask_is_imported_only_with_a_scheduler():
+    code = (
+        "import sys, engine.cli.batch, engine.batch, engine.batch.pool, engine.batch.task, "
+        "engine.batch.index; from engine.cli import build_parser; "
+        "build_parser(command='batch').parse_args(['batch', 'x', '--out', 'y']); "
+        "print(sorted(m for m in sys.modules if m.split('.')[0] in ('dask', 'distributed')))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "[]"
+
+
+def test_dask_cluster_makes_byte_identical_tiles(tmp_path, capsys):
+    distributed = pytest.importorskip("distributed")
+    write_photos(tmp_path / "in", names=("brick", "gravel"))
+    corrupt, tiny = write_bad_photos(tmp_path / "in")
+    tiny.unlink()
+    local, remote = tmp_path / "local", tmp_path / "dask"
+    local.mkdir()
+    for ph in find_photos([str(tmp_path / "in")])[0]:
+        run_photo(ph, SMALL, local, threads=2)  # the local pool's task, in this process
+    with distributed.LocalCluster(
+        n_workers=2,
+        threads_per_worker=1,
+        processes=True,
+        host="127.0.0.1",
+        dashboard_address=None,
+    ) as cluster:
+        code, err = batch(
+            tmp_path / "in",
+            "--out",
+            remote,
+            *FAST,
+            "--scheduler",
+            cluster.scheduler_address,
+            capsys=capsys,
+        )
+    assert code == 3, err
+    assert summary(err) == (3, 2, 0, 0, 1)
+    a, b = tile_bytes(local), tile_bytes(remote)
+    assert len(a) == 2 * (1 + 3 + 1 + 1 + 1)  # template, 3 tiles, preview, thumbnail, project
+    assert a.keys() == b.keys()
+    assert [k for k in a if a[k] != b[k]] == []
+    assert {k: v["status"] for k, v in photo_folders(local).items()} == {
+        k: v["status"] for k, v in photo_folders(remote).items()
+    }
