@@ -195,7 +195,17 @@ def _process_gone(pid: int) -> bool:
         return True
     except (PermissionError, OverflowError):  # someone else's live process / not a pid
         return False
-    return False
+    return _zombie(pid)
+
+
+def _zombie(pid: int) -> bool:
+    """True when ``pid`` has exited but is not yet reaped (Linux; False elsewhere): a worker
+    killed with its parent stays a zombie until init collects it."""
+    try:
+        with open(f"/proc/{pid}/stat", "rb") as f:
+            return f.read().rsplit(b")", 1)[1].split()[0] == b"Z"
+    except (OSError, IndexError):
+        return False
 
 
 def _is_stale(path: Path, pid: int) -> bool:
