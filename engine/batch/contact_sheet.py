@@ -11,7 +11,7 @@ from html import escape
 from urllib.parse import quote
 
 from engine.batch.library import COLUMNS
-from engine.batch.quality import LIMITS
+from engine.batch.quality import past_limit
 
 _CSS = """
 body{font:14px/1.35 system-ui,sans-serif;margin:16px;background:#fafafa;color:#222}
@@ -58,13 +58,6 @@ def _href(key: str, name: str) -> str:
     return escape(f"{quote(key)}/{quote(name)}")
 
 
-def _past_limit(key: str, v) -> bool:
-    lim = LIMITS.get(key)
-    if lim is None or v is None:
-        return False
-    return v > lim[0] if lim[1] == "max" else v < lim[0]
-
-
 def _row(e) -> str:
     cls = ' class="failed"' if e.failed else ""
     cells = []
@@ -96,7 +89,7 @@ def _row(e) -> str:
         text = escape(e.text(key))
         sort_v = escape(str(v)) if v is not None else ""
         klass = "num" if fmt else ""
-        if _past_limit(key, v):
+        if past_limit(key, v):
             klass += " bad"
         if key == "status":
             text = f'<span class="{"err" if e.failed else "ok"}">{text}</span>'

@@ -28,7 +28,7 @@ COLUMNS = (
     ("ring_tone", "Ring tone", "{:.2f}"),
     ("lattice", "Lattice dB", "{:+.1f}"),
     ("duplicates", "Duplicates", "{:d}"),
-    ("share", "Template share", "{:.0%}"),
+    ("template_share", "Template share", "{:.0%}"),
     ("seconds", "Time s", "{:.1f}"),
 )
 

@@ -1,56 +1,50 @@
-"""The quality figures of one photo's tile set, and the warnings they raise in the index.
+"""The quality figures of one photo's set as the index shows them.
 
-Joint figures (wrap border ratio and detail ratio of the seamless tile) and the interior ones
-of issue 10 (frame, ring tone, duplicates, lattice above its floor, template share), with
-issue 10's acceptance limits: a figure past its limit becomes a warning in words.
+A Somol-Haindl set's figures are the ``tileset`` command's own (``manifest["quality"]``:
+:func:`engine.metrics.tileset_quality`, with its warnings in the manifest). The ``tileset
+--wang`` command measures nothing, so a Wang set's figures are taken here with the same metrics,
+adapted to tiles that each carry their own border.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-#: figure -> (limit, "max" or "min", what a person sees when it is past the limit)
+from engine.metrics import QUALITY_LIMITS
+
+#: figure -> (limit, "max" or "min"): issue 10's interior limits and issue 3's wrap and detail
+#: targets; the contact sheet marks the figures past them
 LIMITS = {
-    "wrap": (1.15, "max", "the seamless tile's joint shows (wrap border ratio {v:.2f})"),
-    "detail": (0.95, "min", "the tile is blurrier than the photo (detail ratio {v:.2f})"),
-    "frame": (1.15, "max", "the tiles show a frame along their edges (frame {v:.2f})"),
-    "ring_tone": (1.3, "max", "the tiles' border differs in tone (ring tone {v:.2f})"),
-    "duplicates": (0, "max", "{v:.0f} candidate(s) repeat the template or each other"),
-    "lattice": (1.5, "max", "a layout shows a lattice ({v:+.1f} dB above its floor)"),
+    **{k: (v, "max") for k, v in QUALITY_LIMITS.items()},
+    "wrap": (1.15, "max"),
+    "detail": (0.95, "min"),
 }
 
-
-def measure(source, template, tiles, *, patch_overlap: int, margin: int) -> dict:
-    """Every figure of :data:`LIMITS` plus ``share`` (mean template share) and ``tiles``."""
-    from engine.metrics import (
-        detail_ratio,
-        duplicates,
-        frame,
-        lattice,
-        ring_tone,
-        template_share,
-        wrap_border_ratio,
-    )
-
-    out = {
-        "tiles": len(tiles),
-        "wrap": wrap_border_ratio(template),
-        "detail": detail_ratio(template, source),
-    }
-    if tiles:
-        out["frame"] = frame(tiles, source, limit=2 * patch_overlap).value
-        out["ring_tone"] = ring_tone(tiles, source, width=patch_overlap)
-        out["duplicates"] = duplicates(tiles, template).count
-        out["lattice"] = lattice(tiles, source, template=template, margin=margin).above
-        out["share"] = float(np.mean(template_share(tiles, template)))
-    return {k: (v if isinstance(v, int) else round(float(v), 4)) for k, v in out.items()}
+#: the figures an index row shows (``manifest["quality"]`` has a few more)
+FIGURES = ("wrap", "detail", "frame", "ring_tone", "duplicates", "lattice", "template_share")
 
 
-def measure_wang(source, tiles, *, band: int, margin: int, layout) -> dict:
+def past_limit(name: str, value) -> bool:
+    """True when ``value`` of figure ``name`` is past its :data:`LIMITS` entry."""
+    lim = LIMITS.get(name)
+    if lim is None or value is None:
+        return False
+    return value > lim[0] if lim[1] == "max" else value < lim[0]
+
+
+def somol_figures(manifest: dict) -> dict:
+    """The index's figures of a Somol-Haindl set from its manifest."""
+    q = manifest.get("quality") or {}
+    out = {"tiles": len(manifest["tiles"])}
+    out.update({k: q[k] for k in FIGURES if q.get(k) is not None})
+    return _rounded(out)
+
+
+def wang_figures(source, tiles, *, band: int, margin: int, layout) -> dict:
     """The figures of a Wang set (no template: every tile carries its own border): frame and
-    ring tone within the edge band (tiles reflected, not wrapped: a Wang tile is not
-    seamless with itself), duplicates among the tiles, lattice in the preview's valid
-    ``layout`` against crops carrying each tile's own margin, and the median detail ratio."""
+    ring tone within the edge band (tiles reflected, not wrapped: a Wang tile is not seamless
+    with itself), duplicates among the tiles, lattice in the preview's valid ``layout``
+    against crops carrying each tile's own margin, and the median detail ratio."""
     from engine.metrics import detail_ratio, duplicates, frame, lattice, ring_tone
 
     out = {
@@ -61,16 +55,8 @@ def measure_wang(source, tiles, *, band: int, margin: int, layout) -> dict:
         "duplicates": duplicates(tiles).count,
         "lattice": lattice(tiles, source, margin=margin, layouts=[np.asarray(layout)]).above,
     }
-    return {k: (v if isinstance(v, int) else round(float(v), 4)) for k, v in out.items()}
+    return _rounded(out)
 
 
-def metric_warnings(metrics: dict) -> list[str]:
-    """The figures of ``metrics`` past their :data:`LIMITS`, in words."""
-    out = []
-    for name, (limit, kind, text) in LIMITS.items():
-        v = metrics.get(name)
-        if v is None:
-            continue
-        if (kind == "max" and v > limit) or (kind == "min" and v < limit):
-            out.append(text.format(v=v))
-    return out
+def _rounded(d: dict) -> dict:
+    return {k: (v if isinstance(v, int) else round(float(v), 4)) for k, v in d.items()}

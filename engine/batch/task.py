@@ -75,22 +75,25 @@ def _make_tileset(src: Path, folder: Path, photo: Photo, settings, threads: int)
     return [line[len(tag) :] for line in err.getvalue().splitlines() if line.startswith(tag)]
 
 
-def _figures(folder: Path, manifest: dict, source) -> dict:
-    """The quality figures of the set a manifest describes (tiles read back from ``folder``)."""
-    from engine.batch.quality import measure, measure_wang
+def _figures(folder: Path, manifest: dict, source) -> tuple[dict, list[str]]:
+    """The quality figures of the set a manifest describes and the warnings they raise."""
+    from engine.batch.quality import somol_figures, wang_figures
+
+    if manifest.get("kind") != "wang":  # measured by the tileset command, warnings included
+        return somol_figures(manifest), []
     from engine.io import load_image
+    from engine.metrics import quality_warnings
 
     tiles = [load_image(folder / t["file"]).pixels for t in manifest["tiles"]]
-    resolved = manifest["resolved"]
-    if manifest.get("kind") == "wang":
-        cells = json.loads((folder / manifest["layout"]["json"]).read_text())["cells"]
-        return measure_wang(
-            source, tiles, band=manifest["wang"]["band"], margin=resolved["margin"], layout=cells
-        )
-    template = load_image(folder / manifest["template"]["file"]).pixels
-    return measure(
-        source, template, tiles, patch_overlap=resolved["patch_overlap"], margin=resolved["margin"]
+    cells = json.loads((folder / manifest["layout"]["json"]).read_text())["cells"]
+    figures = wang_figures(
+        source,
+        tiles,
+        band=manifest["wang"]["band"],
+        margin=manifest["resolved"]["margin"],
+        layout=cells,
     )
+    return figures, quality_warnings(figures)
 
 
 # ---------------------------------------------------------------- one folder
@@ -159,11 +162,9 @@ def fill_folder(
         engine_warnings = _make_tileset(src, folder, photo, settings.for_photo(seed), threads)
     mpath = folder / MANIFEST
     manifest = json.loads(mpath.read_text(encoding="utf-8"))
-    from engine.batch.quality import metric_warnings
-
-    metrics = _figures(folder, manifest, source)
+    metrics, figure_warnings = _figures(folder, manifest, source)
     warnings = list(
-        dict.fromkeys([*manifest.get("warnings", []), *engine_warnings, *metric_warnings(metrics)])
+        dict.fromkeys([*manifest.get("warnings", []), *engine_warnings, *figure_warnings])
     )
     _thumbnail(folder / manifest["preview"]["file"], folder / THUMBNAIL, settings.thumbnail)
     record = PhotoRecord(

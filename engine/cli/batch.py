@@ -65,6 +65,12 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "template and candidates; --tile-size N sets its square tiles",
     )
     p.add_argument(
+        "--flatten",
+        action="store_true",
+        help="flatten each photo's lighting before the template search (the low-frequency "
+        "illumination removed, as the tileset command's --flatten)",
+    )
+    p.add_argument(
         "--settings",
         metavar="FILE",
         default=None,
@@ -119,14 +125,18 @@ def _settings(args, fail):
             ("candidates", args.candidates),
             ("wang", args.wang),
             ("seed", args.seed),
+            ("flatten", True if args.flatten else None),
         )
         if v is not None
     }
     try:
         base = read_settings(args.settings) if args.settings else TilesetSettings()
-        return BatchSettings(base.replace(**changes))
+        settings = base.replace(**changes)
     except (TypeError, ValueError) as exc:
         fail(str(exc))
+    if settings.wang is not None and settings.flatten:
+        fail("--flatten is not available for Wang sets (the Wang workflow does not flatten)")
+    return BatchSettings(settings)
 
 
 class _Usage(Exception):

@@ -134,6 +134,17 @@ def test_a_wang_set_per_photo(tmp_path):
     assert doc["kind"] == "wang" and len(doc["tiles"]) == 16
 
 
+def test_flatten_lighting_is_a_setting_of_the_folder(tmp_path):
+    (p,) = write_photos(tmp_path / "in", names=("lichen",))
+    (ph,) = find_photos([str(p)])[0]
+    flat = small(flatten=True)
+    assert flat.digest() != SMALL.digest()
+    assert run_photo(ph, flat, tmp_path / "lib").status == "done"
+    doc = json.loads((tmp_path / "lib" / ph.key / "manifest.json").read_text())
+    assert doc["resolved"]["flatten"] is True
+    assert doc["batch"]["settings_hash"] == flat.digest()
+
+
 def test_index_csv_and_html_sorted_failed_and_warned_first(made):
     _, lib, _, _, _ = made
     entries = read_library(lib)

@@ -97,6 +97,8 @@ def test_bad_arguments_exit_2(tmp_path, capsys):
     assert batch(p, "--out", lib, "--tile-size", "32", "--tile-min", "16", capsys=capsys)[0] == 2
     assert batch(tmp_path / "nothing*.png", "--out", lib, capsys=capsys)[0] == 2
     assert batch(p, "--out", lib, "--scheduler", "localhost", capsys=capsys)[0] == 2
+    assert batch(p, "--out", lib, "--wang", "2", "--flatten", capsys=capsys)[0] == 2
+    assert batch(p, "--out", lib, "--settings", tmp_path / "none.json", capsys=capsys)[0] == 2
     with pytest.raises(SystemExit) as exc:
         batch(p, "--out", lib, "--jobs", "0")
     assert exc.value.code == 2
