@@ -44,7 +44,7 @@ def _die_with_parent(parent: int) -> None:
     except (OSError, AttributeError):
         return
     if os.getppid() != parent:  # the parent died before the request took effect
-        os._exit(1)
+        raise SystemExit(1)
 
 
 def _interrupt_once(signum, frame):
