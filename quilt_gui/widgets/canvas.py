@@ -54,12 +54,22 @@ def cosmetic_pen(color, width: float = 1.0, style=Qt.PenStyle.SolidLine) -> QPen
 
 
 def pixel_path(points, offset=(0, 0)) -> QPainterPath:
-    """The union of unit squares of ``points`` (row, col), shifted by ``offset`` (x, y)."""
+    """The union of unit squares of ``points`` (row, col), shifted by ``offset`` (x, y).
+
+    Each run of horizontally adjacent pixels is one rectangle (a control-point seam's row is
+    one run): fewer shapes to build and paint while seams stream in."""
     path = QPainterPath()
-    pts = np.asarray(points, dtype=np.int64).reshape(-1, 2)
+    pts = np.unique(np.asarray(points, dtype=np.int64).reshape(-1, 2), axis=0)  # row-major
+    if not len(pts):
+        return path
+    r, c = pts[:, 0], pts[:, 1]
+    start = np.ones(len(pts), dtype=bool)
+    start[1:] = (r[1:] != r[:-1]) | (c[1:] != c[:-1] + 1)
+    first = np.flatnonzero(start)
+    length = np.diff(np.append(first, len(pts)))
     ox, oy = offset
-    for r, c in pts:
-        path.addRect(QRectF(float(c + ox), float(r + oy), 1.0, 1.0))
+    for k, n in zip(first.tolist(), length.tolist(), strict=True):
+        path.addRect(QRectF(float(c[k] + ox), float(r[k] + oy), float(n), 1.0))
     return path
 
 
