@@ -45,6 +45,7 @@ from quilt_gui.widgets.source_view import SourceView
 from quilt_gui.widgets.status import JobStatus, MessageBar
 from quilt_gui.widgets.tile_view import REPEATS, TileView
 from quilt_gui.widgets.wang_view import WangView
+from quilt_gui.widgets.watch_search import describe_seam
 from quilt_gui.widgets.wrap_view import WrapView
 from resources import SAMPLE_NAMES
 
@@ -402,7 +403,8 @@ class MainWindow(QMainWindow):
         self.criterion_label = QLabel()
         self.criterion_label.setToolTip(
             "Seam criterion (sum of the error along the seam) of "
-            "the left/right (H) and top/bottom (V) overlaps"
+            "the left/right (H) and top/bottom (V) overlaps, and the method and variant "
+            "that made the seams"
         )
         self.job_status = JobStatus(self.jobs)
         sb.addPermanentWidget(self.pixel_label)
@@ -418,6 +420,7 @@ class MainWindow(QMainWindow):
         self.files.message.connect(self.show_message)
         self.files.image_opened.connect(self._on_image_opened)
         self.pipeline.seam_updated.connect(self._on_seam_updated)
+        self.overlap_panel.watch.state_changed.connect(self._show_criteria)
         doc.modified_changed.connect(self._update_title)
         doc.path_changed.connect(self._update_title)
         doc.source_changed.connect(self._update_title)
@@ -677,7 +680,10 @@ class MainWindow(QMainWindow):
             self.criterion_label.setText(text)
             return
         parts = [f"{k[0].upper()} {v:.3f}" for k, v in sorted(self._criteria.items())]
-        self.criterion_label.setText("seam " + " · ".join(parts) if parts else "")
+        s = self.doc.tileset.seamless
+        made = self.overlap_panel.watch.variant_text() or (s and describe_seam(s.seam))
+        text = "seam " + " · ".join(parts) if parts else ""
+        self.criterion_label.setText(f"{text} — {made}" if parts and made else text)
 
     @Slot()
     def _update_title(self, *_args) -> None:

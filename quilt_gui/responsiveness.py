@@ -133,16 +133,40 @@ def recompute_latency(window, method: str, repeats: int = 3) -> float:
     return float(np.median(times))
 
 
-def measure_all(window, *, repeats: int = 3, heavy: bool = False) -> dict[str, dict]:
+def measure_watch(window, improvements: int = 240) -> dict:
+    """Gap statistics while *Watch the search* draws its first ``improvements`` at its own pace
+    (about 8 s at 30 a second), then skips to the end and goes back to the default seams.
+    Adds ``drawn`` and ``rate`` (drawn improvements per second)."""
+    watch = window.overlap_panel.watch
+    meter = GapMeter()
+    meter.start()
+    watch.start()
+    wait_until(lambda: watch.drawn >= improvements or watch.state == "finished", 120)
+    gaps = meter.stop()
+    out = gap_stats(gaps)
+    out.update(drawn=watch.drawn, rate=watch.drawn / max(out["seconds"], 1e-9))
+    watch.skip()
+    wait_until(lambda: watch.state == "finished", 60)
+    watch.back()
+    wait_until(lambda: not window.pipeline.busy())
+    return out
+
+
+def measure_all(
+    window, *, repeats: int = 3, heavy: bool = False, watch: bool = False
+) -> dict[str, dict]:
     """The figures of the benchmark table (the window must have the sample open).
 
     ``heavy`` adds runs of several seconds (300 candidates; a 1536x1536 quilt), so the
-    percentiles rest on thousands of ticks rather than a few dozen."""
+    percentiles rest on thousands of ticks rather than a few dozen; ``watch`` the animation of
+    *Watch the search* (:func:`measure_watch`, about 8 s)."""
     doc = window.doc
     window.pipeline.find_template()
     wait_until(lambda: not window.pipeline.busy())
     rows = {f"{doc.params['n_candidates']} candidates": measure_candidates(window, repeats)}
     rows["quilting (best match)"] = measure_quilting(window)
+    if watch:
+        rows["watch the search (paced)"] = measure_watch(window)
     if heavy:
         n, size = doc.params["n_candidates"], (doc.params["out_width"], doc.params["out_height"])
         doc.set_param("n_candidates", 300)

@@ -27,6 +27,7 @@ from quilt_gui.widgets.source_view import (
     WaypointItem,
     nearest_waypoint,
 )
+from quilt_gui.widgets.watch_search import WatchSearch
 
 GAP = 3  # pixels between the three panels
 #: The two regions of each overlap, in panel order (R1 kept on the outside, then R2).
@@ -170,6 +171,8 @@ class OverlapPanel(QWidget):
         split.setStretchFactor(0, 3)  # the left/right overlap is tall and narrow
         split.setStretchFactor(1, 2)
         lay.addWidget(split, 1)
+        self.watch = WatchSearch(doc, pipeline)
+        lay.addWidget(self.watch)
         row = QHBoxLayout()
         self.clear_button = QPushButton("Clear waypoints")
         self.clear_button.setToolTip("Remove every waypoint of both seams")
