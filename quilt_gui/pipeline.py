@@ -25,7 +25,10 @@ from quilt_gui.jobs import error_text
 
 log = logging.getLogger(__name__)
 
-__all__ = ["Pipeline"]
+__all__ = ["SWEEP_SAMPLES", "Pipeline"]
+
+#: rectangles the template search streams per chunk of widths (drawn as its sweep)
+SWEEP_SAMPLES = 24
 
 
 def _soon(parent: QObject, slot) -> QTimer:
@@ -43,6 +46,7 @@ class Pipeline(QObject):
     message = Signal(str, str)  # level ("info" | "warning" | "error"), text
     seam_updated = Signal(object)  # engine.tiles.seamless.SeamlessUpdate, live
     template_searching = Signal(bool)
+    template_swept = Signal(object)  # engine.tiles.TemplateSweep: rectangles being scored
     candidate_failed = Signal(int)  # a re-roll / patch move of this candidate failed
 
     def __init__(self, doc: Document, manager: jobs.JobManager | None = None, parent=None) -> None:
@@ -70,6 +74,7 @@ class Pipeline(QObject):
         self._gen_wanted, self._gen_next = 0, 0  # candidates asked for / shown in index order
         self._gen_waiting: dict[int, CandidateTile] = {}  # finished before their turn
         self._quilt_mode = "quilt"  # what a parameter change restarts: "quilt" or "transfer"
+        self.sweep_samples = SWEEP_SAMPLES  # 0: the template search streams no sweep
 
     # ------------------------------------------------------------------ helpers
     def _error(self, exc: BaseException) -> None:
@@ -154,6 +159,7 @@ class Pipeline(QObject):
             tile_max=hi,
             overlap=s.overlap or doc.tileset.overlap(),
             joint_weight=s.joint_weight,
+            sweep=self.sweep_samples,
             on_event=self._on_template_event,
             on_done=self._on_template_done,
             on_error=self._on_template_error,
@@ -161,10 +167,12 @@ class Pipeline(QObject):
         )
 
     def _on_template_event(self, event) -> None:
-        from engine.tiles.template import TemplateUpdate
+        from engine.tiles.template import TemplateSweep, TemplateUpdate
 
         if isinstance(event, TemplateUpdate):
             self.doc.tileset.apply_template_rect(event.rect)
+        elif isinstance(event, TemplateSweep):
+            self.template_swept.emit(event)
 
     def _on_template_done(self, template) -> None:
         self.doc.tileset.apply_template_rect(template.rect)

@@ -27,6 +27,7 @@ from quilt_gui.widgets.canvas import (
 )
 from quilt_gui.widgets.exclusion import ExclusionPainter
 from quilt_gui.widgets.rect_item import EditableRect
+from quilt_gui.widgets.template_sweep import SweepItem
 
 REGION_COLORS = {"R_L": "#3fc1ff", "R_R": "#3fc1ff", "R_T": "#ff5fd2", "R_B": "#ff5fd2"}
 # both stand out on the heat map (black, purple, red, orange, pale yellow)
@@ -90,6 +91,8 @@ class SourceView(ImageCanvas):
         self.patch_item.hide()
         self.add_item(self.patch_item)
         self.patch_index: int | None = None
+        self.sweep = SweepItem()  # the template search's sweep while it runs
+        self.add_item(self.sweep)
         self.painter = ExclusionPainter(doc, self)  # excluded pixels: Shift+drag, Ctrl+Shift+click
         self._waypoint_items: list[WaypointItem] = []
         self.heat_visible = True
@@ -110,6 +113,7 @@ class SourceView(ImageCanvas):
         pipeline.seam_updated.connect(self._on_seam_updated)
         pipeline.candidate_failed.connect(self._on_candidate_changed)  # the patch snaps back
         pipeline.template_searching.connect(self._on_searching)
+        pipeline.template_swept.connect(self.sweep.add_event)
 
     # ------------------------------------------------------------------ document -> view
     @Slot()
@@ -129,8 +133,10 @@ class SourceView(ImageCanvas):
 
     @Slot(bool)
     def _on_searching(self, searching: bool) -> None:
-        """The rectangle animates while the search runs; it is not draggable meanwhile."""
+        """The rectangle animates while the search runs, its sweep drawn faintly; it is not
+        draggable meanwhile."""
         self.rect_item.setEnabled(not searching)
+        (self.sweep.start if searching else self.sweep.stop)()
 
     @Slot(object)
     def _on_zoom(self, zoom: float) -> None:

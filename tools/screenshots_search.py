@@ -1,0 +1,82 @@
+"""Screenshots of the searches on screen: docs/watch_search.png and docs/template_sweep.png.
+
+    xvfb-run -a -s "-screen 0 1600x1000x24" python tools/screenshots_search.py
+
+``watch_search.png``: *Watch the search* on the bundled sample's tile, mid-way (the paper's
+oscillating search drawing its improvements, the criterion falling in the chart).
+``template_sweep.png``: *Find best tile* with a tile size range, caught during its first
+horizontal phase: the rectangles scored so far drawn faintly, the best so far highlighted.
+"""
+
+from __future__ import annotations
+
+import sys
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+
+def main() -> int:
+    from PySide6.QtCore import QSettings
+
+    from quilt_gui.app import make_app
+
+    app = make_app(theme="dark")
+    QSettings.setDefaultFormat(QSettings.Format.IniFormat)
+    QSettings.setPath(
+        QSettings.Format.IniFormat, QSettings.Scope.UserScope, tempfile.mkdtemp(prefix="qs_")
+    )
+    from quilt_gui import params
+    from quilt_gui.main_window import MainWindow
+    from quilt_gui.responsiveness import wait_until
+
+    out = ROOT / "docs"
+    w = MainWindow()
+    w.files.ask_save_changes = lambda: "discard"
+    w.resize(1600, 1000)
+    w.show()
+    w.open_initial(None)
+    idle = lambda: w.doc.has_source and not w.pipeline.busy()  # noqa: E731
+    wait_until(idle)
+    doc = w.doc
+
+    # -- the template sweep, caught in its first horizontal phase
+    doc.set_params({"tile_size": params.ANY, "tile_min": 96, "tile_max": 256})
+    wait_until(idle)
+    sweep = w.source_view.sweep
+    caught = []
+
+    def catch(event) -> None:
+        if not caught and event.round == 0 and event.phase == "horizontal" and sweep.events > 12:
+            sweep._rebuild()
+            app.processEvents()
+            w.grab().save(str(out / "template_sweep.png"))
+            caught.append(event)
+
+    w.pipeline.template_swept.connect(catch)
+    w.message_bar.dismiss()
+    w.source_view.fit()
+    w.act_find.trigger()
+    wait_until(idle)
+    w.pipeline.template_swept.disconnect(catch)
+    print("wrote" if caught else "MISSED", out / "template_sweep.png")
+
+    # -- watch the search, mid-way
+    watch = w.overlap_panel.watch
+    watch.start()
+    wait_until(lambda: watch.drawn >= 150 or watch.state == "finished", 120)
+    w.message_bar.dismiss()
+    app.processEvents()
+    w.grab().save(str(out / "watch_search.png"))
+    print("wrote", out / "watch_search.png", f"({watch.drawn} improvements drawn)")
+    watch.back()
+    wait_until(idle)
+    w.close()
+    app.processEvents()
+    return 0 if caught else 1
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
