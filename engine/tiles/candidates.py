@@ -370,7 +370,8 @@ class _Setup:
         origins: list[tuple[int, int]] = []
         # content already used: the template's window and every chosen patch (luminance);
         # a window this close to one of them would make a duplicate candidate
-        seen = [self._luminance(self.U[MAIN])] + [self._window(o) for o in avoid]
+        step = self._stride
+        seen = [self._luminance(self.U[MAIN][::step, ::step])] + [self._window(o) for o in avoid]
         same = 0
         if allowed.any():
             limit = max(float(e[allowed].min()), zero) * (1 + self.quality)
@@ -417,9 +418,15 @@ class _Setup:
 
         return luminance(window).astype(np.float32)
 
+    @property
+    def _stride(self) -> int:
+        """Every k-th pixel of a window is enough to compare contents (~128 per side)."""
+        return max(1, min(self.ph, self.pw) // 128)
+
     def _window(self, origin) -> np.ndarray:
         y, x = origin
-        return self._luminance(self.S[y : y + self.ph, x : x + self.pw])
+        k = self._stride
+        return self._luminance(self.S[y : y + self.ph : k, x : x + self.pw : k])
 
     def random_origin(self, gen: np.random.Generator) -> tuple[int, int]:
         H, W = self.S.shape[:2]
