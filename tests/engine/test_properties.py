@@ -15,7 +15,7 @@ from engine.metrics import border_ratio, grid_border_ratio
 from engine.seams import SeamSpec, find_seam
 from engine.tiles import assemble, random_layout
 
-FAST = settings(max_examples=40, deadline=None)  # numba kernels: no per-example deadline
+FAST = settings(max_examples=40)  # the examples are the same on every run (tests/conftest.py)
 
 error_maps = st.tuples(st.integers(2, 12), st.integers(2, 9)).flatmap(
     lambda shape: arrays(np.float64, shape, elements=st.floats(0, 1, width=32))
@@ -53,7 +53,6 @@ def test_the_optima_are_ordered_as_their_path_models(e):
     dp = find_seam(e, method="dp")
     assert find_seam(e, method="dijkstra").criterion <= dp.criterion + 1e-9
     assert find_seam(e, method="minimax").peak <= dp.peak + 1e-9
-    assert find_seam(e, method="oscillating-optimal").criterion >= dp.criterion - 1e-9
 
 
 @FAST
