@@ -20,7 +20,9 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 
-def main() -> int:
+def open_editor():
+    """(app, window, idle) with the bundled sample open in a 1600x1000 dark window, settings
+    in a temporary folder; ``idle()`` is true once no job runs (also tools/screenshots_search)."""
     from PySide6.QtCore import QSettings
 
     from quilt_gui.app import make_app
@@ -35,8 +37,6 @@ def main() -> int:
     from quilt_gui.main_window import MainWindow
     from quilt_gui.responsiveness import wait_until
 
-    out = ROOT / "docs"
-    out.mkdir(exist_ok=True)
     w = MainWindow()
     w.files.ask_save_changes = lambda: "discard"
     w.resize(1600, 1000)
@@ -44,6 +44,15 @@ def main() -> int:
     w.open_initial(None)
     idle = lambda: w.doc.has_source and not w.pipeline.busy()  # noqa: E731
     wait_until(idle)
+    return app, w, idle
+
+
+def main() -> int:
+    from quilt_gui.responsiveness import wait_until
+
+    app, w, idle = open_editor()
+    out = ROOT / "docs"
+    out.mkdir(exist_ok=True)
     doc = w.doc
 
     def shot(widget, name: str) -> None:

@@ -11,35 +11,20 @@ horizontal phase: the rectangles scored so far drawn faintly, the best so far hi
 from __future__ import annotations
 
 import sys
-import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
+sys.path[:0] = [str(ROOT), str(ROOT / "tools")]
 
 
 def main() -> int:
-    from PySide6.QtCore import QSettings
+    from screenshots import open_editor
 
-    from quilt_gui.app import make_app
-
-    app = make_app(theme="dark")
-    QSettings.setDefaultFormat(QSettings.Format.IniFormat)
-    QSettings.setPath(
-        QSettings.Format.IniFormat, QSettings.Scope.UserScope, tempfile.mkdtemp(prefix="qs_")
-    )
     from quilt_gui import params
-    from quilt_gui.main_window import MainWindow
     from quilt_gui.responsiveness import wait_until
 
+    app, w, idle = open_editor()
     out = ROOT / "docs"
-    w = MainWindow()
-    w.files.ask_save_changes = lambda: "discard"
-    w.resize(1600, 1000)
-    w.show()
-    w.open_initial(None)
-    idle = lambda: w.doc.has_source and not w.pipeline.busy()  # noqa: E731
-    wait_until(idle)
     doc = w.doc
 
     # -- the template sweep, caught in its first horizontal phase

@@ -83,6 +83,7 @@ _DC = np.array([0, -1, 1, -1, 1], dtype=np.int64)
 # the rows: left, bottom-left, bottom, bottom-right, right)
 _PR = np.array([0, -1, -1, -1, 0], dtype=np.int64)
 _PC = np.array([-1, -1, 0, 1, 1], dtype=np.int64)
+_PR2 = -_PR
 
 
 @njit(cache=True, nogil=True)
@@ -179,6 +180,30 @@ def _walk(error, image, use_image, start, trow, tcol, max_run, path):
 
 # ----------------------------------------------------------------------------- published
 @njit(cache=True, nogil=True)
+def _cheapest(error, image, use_image, r, c, drs, dcs, taken, blocked, row_run, col_run, max_run):
+    """The cheapest allowed step (drs[d], dcs[d]) from (r, c), the first of equals; -1 if none.
+
+    Allowed: inside the map, not on the line itself (``taken``) nor ``blocked``, and both
+    straight runs within ``max_run``."""
+    h, w = error.shape
+    best = np.inf
+    pick = -1
+    for d in range(drs.shape[0]):
+        nr = r + drs[d]
+        nc = c + dcs[d]
+        if nr < 0 or nr >= h or nc < 0 or nc >= w or taken[nr, nc] > 0 or blocked[nr, nc]:
+            continue
+        rr, cr = _runs_after(drs[d], dcs[d], row_run, col_run)
+        if rr > max_run or cr > max_run:
+            continue
+        v = _step_cost(error, image, use_image, r, c, nr, nc)
+        if v < best:
+            best = v
+            pick = d
+    return pick
+
+
+@njit(cache=True, nogil=True)
 def _line1(error, image, use_image, ra, rb, cb, blocked, max_run, on1, line):
     """Line 1 of the segment rows ra..rb from (rb, cb) towards the top right; stops on row ra or
     the right column. Marks ``on1`` with 1-based indices; returns its length."""
@@ -193,20 +218,9 @@ def _line1(error, image, use_image, ra, rb, cb, blocked, max_run, on1, line):
     row_run = 1
     col_run = 1
     while r > ra and c < w - 1:
-        best = np.inf
-        pick = -1
-        for d in range(5):
-            nr = r + _PR[d]
-            nc = c + _PC[d]
-            if nc < 0 or nc >= w or on1[nr, nc] > 0 or blocked[nr, nc]:
-                continue
-            rr, cr = _runs_after(_PR[d], _PC[d], row_run, col_run)
-            if rr > max_run or cr > max_run:
-                continue
-            v = _step_cost(error, image, use_image, r, c, nr, nc)
-            if v < best:
-                best = v
-                pick = d
+        pick = _cheapest(
+            error, image, use_image, r, c, _PR, _PC, on1, blocked, row_run, col_run, max_run
+        )
         if pick < 0:  # stuck: up, up-left, up-right, or end here
             for d in (2, 1, 3):
                 nc = c + _PC[d]
@@ -267,24 +281,13 @@ def _line2(error, image, use_image, ra, ca, rb, cb, blocked, max_run, on1, line)
         if r == rb:  # bottom row without meeting: along it to line 1's start
             c += 1 if cb > c else -1
             continue
-        best = np.inf
-        pick = -1
-        for d in range(5):
-            nr = r - _PR[d]
-            nc = c + _PC[d]
-            if nc < 0 or nc >= w or visited[nr, nc] or blocked[nr, nc]:
-                continue
-            rr, cr = _runs_after(_PR[d], _PC[d], row_run, col_run)
-            if rr > max_run or cr > max_run:
-                continue
-            v = _step_cost(error, image, use_image, r, c, nr, nc)
-            if v < best:
-                best = v
-                pick = d
+        pick = _cheapest(
+            error, image, use_image, r, c, _PR2, _PC, visited, blocked, row_run, col_run, max_run
+        )
         if pick < 0:
             pick = 2  # stuck: down (rows below ra are never blocked nor visited)
-        row_run, col_run = _runs_after(_PR[pick], _PC[pick], row_run, col_run)
-        r -= _PR[pick]
+        row_run, col_run = _runs_after(_PR2[pick], _PC[pick], row_run, col_run)
+        r += _PR2[pick]
         c += _PC[pick]
 
 
