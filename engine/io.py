@@ -200,6 +200,7 @@ def _probe(f, head: bytes, fail, check_size) -> tuple[int, int, int, str]:
     checked; reads only headers (PNG: the first 33 bytes)."""
     from engine.budget import MemoryBudgetError, check_memory
 
+    w = h = 0
     frames, kind = 1, "image"
     if head.startswith(_PNG) and len(head) >= 33 and head[12:16] == b"IHDR":
         w, h = struct.unpack(">II", head[16:24])
@@ -221,7 +222,7 @@ def _probe(f, head: bytes, fail, check_size) -> tuple[int, int, int, str]:
         if head.startswith(_TIFF):
             w, h, frames = _tiff_probe(f, fail, check_size)
             kind = "multi-page TIFF"
-        else:
+        elif not w:  # else the IHDR gave the size of a PNG Pillow cannot open
             return 0, 0, 1, "image"
     try:
         check_memory(
@@ -254,12 +255,12 @@ def _decode(data: bytes, name: str, fail, check_size, max_pixels: int) -> Loaded
         tiff = _tiff_exact(data, fail, check_size)
         if tiff is not None:
             return LoadedImage(_oriented(tiff[0], tiff[1]), 16, name, tiff[2])
+    exact = _png_exact(data, max_pixels, fail)
+    if exact is not None:
+        return LoadedImage(_oriented(exact[0], _png_orientation(data)), exact[1], name, exact[2])
     try:
         with Image.open(io.BytesIO(data)) as im:
             check_size(*im.size)
-            exact = _png_16bit(data, max_pixels, fail)
-            if exact is not None:
-                return LoadedImage(_oriented(exact[0], _orientation(im)), 16, name, exact[1])
             im.load()
             im = ImageOps.exif_transpose(im)
             pixels, depth, mode = _to_array(im, fail)
@@ -306,17 +307,40 @@ def _orientation(im: Image.Image) -> int:
         return 1
 
 
-def _png_16bit(data: bytes, max_pixels: int, fail):
-    """(pixels, mode) of a 16-bit PNG decoded without loss, else None."""
-    if data.startswith(_PNG) and data[24] == 16:
-        from engine.png import PNGError, decode_png
+def _png_exact(data: bytes, max_pixels: int, fail):
+    """(pixels, bit depth, mode) of an 8/16-bit gray / RGB(A) PNG decoded by libpng (exact at
+    16 bits, where Pillow would drop colour to 8; tolerant of damaged ancillary chunks, which
+    Pillow refuses); None for palette and 1/2/4-bit PNGs, which Pillow reads."""
+    if not data.startswith(_PNG):
+        return None
+    from engine.png import PNGError, decode_png, read_header
 
-        try:
-            q = decode_png(data, max_pixels=max_pixels)
-        except PNGError as exc:
-            raise fail(f"the file is truncated or corrupt ({exc})") from None
-        return _from_uint16(q)
-    return None
+    try:
+        head = read_header(data)
+        if head.colour_type not in (0, 2, 4, 6) or head.bit_depth not in (8, 16):
+            return None
+        q = decode_png(data, max_pixels=max_pixels)
+    except PNGError as exc:
+        raise fail(f"the file is truncated or corrupt ({exc})") from None
+    except MemoryError:
+        raise fail("there is not enough memory to decode it") from None
+    pixels, mode = _from_uint16(q) if q.dtype == np.uint16 else _from_uint8(q)
+    return pixels, head.bit_depth, mode
+
+
+def _png_orientation(data: bytes) -> int:
+    """The EXIF orientation of a PNG (its eXIf chunk), 1 if none or unreadable."""
+    try:
+        with Image.open(io.BytesIO(data)) as im:
+            return _orientation(im)
+    except Exception:  # noqa: BLE001 - Pillow is stricter than libpng: no orientation then
+        return 1
+
+
+def _from_uint8(q: np.ndarray) -> tuple[np.ndarray, str]:
+    from engine.bitdepth import to_float
+
+    return to_float(q), ("L", "LA", "RGB", "RGBA")[q.shape[2] - 1]
 
 
 def _from_uint16(q: np.ndarray) -> tuple[np.ndarray, str]:

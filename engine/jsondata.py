@@ -53,15 +53,15 @@ def loads_bounded(raw: bytes, *, max_values: int = MAX_VALUES, max_depth: int = 
     Both are measured on the text before parsing: with strings blanked, every value but the
     first follows a ``,``, ``[``, ``{`` or ``:`` (an upper bound), and the depth is the running
     count of opening minus closing brackets."""
-    bare = np.frombuffer(_blank_strings(raw), np.uint8)
-    opens = (bare == ord("[")) | (bare == ord("{"))
-    count = 1 + int(np.count_nonzero(opens | (bare == ord(",")) | (bare == ord(":"))))
+    bare = _blank_strings(raw)
+    count = 1 + sum(bare.count(c) for c in (b",", b"[", b"{", b":"))
     if count > max_values:
         raise JSONDataError(
             f"it holds about {count:,} values, over the limit of {max_values:,}; refused"
         )
-    closes = (bare == ord("]")) | (bare == ord("}"))
-    depth = int(np.cumsum(opens.astype(np.int32) - closes).max(initial=0))
+    a = np.frombuffer(bare, np.uint8)
+    step = (a == ord("[")).astype(np.int8) + (a == ord("{")) - (a == ord("]")) - (a == ord("}"))
+    depth = int(np.cumsum(step, dtype=np.int32).max(initial=0))
     if depth > max_depth:
         raise JSONDataError(
             f"it is nested too deeply ({depth} levels, over the limit of {max_depth}); refused"

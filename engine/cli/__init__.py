@@ -50,12 +50,15 @@ def build_parser(prog: str = "quilt-studio", command: str | None = None):
 
 def main(argv: list[str] | None = None) -> int:
     """Run a headless sub-command; returns the process exit code."""
-    argv = sys.argv[1:] if argv is None else list(argv)
-    parser = build_parser(command=argv[0] if argv and argv[0] in SUBCOMMANDS else None)
-    args = parser.parse_args(argv)
-    if args.command is None:
-        parser.print_help()
-        return 2
-    from engine.cli.outcome import run_command
+    from engine.cli.outcome import run_command, stopped_early
 
+    argv = sys.argv[1:] if argv is None else list(argv)
+    with stopped_early() as code:  # Ctrl+C / SIGTERM while the command is being set up
+        parser = build_parser(command=argv[0] if argv and argv[0] in SUBCOMMANDS else None)
+        args = parser.parse_args(argv)
+        if args.command is None:
+            parser.print_help()
+            return 2
+    if code:
+        return code[0]
     return run_command(args)

@@ -82,6 +82,7 @@ def run(args) -> int:
     project = load_project(args.project)
     if args.name is not None:
         project.name = args.name
+    print(f"quilt-studio export: writing {args.project} as a bundle to {args.out}", file=sys.stderr)
     manifest = export_project(
         project,
         args.out,
@@ -96,6 +97,7 @@ def run(args) -> int:
         tile_format=args.tile_format,
         overwrite=args.overwrite,
         wang=args.wang,
+        inputs=[args.project],
     )
     print(
         f"quilt-studio export: wrote {manifest['tile_count']} tiles x {len(manifest['maps'])} maps "

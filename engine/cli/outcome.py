@@ -15,7 +15,7 @@ import threading
 import warnings
 from contextlib import contextmanager
 
-__all__ = ["Terminated", "run_command"]
+__all__ = ["Terminated", "run_command", "stopped_early"]
 
 
 class Terminated(KeyboardInterrupt):
@@ -53,6 +53,23 @@ def _warnings_as_lines(name: str):
         warnings.simplefilter("always")
         warnings.showwarning = show
         yield
+
+
+@contextmanager
+def stopped_early():
+    """Around the set-up before :func:`run_command` (imports, parsing): SIGTERM or Ctrl+C
+    there ends the process with its exit code and one line instead of a traceback; the
+    yielded list receives that code."""
+    code: list[int] = []
+    try:
+        with _sigterm_as_interrupt():
+            yield code
+    except Terminated:
+        print("quilt-studio: terminated (SIGTERM) before it started", file=sys.stderr)
+        code.append(143)
+    except KeyboardInterrupt:
+        print("quilt-studio: interrupted before it started", file=sys.stderr)
+        code.append(130)
 
 
 def run_command(args) -> int:

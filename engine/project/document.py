@@ -12,6 +12,7 @@ from collections.abc import Callable
 import numpy as np
 
 from engine.candidate import CandidateTile
+from engine.project.checks import finite_number
 from engine.project.model import PROJECT_FORMAT, PROJECT_VERSION, SAFE_NAME, Project
 
 __all__ = ["from_doc", "to_doc"]
@@ -97,6 +98,11 @@ def _candidate(i: int, c: dict, images: dict, main: str, s, key="candidates") ->
     if "criterion" not in scores and score is not None:
         scores["score"] = score
     weight = params.get("weight", 1.0)
+    if isinstance(weight, (int, float)) and not (finite_number(weight) and weight >= 0):
+        s.fail(
+            f"project.json: {where}.params.weight must be a finite number >= 0, got "
+            f"{weight!r:.40}"
+        )
     own = {"weight", "scores", "patch_rect", "target_rect", "loop"}
     return CandidateTile(
         index=i,
