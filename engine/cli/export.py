@@ -77,8 +77,17 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def run(args) -> int:
+    from engine._fs import check_folder
+    from engine.export import bundle_files
     from engine.project import export_project, load_project
 
+    check_folder(  # refuse an output folder before reading the project
+        args.out,
+        owned=bundle_files,
+        inputs=[args.project],
+        overwrite=args.overwrite,
+        action="export to",
+    )
     project = load_project(args.project)
     if args.name is not None:
         project.name = args.name

@@ -1,0 +1,182 @@
+"""Signals during every sub-command (issue 12, "also untested"): Ctrl+C (SIGINT) and SIGTERM
+end a running job with exit code 130 / 143, one line saying so and no output or temporary left;
+``kill -9`` in the middle of writing leaves the previous output (or none), never a torn one,
+and the next run removes what the killed one left.
+
+Real processes are needed here; each job is signalled as soon as it reports it has started."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import resources
+from engine.cli import main
+from engine.io import load_image
+from engine.png import decode_png, encode_png
+from tests.engine.hostile import SIGNALS, signal_and_wait, start_cli, wait_for_line
+
+
+@pytest.fixture(scope="module")
+def inputs(tmp_path_factory):
+    d = tmp_path_factory.mktemp("inputs")
+    S = load_image(resources.sample_path("cobblestones")).pixels
+    q = np.round(S * 255).astype(np.uint8)
+    (d / "sample.png").write_bytes(encode_png(q))
+    (d / "small.png").write_bytes(encode_png(q[:96, :96]))
+    mask = np.zeros(q.shape[:2], np.uint8)
+    mask[150:350, 150:350] = 255
+    (d / "mask.png").write_bytes(encode_png(mask))
+    g = np.random.default_rng(0)
+    for name in ("r1", "r2"):  # a tall overlap whose Dijkstra search takes a while
+        (d / f"{name}.png").write_bytes(encode_png(g.integers(0, 256, (3000, 600), np.uint8)))
+    argv = [
+        "tileset",
+        str(d / "sample.png"),
+        "--out",
+        str(d / "set"),
+        "--candidates",
+        "12",
+        "--tile-min",
+        "128",
+        "--preview",
+        "6x6",
+        "--project",
+        str(d / "big.quiltproj"),
+    ]
+    assert main(argv) == 0  # fmt: skip
+    return d
+
+
+def commands(d: Path, out: Path) -> dict[str, tuple[list, str]]:
+    """Sub-command -> (arguments, a stderr text that shows the work has started)."""
+    return {
+        "tileset": (
+            [
+                "tileset",
+                d / "sample.png",
+                "--out",
+                out,
+                "--candidates",
+                "12",
+                "--tile-min",
+                "128",
+                "--preview",
+                "6x6",
+            ],
+            "template:",
+        ),  # fmt: skip
+        "synth": (
+            [
+                "synth",
+                d / "sample.png",
+                "--size",
+                "1024x1024",
+                "--block",
+                "32",
+                "-o",
+                out / "o.png",
+            ],
+            "synth: ",
+        ),  # fmt: skip
+        "transfer": (
+            ["transfer", d / "sample.png", d / "sample.png", "--block", "24", "-o", out / "o.png"],
+            "transfer: ",
+        ),  # fmt: skip
+        "export": (["export", d / "big.quiltproj", "--out", out, "--extrude", "2"], "writing"),
+        "seam": (
+            [
+                "seam",
+                d / "r1.png",
+                d / "r2.png",
+                "--method",
+                "dijkstra",
+                "--save-mask",
+                out / "m.png",
+            ],
+            "seam: dijkstra",
+        ),  # fmt: skip
+        "heal": (["heal", d / "sample.png", d / "mask.png", "-o", out / "o.png"], "heal: "),
+    }
+
+
+COMMANDS = ("tileset", "synth", "transfer", "export", "seam", "heal")
+
+
+@pytest.mark.parametrize("name", ["SIGINT", "SIGTERM"])
+@pytest.mark.parametrize("command", COMMANDS)
+def test_interrupt_and_terminate_end_cleanly(inputs, tmp_path, command, name):
+    sig, code, word = SIGNALS[name]
+    out = tmp_path / "out"
+    if command not in ("tileset", "export"):
+        out.mkdir()
+    argv, started = commands(inputs, out)[command]
+    proc = start_cli(*argv)
+    wait_for_line(proc, started)
+    rc, rest = signal_and_wait(proc, sig)
+    assert rc == code, rest
+    assert rest.strip().endswith(
+        f"quilt-studio {command}: {word}{' (SIGTERM)' if code == 143 else ''}; "
+        "no output was left half-written"
+    ), rest
+    assert "Traceback" not in rest
+    leftovers = sorted(os.listdir(tmp_path)) + (sorted(os.listdir(out)) if out.is_dir() else [])
+    assert leftovers in (["out"], []), leftovers
+
+
+def temporaries(folder: Path) -> list[str]:
+    return sorted(n for n in os.listdir(folder) if n.startswith("."))
+
+
+def kill_when(proc, appears, timeout=120):
+    """kill -9 ``proc`` as soon as ``appears()`` is true (polled every 2 ms)."""
+    end = time.monotonic() + timeout
+    while not appears():
+        assert proc.poll() is None, "the job ended before the moment to kill it"
+        assert time.monotonic() < end, "the moment to kill never came"
+        time.sleep(0.002)
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait(timeout=60)
+    proc.stderr.close()
+
+
+@pytest.mark.parametrize("command", ["tileset", "export"])
+def test_kill_9_while_writing_a_folder_leaves_the_old_one_whole(inputs, tmp_path, command):
+    out = tmp_path / "out"
+    argv, _ = commands(inputs, out)[command]
+    assert main([str(a) for a in argv]) == 0
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    proc = start_cli(*argv, *(["--overwrite"] if command == "export" else []))
+    kill_when(proc, lambda: any(".out.tmp-" in n for n in os.listdir(tmp_path)))
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == before  # never a mix
+    assert temporaries(tmp_path)  # the killed run's half-written folder...
+    argv2 = [*argv, "--overwrite"] if command == "export" else argv
+    assert main([str(a) for a in argv2]) == 0
+    assert temporaries(tmp_path) == []  # ...is removed by the next run
+    manifest = json.loads(
+        (out / ("manifest.json" if command == "tileset" else "tileset.json")).read_text()
+    )
+    assert sorted(os.listdir(out)) == manifest["files"]
+
+
+@pytest.mark.parametrize("command", ["synth", "transfer", "heal", "seam"])
+def test_kill_9_never_leaves_a_torn_image(inputs, tmp_path, command):
+    out = tmp_path / "out"
+    out.mkdir()
+    argv, started = commands(inputs, out)[command]
+    proc = start_cli(*argv)
+    wait_for_line(proc, started)
+    time.sleep(0.2)
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait(timeout=60)
+    proc.stderr.close()
+    for p in out.iterdir():  # an output is there whole or not at all
+        assert p.name.startswith(".") or decode_png(p.read_bytes()).size > 0, p
+    # (a temporary file of a killed atomic write is removed by the next write to that path:
+    # tests/engine/test_robust_outputs.py::test_d10_stale_temporary_files_of_atomic_writes)
