@@ -100,8 +100,7 @@ def _candidate(i: int, c: dict, images: dict, main: str, s, key="candidates") ->
     weight = params.get("weight", 1.0)
     if isinstance(weight, (int, float)) and not (finite_number(weight) and weight >= 0):
         s.fail(
-            f"project.json: {where}.params.weight must be a finite number >= 0, got "
-            f"{weight!r:.40}"
+            f"project.json: {where}.params.weight must be a finite number >= 0, got {weight!r:.40}"
         )
     own = {"weight", "scores", "patch_rect", "target_rect", "loop"}
     return CandidateTile(
