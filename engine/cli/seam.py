@@ -119,7 +119,8 @@ def run(args) -> int:
     ):
         if path:
             check_output(path, bit_depth=bits, channels=channels)  # before the search
-    print(f"quilt-studio seam: {args.method} through a {w}x{h} overlap", file=sys.stderr)
+    if not args.json:  # --json keeps stderr for errors only
+        print(f"quilt-studio seam: {args.method} through a {w}x{h} overlap", file=sys.stderr)
     err = error_map(r1, r2, metric=spec.metric)
     # a fresh process loads (or compiles) the method's numba kernels on first use, ~0.2 s:
     # do that on a tiny map so the time printed is the search's own
