@@ -18,6 +18,7 @@ unsupported mode.
 
 from __future__ import annotations
 
+import dataclasses
 import io
 import logging
 import numbers
@@ -108,6 +109,8 @@ class LoadedImage:
     bit_depth: int
     path: str
     mode: str
+    notes: tuple[str, ...] = ()
+    """Caveats to tell the user, e.g. "animated GIF with 3 frames; using the first frame"."""
 
     @property
     def has_alpha(self) -> bool:
@@ -188,10 +191,9 @@ def load_image(path, *, max_pixels: int = DEFAULT_MAX_PIXELS) -> LoadedImage:
             raise fail(f"cannot be read ({exc.strerror or exc})") from None
         loaded = _decode(data, name, fail, check_size, max_pixels)
     if frames > 1:
-        warnings.warn(
-            ImageWarning(f"{name}: {kind} with {frames} frames; using the first frame"),
-            stacklevel=2,
-        )
+        note = f"{kind} with {frames} frames; using the first frame"
+        loaded = dataclasses.replace(loaded, notes=(note,))
+        warnings.warn(ImageWarning(f"{name}: {note}"), stacklevel=2)
     return loaded
 
 

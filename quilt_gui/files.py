@@ -203,9 +203,10 @@ class ProjectFiles(QObject):
         note = self._fit_parameters(loaded.pixels.shape)
         self._remember(path, "last_open_dir", remember)
         h, w = loaded.pixels.shape[:2]
+        caveats = "".join(f"{n[0].upper()}{n[1:]}. " for n in loaded.notes)
         self._say(
-            "info",
-            f"Opened {Path(path).name}: {w}×{h}, {loaded.bit_depth}-bit "
+            "warning" if caveats else "info",
+            f"{caveats}Opened {Path(path).name}: {w}×{h}, {loaded.bit_depth}-bit "
             f"{mode_text(loaded.mode)}. {note}Next: Find best tile (Ctrl+T) or draw the "
             "tile rectangle.",
         )
