@@ -22,8 +22,14 @@ class Terminated(KeyboardInterrupt):
     """SIGTERM, raised in the main thread like Ctrl+C so every job cancels and cleans up."""
 
 
-def _on_sigterm(signum, frame):
-    raise Terminated
+_received: list[int] = []
+"""Signals received by the handlers below (one may be swallowed where it is raised, e.g. in
+the middle of an extension module's import: the command then still ends with its code)."""
+
+
+def _on_signal(signum, frame):
+    _received.append(signum)
+    raise Terminated if signum == signal.SIGTERM else KeyboardInterrupt
 
 
 @contextmanager
@@ -31,11 +37,12 @@ def _sigterm_as_interrupt():
     if threading.current_thread() is not threading.main_thread():
         yield
         return
-    previous = signal.signal(signal.SIGTERM, _on_sigterm)
+    previous = {s: signal.signal(s, _on_signal) for s in (signal.SIGTERM, signal.SIGINT)}
     try:
         yield
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        for s, handler in previous.items():
+            signal.signal(s, handler)
 
 
 @contextmanager
@@ -78,9 +85,16 @@ def run_command(args) -> int:
 
     name = f"quilt-studio {args.command}"
     kept = "no output was left half-written"
+    _received.clear()
     try:
         with _sigterm_as_interrupt(), _warnings_as_lines(name):
-            return int(args.func(args) or 0)
+            code = int(args.func(args) or 0)
+        if _received:  # a signal came but was swallowed where it was raised: the work is done
+            term = _received[0] == signal.SIGTERM
+            what = "terminated (SIGTERM)" if term else "interrupted"
+            print(f"{name}: {what} as it finished; its outputs are complete", file=sys.stderr)
+            return 143 if term else 130
+        return code
     except (ImageError, ValueError, TypeError, OSError) as exc:  # engine validation errors
         print(f"{name}: error: {exc}", file=sys.stderr)
         return 1

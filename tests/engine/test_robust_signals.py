@@ -17,9 +17,13 @@ import numpy as np
 import pytest
 
 import resources
+from engine._fs import check_folder
 from engine.cli import main
+from engine.cli.tileset import tileset_files
+from engine.export import bundle_files
 from engine.io import load_image
 from engine.png import decode_png, encode_png
+from engine.project import project_from_tileset, save_project
 from tests.engine.hostile import SIGNALS, signal_and_wait, start_cli, wait_for_line
 
 
@@ -36,21 +40,10 @@ def inputs(tmp_path_factory):
     g = np.random.default_rng(0)
     for name in ("r1", "r2"):  # a tall overlap whose Dijkstra search takes a while
         (d / f"{name}.png").write_bytes(encode_png(g.integers(0, 256, (3000, 600), np.uint8)))
-    argv = [
-        "tileset",
-        str(d / "sample.png"),
-        "--out",
-        str(d / "set"),
-        "--candidates",
-        "12",
-        "--tile-min",
-        "128",
-        "--preview",
-        "6x6",
-        "--project",
-        str(d / "big.quiltproj"),
-    ]
-    assert main(argv) == 0  # fmt: skip
+    # a project whose export takes a few seconds (a 2560 px preview to encode), made directly
+    tiles = [q[i * 20 : i * 20 + 128, i * 30 : i * 30 + 128] for i in range(12)]
+    preview = np.tile(q[:128, :128], (20, 20, 1))
+    save_project(d / "big.quiltproj", project_from_tileset(sources=q, tiles=tiles, preview=preview))
     return d
 
 
@@ -119,6 +112,7 @@ def test_interrupt_and_terminate_end_cleanly(inputs, tmp_path, command, name):
     argv, started = commands(inputs, out)[command]
     proc = start_cli(*argv)
     wait_for_line(proc, started)
+    time.sleep(0.3)  # as a person would: not in the middle of a lazy import (see outcome.py)
     rc, rest = signal_and_wait(proc, sig)
     assert rc == code, rest
     assert rest.strip().endswith(
@@ -156,8 +150,8 @@ def test_kill_9_while_writing_a_folder_leaves_the_old_one_whole(inputs, tmp_path
     kill_when(proc, lambda: any(".out.tmp-" in n for n in os.listdir(tmp_path)))
     assert {p.name: p.read_bytes() for p in out.iterdir()} == before  # never a mix
     assert temporaries(tmp_path)  # the killed run's half-written folder...
-    argv2 = [*argv, "--overwrite"] if command == "export" else argv
-    assert main([str(a) for a in argv2]) == 0
+    owned = tileset_files if command == "tileset" else bundle_files
+    check_folder(out, owned=owned)  # (what the next run does first)
     assert temporaries(tmp_path) == []  # ...is removed by the next run
     manifest = json.loads(
         (out / ("manifest.json" if command == "tileset" else "tileset.json")).read_text()
