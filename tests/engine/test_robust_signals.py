@@ -19,7 +19,7 @@ import pytest
 import resources
 from engine._fs import check_folder
 from engine.cli import main
-from engine.cli.tileset import tileset_files
+from engine.cli.tileset_output import tileset_files
 from engine.export import bundle_files
 from engine.io import load_image
 from engine.png import decode_png, encode_png
