@@ -19,7 +19,7 @@ import numpy as np
 from engine._validate import as_image, choice
 from engine.seams.spec import METRICS
 
-__all__ = ["METRICS", "colour_channels", "error_map"]
+__all__ = ["METRICS", "colour_channels", "error_map", "error_map_of"]
 
 
 def colour_channels(image: np.ndarray) -> np.ndarray:
@@ -63,6 +63,12 @@ def error_map(r1, r2, *, metric: str = "euclid") -> np.ndarray:
                 f"r1 and r2 must have compatible channels, got {a.shape[2]} and {b.shape[2]}"
             )
         a, b = _rgb(a), _rgb(b)
+    return error_map_of(a, b, metric)
+
+
+def error_map_of(a: np.ndarray, b: np.ndarray, metric: str) -> np.ndarray:
+    """:func:`error_map` of two float (h, w, C) arrays of one shape, already checked (the
+    engine's inner loops call it once per block, where the checks cost more than the map)."""
     if metric == "lab":
         from skimage.color import rgb2lab
 

@@ -44,6 +44,10 @@ __all__ = [
 ]
 
 
+WEIGHT_CACHE_BYTES = 32 * 2**20
+"""Memory a spectrum may spend on the weight terms of recurring overlap masks."""
+
+
 def _workers(threads: int | None) -> int:
     return 1 if threads is None else max(1, int(threads))
 
@@ -69,6 +73,7 @@ class SampleSpectrum:
         sq = np.stack([np.sum(chans[list(g)] ** 2, axis=0) for g in self.groups])
         self._fs = self._forward(chans)
         self._fsq = self._forward(sq)
+        self._wcache: dict = {}
 
     def _setup(self, sample, groups, workers) -> None:
         s = np.ascontiguousarray(np.asarray(sample, dtype=np.float32))
@@ -114,6 +119,21 @@ class SampleSpectrum:
         x = _channel_sum(self._forward(k), self._fs)
         h, w = self.shape
         return self._inverse(x, h - kh + 1, w - kw + 1)
+
+    def _weight_terms(self, wts: np.ndarray, workers) -> np.ndarray:
+        """``Σ_g F(W_g)* F(Σ_{c∈g} S_c²)`` of each weight map (n, G, bh, bw). Quilting's blocks
+        share a few overlap masks: each one's term is kept (up to :data:`WEIGHT_CACHE_BYTES`),
+        so most queries transform only their kernels' colour channels."""
+        keys = [(w.shape, w.tobytes()) for w in wts]
+        out = [self._wcache.get(key) for key in keys]
+        todo = [i for i, v in enumerate(out) if v is None]
+        if todo:
+            fresh = _channel_sum(self._forward(wts[todo], workers), self._fsq)
+            for i, v in zip(todo, fresh, strict=True):
+                out[i] = v
+                if (len(self._wcache) + 1) * v.nbytes <= WEIGHT_CACHE_BYTES:
+                    self._wcache[keys[i]] = v
+        return np.stack(out) if len(out) > 1 else out[0][None]
 
     def ssd(self, targets: np.ndarray, weights: np.ndarray, *, workers: int | None = None):
         """Weighted SSD maps for a batch of blocks of one shape.
@@ -162,9 +182,9 @@ class SampleSpectrum:
             )
         if bh > h or bw > w:
             raise ValueError(f"block {bw}x{bh} is larger than the sample {w}x{h}")
-        f = self._forward(np.concatenate([wts, -2.0 * k], axis=1), workers)  # one transform call
-        x = _channel_sum(f[:, : wts.shape[1]], self._fsq)
-        x += _channel_sum(f[:, wts.shape[1] :], self._fs)
+        x = _channel_sum(self._forward(k, workers), self._fs)
+        x *= -2
+        x += self._weight_terms(wts, workers)
         e = self._inverse(x, h - bh + 1, w - bw + 1, workers)
         e += np.asarray(const, dtype=np.float64).astype(np.float32)[:, None, None]
         np.maximum(e, 0, out=e)
@@ -356,15 +376,45 @@ def select_within_tolerance(errors: np.ndarray, *, tolerance: float, zero_level:
     whose error is 0. Returns ``(flat index, e_min, number of qualifying entries)``.
     """
     flat = errors.ravel()
-    i_min = int(np.argmin(flat))
+    i_min = int(_argmin(flat))
     e_min = float(flat[i_min])
     if not np.isfinite(e_min):
         raise ValueError("no valid candidate position (every position is excluded)")
-    limit = (1.0 + tolerance) * max(e_min, zero_level)
-    ok = np.flatnonzero(flat <= limit)
-    if ok.size == 0:  # float round-off
+    limit = flat.dtype.type((1.0 + tolerance) * max(e_min, zero_level))  # compared in e's dtype
+    n = int(_count_at_most(flat, limit))
+    if n == 0:  # float round-off
         return i_min, e_min, 1
-    return int(ok[rng.integers(ok.size)]), e_min, int(ok.size)
+    return int(_kth_at_most(flat, limit, rng.integers(n))), e_min, n
+
+
+@njit(cache=True, nogil=True)
+def _argmin(flat):  # pragma: no cover - compiled
+    """``np.argmin`` without the GIL (first of equal minima)."""
+    best, i = flat[0], 0
+    for j in range(1, flat.size):
+        if flat[j] < best:
+            best, i = flat[j], j
+    return i
+
+
+@njit(cache=True, nogil=True)
+def _count_at_most(flat, limit):  # pragma: no cover - compiled
+    n = 0
+    for v in flat:
+        if v <= limit:
+            n += 1
+    return n
+
+
+@njit(cache=True, nogil=True)
+def _kth_at_most(flat, limit, k):  # pragma: no cover - compiled
+    """Index of the ``k``-th (0-based) entry ``<= limit``."""
+    for j in range(flat.size):
+        if flat[j] <= limit:
+            if k == 0:
+                return j
+            k -= 1
+    return -1
 
 
 # ---------------------------------------------------------------------------- fast mode

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from engine.cancel import check
-from engine.errormap import colour_channels, error_map
+from engine.errormap import colour_channels, error_map_of
 from engine.exclusion import valid_anchors
 from engine.matching import (
     ZERO_ERROR_FRACTION,
@@ -57,9 +57,10 @@ class Quilter:
     """Shared state of one synthesis: sample, spectra, canvas, valid anchors, options.
 
     :func:`engine.quilting.scheduler.run_levels` drives it: :meth:`prepare` once, then per
-    block :meth:`load` (read the canvas under it), :meth:`search` (any thread) and :meth:`place`
-    (choose, cut, paste). Texture transfer subclasses it and overrides :meth:`make_spectrum`,
-    :meth:`load`, :meth:`zero_level_for` and :meth:`search` (its α-weighted cost).
+    batch of blocks :meth:`run_batch`: :meth:`load` (read the canvas under them), :meth:`search`
+    and :meth:`place` (choose, cut, paste), on any thread. Texture transfer subclasses it and
+    overrides :meth:`search_sample`, :meth:`load`, :meth:`zero_level_for` and :meth:`search`
+    (its α-weighted cost).
     """
 
     def __init__(self, *, seed: int, cancel, threads: int, plan: Plan, **options):
@@ -97,12 +98,17 @@ class Quilter:
         if self.plan.search == "pca":
             self.pca()
 
-    def run_block(self, wk: BlockWork) -> list[tuple[BlockRecord, np.ndarray]]:
-        """Load, search and place one block whose predecessors are placed; its records."""
+    def run_batch(self, works: list[BlockWork]) -> list[tuple[BlockRecord, np.ndarray]]:
+        """Load, search and place blocks of one level whose predecessors are placed (their
+        footprints are disjoint); their records in order."""
         check(self.cancel)
-        self.load(wk)
-        self.search([wk])
-        return self.place(wk)
+        for wk in works:
+            self.load(wk)
+        self.search(works)
+        out = []
+        for wk in works:
+            out.extend(self.place(wk))
+        return out
 
     # ---------------------------------------------------------------- sample helpers
     @property
@@ -327,7 +333,7 @@ class Quilter:
         else:
             old_full = self.canvas[self.idx(wk.y, wk.x, h, w)]
             overlap = wk.filled
-            err = error_map(wk.old, colour_channels(new), metric=self.seam.metric)
+            err = error_map_of(wk.old, colour_channels(new), self.seam.metric)
             err[~overlap] = 0
             if not self.seam.cuts:
                 keep = np.zeros((h, w), dtype=bool)

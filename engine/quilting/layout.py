@@ -87,12 +87,9 @@ def arms_of(filled: np.ndarray) -> tuple[int, int, int, int]:
     h, w = filled.shape
     rows = filled.all(axis=1)
     cols = filled.all(axis=0)
-
-    def lead(v):
-        k = int(np.argmin(v)) if not v.all() else v.size
-        return k
-
-    t, left = lead(rows), lead(cols)
-    b = lead(rows[::-1]) if t < h else 0
-    r = lead(cols[::-1]) if left < w else 0
+    if rows.all():  # the whole block (then every column is full too)
+        return h, w, 0, 0
+    t, left = int(rows.argmin()), int(cols.argmin()) if not cols.all() else w
+    b = int(rows[::-1].argmin())
+    r = int(cols[::-1].argmin()) if left < w else 0
     return t, left, b, r

@@ -13,10 +13,10 @@ from __future__ import annotations
 
 import threading
 from concurrent.futures import Future, ThreadPoolExecutor
-from dataclasses import replace
 
 import numpy as np
 
+from engine.cancel import check
 from engine.events import Progress
 from engine.quilting.core import BlockWork, Quilter
 from engine.quilting.records import BlockPlaced, BlockRecord
@@ -40,8 +40,12 @@ def dependencies(rects, shape, torus: bool):
     last = np.full((ny, nx), -1, dtype=np.int64)
     preds, levels = [], []
     for k, (y, x, h, w) in enumerate(rects):
-        idx = np.ix_(ry[y, h], rx[x, w])
-        p = sorted({int(v) for v in last[idx].ravel()} - {-1})
+        cy, cx = ry[y, h], rx[x, w]
+        if isinstance(cy, slice) and isinstance(cx, slice):
+            idx = (cy, cx)
+        else:  # a footprint wrapping around the torus
+            idx = np.ix_(*(np.r_[c] if isinstance(c, slice) else c for c in (cy, cx)))
+        p = [int(v) for v in np.unique(last[idx]) if v >= 0]
         preds.append(p)
         levels.append(1 + max((levels[j] for j in p), default=-1))
         last[idx] = k
@@ -57,7 +61,10 @@ def _axis_cells(spans, n: int, torus: bool):
     for s, k in set(spans):
         if not torus and s + k > n:
             raise AssertionError("block outside a non-tileable canvas")
-        covered[s, k] = np.unique(cell_of[np.arange(s, s + k) % n])
+        if s + k <= n:  # no wrap: a run of cells
+            covered[s, k] = slice(int(cell_of[s]), int(cell_of[s + k - 1]) + 1)
+        else:
+            covered[s, k] = np.unique(cell_of[np.arange(s, s + k) % n])
     return covered, len(cuts) - 1
 
 
@@ -65,42 +72,67 @@ POOL_MIN_SAMPLE_AREA = 200 * 200
 """Below this sample area a block's search is so cheap that handing blocks to other threads
 costs more than it saves: such runs stay on one thread (same result either way)."""
 
+BATCH_MAX_SAMPLE_AREA = 512 * 512
+"""Up to this sample area, consecutive blocks of one level are searched together (up to
+:data:`BATCH` per FFT call: the calls' overhead exceeds the transforms of a small sample); above
+it one by one (batched transforms of a large sample only thrash the cache)."""
+
+BATCH = 4
+
 
 def run_levels(q: Quilter, rects, total_label: str):
     """Place ``rects`` (top-level blocks, raster order); yields events, returns the records.
 
-    Each block is loaded (the canvas under it read), searched and placed as one task, as soon as
-    its predecessors are placed; with ``threads > 1`` the tasks run on a pool (FFTs and numba
-    kernels release the GIL) and blocks of one level are placed side by side (their footprints
-    are disjoint). Records and events come out in level order (level, then raster index) whatever
-    the number of threads, and every block sees exactly the canvas its predecessors left and
-    draws from its own generator: the result does not depend on the number of threads.
+    Blocks go in level order (level, then raster index), in fixed batches of consecutive blocks
+    of one level (:data:`BATCH`, or one on large samples). A batch is loaded (the canvas under
+    it read), searched and placed as one task as soon as its blocks' predecessors are placed;
+    with ``threads > 1`` the tasks run on a pool (FFTs and numba kernels release the GIL), and
+    blocks of one level are placed side by side (their footprints are disjoint). Records and
+    events come out in level order whatever the number of threads, every block sees exactly the
+    canvas its predecessors left and draws from its own generator, and the batches do not
+    depend on the threads: the result does not depend on the number of threads.
     """
     q.prepare()  # shared search structures, built once before any thread reads them
     preds, levels = dependencies(rects, q.out_shape, q.tileable)
     order = sorted(range(len(rects)), key=lambda k: (levels[k], k))
+    area = q.sample.shape[0] * q.sample.shape[1]
+    size = BATCH if area <= BATCH_MAX_SAMPLE_AREA else 1
+    batches: list[list[int]] = []
+    for k in order:
+        if batches and len(batches[-1]) < size and levels[batches[-1][0]] == levels[k]:
+            batches[-1].append(k)
+        else:
+            batches.append([k])
+    batch_of = {k: b for b, members in enumerate(batches) for k in members}
+    needs = [sorted({batch_of[j] for k in members for j in preds[k]}) for members in batches]
 
-    def work(k: int) -> BlockWork:
-        return BlockWork(k, *rects[k], rng=np.random.default_rng([q.seed, k]))
+    def run(b: int):
+        works = [
+            BlockWork(k, *rects[k], rng=np.random.default_rng([q.seed, k])) for k in batches[b]
+        ]
+        return q.run_batch(works)
 
-    heavy = q.sample.shape[0] * q.sample.shape[1] >= POOL_MIN_SAMPLE_AREA
-    if q.threads > 1 and heavy:
-        placed = _DependencyPool(q, work, preds, q.threads)
-        outcomes = (placed.result(k) for k in order)
+    if q.threads > 1 and area >= POOL_MIN_SAMPLE_AREA:
+        placed = _DependencyPool(run, needs, q.threads)
+        outcomes = (placed.result(b) for b in range(len(batches)))
     else:
         placed = None
-        outcomes = (q.run_block(work(k)) for k in order)
+        outcomes = (run(b) for b in range(len(batches)))
     records: list[BlockRecord] = []
+    done = 0
     try:
-        for i, (k, out) in enumerate(zip(order, outcomes, strict=True)):
+        for b, out in enumerate(outcomes):
+            check(q.cancel)
             for rec, pixels in out:
-                rec = replace(rec, index=len(records))
+                # numbered here, in level order, before anyone else sees the record
+                object.__setattr__(rec, "index", len(records))
                 records.append(rec)
                 if q.stream:
                     yield BlockPlaced(rec, pixels)
-            last = i + 1 == len(order) or levels[order[i + 1]] != levels[k]
+            done += len(batches[b])
+            last = b + 1 == len(batches) or levels[batches[b + 1][0]] != levels[batches[b][0]]
             if q.stream and last:
-                yield Progress(i + 1, len(rects), total_label)
+                yield Progress(done, len(rects), total_label)
     finally:
         if placed is not None:
             placed.shutdown()
@@ -108,15 +140,15 @@ def run_levels(q: Quilter, rects, total_label: str):
 
 
 class _DependencyPool:
-    """Runs :meth:`Quilter.run_block` for every block on ``threads`` workers, each block as soon
-    as its predecessors are placed; :meth:`result` waits for one block's records."""
+    """Runs ``run(task)`` for every task on ``threads`` workers, each as soon as the tasks it
+    ``needs`` have run; :meth:`result` waits for one task's result."""
 
-    def __init__(self, q: Quilter, work, preds, threads: int):
-        self.q, self.work = q, work
-        self.done = [Future() for _ in preds]
-        self.waiting = [len(p) for p in preds]
-        self.dependents = [[] for _ in preds]
-        for k, p in enumerate(preds):
+    def __init__(self, run, needs, threads: int):
+        self.run = run
+        self.done = [Future() for _ in needs]
+        self.waiting = [len(p) for p in needs]
+        self.dependents = [[] for _ in needs]
+        for k, p in enumerate(needs):
             for j in p:
                 self.dependents[j].append(k)
         self.lock = threading.Lock()
@@ -129,7 +161,7 @@ class _DependencyPool:
         if self.stopped:
             return
         try:
-            self.done[k].set_result(self.q.run_block(self.work(k)))
+            self.done[k].set_result(self.run(k))
         except BaseException as exc:  # handed to the consumer by result()
             self.done[k].set_exception(exc)
             return
