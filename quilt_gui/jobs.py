@@ -78,6 +78,7 @@ class Job(QObject):
         self.token = CancelToken()
         self.state = "running"  # running | done | cancelled | failed | aborted
         self.progress: Progress | None = None
+        self.estimate = ""  # the engine's own estimate, shown until the job's rate is known
         self.started_at = time.perf_counter()
         self.result: Any = None
         self.error: BaseException | None = None

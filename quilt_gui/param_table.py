@@ -400,14 +400,17 @@ PARAMS: tuple[Param, ...] = (
     ),
     _P(
         "q_mode",
-        "exact",
+        "auto",
         "Search",
-        "Exhaustive: compare every piece of the source; Fast: compare a summary of each piece, "
-        "then the best few exactly (for large outputs).",
+        "Exhaustive: compare every piece of the source; Fast: find the best pieces on a reduced "
+        "copy of the source, then compare them exactly (large sources in seconds); Auto: "
+        "exhaustive when it takes under about 10 s. The status bar shows the estimate.",
         "Quilting",
         basic=True,
-        paper="exact FFT search · principal-component ranking",
-        **_choices(("exact", "fast"), {"exact": "Exhaustive", "fast": "Fast"}),
+        paper="exact FFT search · coarse-to-fine search with exact re-ranking",
+        **_choices(
+            ("auto", "exact", "fast"), {"auto": "Auto", "exact": "Exhaustive", "fast": "Fast"}
+        ),
     ),
     _P(
         "q_method",

@@ -528,7 +528,7 @@ class Pipeline(QObject):
         p = doc.params
         doc.quilting.start(doc.quilting.target.shape[:2])
         opts = quilt_options(p)
-        for key in ("select", "candidates", "tileable", "adaptive_threshold", "min_block", "mode"):
+        for key in ("select", "candidates", "tileable", "adaptive_threshold", "min_block"):
             opts.pop(key)
         return self.jobs.start(
             "quilt",
@@ -549,7 +549,7 @@ class Pipeline(QObject):
         )
 
     def _on_quilt_event(self, event) -> None:
-        from engine.quilting import BlockPlaced
+        from engine.quilting import BlockPlaced, Estimated
         from engine.transfer import IterationDone
 
         if self.doc.quilting.output is None:
@@ -558,6 +558,9 @@ class Pipeline(QObject):
             self.doc.quilting.place_block(event.record, np.asarray(event.pixels))
         elif isinstance(event, IterationDone):
             self.doc.quilting.finish_iteration(event)
+        elif isinstance(event, Estimated) and (job := self.jobs.get("quilt")) is not None:
+            job.estimate = f"estimate: {event.plan.describe()}"  # the status bar shows it
+            self.jobs.progress.emit(job)
 
     def _on_quilt_done(self, result) -> None:
         self.doc.quilting.finish(result)

@@ -204,7 +204,11 @@ class JobStatus(QWidget):
         self.others.setVisible(bool(others))
         p = job.progress
         left = time_left(job)
-        self.label.setText(job.label + (f" — {duration_text(left)} left" if left else ""))
+        note = f" — {duration_text(left)} left" if left else ""
+        if not left and job.estimate:
+            note = f" — {job.estimate}"
+        self.label.setText(job.label + note)
+        self.label.setToolTip(job.estimate)
         if p is None or p.total <= 0:
             self.bar.setRange(0, 0)  # busy indicator
         else:
