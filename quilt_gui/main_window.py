@@ -55,14 +55,16 @@ _warmup_started = False
 
 
 def _warmup() -> None:
+    import engine.quilting.synthesis
     import engine.seams
 
     engine.seams.warmup()
+    engine.quilting.synthesis.warmup()
 
 
 def start_warmup(manager: jobs.JobManager) -> jobs.Job | None:
-    """Load (or compile) the numba seam kernels in a worker, once per process, so the first
-    seam a person asks for is not held up by it and the GUI thread never is."""
+    """Load (or compile) the numba seam and quilting kernels in a worker, once per process, so
+    the first seam or quilt a person asks for is not held up by it and the GUI thread never is."""
     global _warmup_started
     if _warmup_started:
         return None
@@ -70,7 +72,7 @@ def start_warmup(manager: jobs.JobManager) -> jobs.Job | None:
     return manager.start(
         "warmup",
         _warmup,
-        label="Loading the seam kernels",
+        label="Loading the seam and quilting kernels",
         pass_cancel=False,
         on_error=lambda exc: log.warning("seam kernel warm-up failed: %s", exc),
     )

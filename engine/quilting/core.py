@@ -74,7 +74,7 @@ class Quilter:
         self.match_sample = np.ascontiguousarray(colour_channels(sample))
         self.canvas = np.zeros((*out_shape, sample.shape[2]), np.float32)
         self.filled = np.zeros(out_shape, dtype=bool)
-        self.floor = error_floor(self.match_sample)
+        self.floor = 0.0  # error_floor, measured in prepare (after the plan is out)
         self._valid: dict[tuple[int, int], tuple[np.ndarray | None, np.ndarray]] = {}
         self._spectrum = None
         self._pca = None
@@ -85,6 +85,7 @@ class Quilter:
 
     def prepare(self) -> None:
         """Build the structures every search shares (before any thread reads them)."""
+        self.floor = error_floor(self.match_sample)
         if self.select != "best":
             return
         if self.plan.search == "pyramid":

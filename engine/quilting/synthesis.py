@@ -14,7 +14,7 @@ from engine.quilting.options import check_options, resolve_threads
 from engine.quilting.records import QuiltResult
 from engine.quilting.scheduler import run_levels
 
-__all__ = ["iter_quilt", "quilt", "quilt_unstreamed"]
+__all__ = ["iter_quilt", "quilt", "quilt_unstreamed", "warmup"]
 
 
 def iter_quilt(
@@ -175,6 +175,22 @@ def _iter_quilt(q: Quilter):
             min_block=q.min_block,
         ),
     )
+
+
+def warmup() -> None:
+    """Load (or compile) the numba kernels of every search on tiny inputs: call it in a worker
+    at start-up, so that the first quilting job is not held up by it (loading them holds the
+    GIL for a noticeable time)."""
+    import numpy as np
+
+    from engine.pyramid import PyramidSearch
+
+    s = np.random.default_rng(0).random((72, 72, 3), dtype=np.float32)
+    for mode in ("exact", "fast"):
+        quilt(s, (40, 40), block=16, overlap=4, mode=mode, rng=0, threads=1)
+    m = np.zeros((16, 16, 1), np.float32)
+    m[:4] = 1
+    PyramidSearch(s, levels=1, keep=2, coarse_keep=4).query(s[:16, :16], m, seeds=[(1, 1)])
 
 
 def quilt(sample, out_shape, **options) -> QuiltResult:
