@@ -7,8 +7,10 @@ sample (``resources/samples/cobblestones.png`` by default):
 * B — 1024×1024 from a 256×256 sample, block 48, overlap 8, same settings.
 
 Rows: a straightforward baseline (numpy: ``scipy.signal.fftconvolve`` per channel and block in
-float64, union L mask, the compiled dp L-cut, single thread), the exact FFT search and the fast
-(principal components + exact re-ranking) search, on 1 and 2 threads. Every time is the median
+float64, union L mask, the compiled dp L-cut, single thread), with ``--start DIR`` the exact search
+of the commit issue 15 started from (a219639, in a process of its own: the "× start" column), the
+exact FFT search and the fast (principal components + exact re-ranking) search, on 1 and 2
+threads. Every time is the median
 of repeats (the load average is printed: on a shared machine rerun when it is near 0).
 Samples under 200×200 (job A) run on one thread whatever ``threads`` says
 (:data:`engine.quilting.scheduler.POOL_MIN_SAMPLE_AREA`). Each output's border ratio along the
@@ -18,12 +20,17 @@ helper threads spent during the runs (0 when every product stays on the calling 
 should on a small shared machine). Then: the streaming overhead (``quilt`` draining every event
 vs the same run creating none, the two run in turn), and the quality figures: grid border ratio
 of best+dp vs best+straight vs random on every bundled sample, and the mean seam peak of Long &
-Mould's minimax at half-block overlap vs dp at the same overlap.
+Mould's minimax at half-block overlap vs dp at the same overlap. Between them the large jobs of
+:mod:`benchmarks.quilting_large` (4096² and 8192² samples in ``auto``, transfer at 4096²;
+``--large-quality`` adds auto vs exact at 4096²). Everything printed is also written to
+``benchmarks/results/quilting.txt``.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
+import io
 import os
 import sys
 import threading
@@ -36,6 +43,7 @@ from scipy import signal
 if __package__ in (None, ""):  # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from benchmarks import quilting_large  # noqa: E402
 from benchmarks._util import format_table, median_time  # noqa: E402
 from engine.errormap import error_map  # noqa: E402
 from engine.io import load_image  # noqa: E402
@@ -132,8 +140,48 @@ def blas_cpu_seconds() -> float | None:
     return total / os.sysconf("SC_CLK_TCK")
 
 
+START_SNIPPET = """
+import json, sys, time
+import numpy as np
+from engine.quilting import quilt
+s = np.load(sys.argv[1])
+out, block, overlap, threads, repeats = json.loads(sys.argv[2])
+quilt(s, tuple(out), block=block, overlap=overlap, rng=0, threads=threads)
+times = []
+for _ in range(repeats):
+    t0 = time.perf_counter()
+    quilt(s, tuple(out), block=block, overlap=overlap, rng=0, threads=threads)
+    times.append(time.perf_counter() - t0)
+print(json.dumps(times))
+"""
+
+
+def start_time(start_dir: str, sample: np.ndarray, j: dict, threads: int, repeats: int) -> float:
+    """Median seconds of the exact search (then the only one) of job ``j`` in a checkout of the
+    commit issue 15's work started from (``--start DIR``), in a process of its own."""
+    import json
+    import subprocess
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "sample.npy"
+        np.save(path, sample)
+        spec = json.dumps([list(j["out"]), j["block"], j["overlap"], threads, repeats])
+        env = {**os.environ, "PYTHONPATH": start_dir}
+        out = subprocess.run(
+            [sys.executable, "-c", START_SNIPPET, str(path), spec],
+            capture_output=True,
+            text=True,
+            cwd=start_dir,
+            env=env,
+            check=True,
+        )
+    return float(np.median(json.loads(out.stdout.strip().splitlines()[-1])))
+
+
 def speed(args) -> None:
     print(f"## Speed (sample {args.sample}; load average {os.getloadavg()[0]:.2f})\n")
+    start = {}
     blas_before = blas_cpu_seconds()
     rows = []
     for job in args.jobs:
@@ -156,9 +204,26 @@ def speed(args) -> None:
                 "",
                 "",
                 f"{block_grid_border_ratio(_Grid(base_img, **kw)):.3f}",
+                "",
             ]
         )
-        images = {}
+        images, exact_t = {}, {}
+        if args.start:
+            for threads in (1, 2):
+                start[job, threads] = start_time(args.start, s, j, threads, args.repeats)
+                rows.append(
+                    [
+                        job,
+                        f"exact at the start ({Path(args.start).name})",
+                        threads,
+                        f"{start[job, threads]:.3f}",
+                        f"{base_t / start[job, threads]:.2f}",
+                        "",
+                        "",
+                        "",
+                        "1.00",
+                    ]
+                )
         for mode in ("exact", "fast"):
             for threads in (1, 2):
                 t, res = median_time(
@@ -169,6 +234,10 @@ def speed(args) -> None:
                     max_time=args.max_time,
                 )
                 images[mode, threads] = res.image
+                vs_start = ""
+                if mode == "exact" and (job, threads) in start:
+                    gain = start[job, threads] / t
+                    vs_start = f"{gain:.2f} ({'yes' if gain >= 1.8 else 'NO'}: >= 1.8)"
                 target = TARGETS.get((job, mode))
                 rows.append(
                     [
@@ -180,10 +249,15 @@ def speed(args) -> None:
                         "" if target is None else f"<= {target}",
                         "" if target is None else ("yes" if t <= target else "NO"),
                         f"{block_grid_border_ratio(res):.3f}",
+                        vs_start,
                     ]
                 )
+                if mode == "exact":
+                    exact_t[threads] = t
             same = np.array_equal(images[mode, 1], images[mode, 2])
             print(f"job {job} {mode}: identical output on 1 and 2 threads: {same}")
+        scale = exact_t[1] / exact_t[2]
+        print(f"job {job} exact: 2 threads {scale:.2f}x faster than 1 (target for B: >= 1.5)")
     print()
     print(
         format_table(
@@ -196,6 +270,7 @@ def speed(args) -> None:
                 "target",
                 "met",
                 "grid border ratio",
+                "× start (target >= 1.8)",
             ],
             rows,
         )
@@ -331,16 +406,79 @@ def main(argv=None) -> int:
     p.add_argument("--repeats", type=int, default=5, help="minimum repeats per timing (default 5)")
     p.add_argument("--max-time", type=float, default=30.0, help="time budget per timing (s)")
     p.add_argument("--seeds", type=int, default=2, help="seeds averaged in the quality tables")
+    p.add_argument(
+        "--start",
+        default=None,
+        metavar="DIR",
+        help="a checkout of the commit issue 15 started from (a219639): its exact search is "
+        "timed on jobs A and B too (git worktree add /tmp/start a219639)",
+    )
     p.add_argument("--skip-speed", action="store_true")
     p.add_argument("--skip-quality", action="store_true")
+    p.add_argument("--skip-large", action="store_true", help="skip the 4096²/8192² jobs")
+    p.add_argument(
+        "--large-quality",
+        action="store_true",
+        help="auto vs exact at 4096² on every sample (about 20 min on a quiet machine)",
+    )
+    p.add_argument("--large-repeats", type=int, default=3, help="timed runs per large job")
+    quilting_large.add_arguments(p)
     args = p.parse_args(argv)
     args.jobs = [j for j in args.jobs.upper() if j in JOBS]
-    if not args.skip_speed:
-        speed(args)
-        streaming(args)
-    if not args.skip_quality:
-        quality(args)
+    args.large_jobs = [j.strip().upper() for j in args.large_jobs.split(",") if j.strip()]
+    out = io.StringIO()
+    with contextlib.redirect_stdout(_Tee(sys.stdout, out)):
+        print(f"{_provenance()}\npython -m benchmarks.quilting {' '.join(argv or sys.argv[1:])}\n")
+        if not args.skip_speed:
+            speed(args)
+            streaming(args)
+        if not args.skip_large:
+            quilting_large.large(
+                argparse.Namespace(**{**vars(args), "repeats": args.large_repeats})
+            )
+        if args.large_quality:
+            quilting_large.large_quality(args)
+        if not args.skip_quality:
+            quality(args)
+    RESULTS.parent.mkdir(exist_ok=True)
+    RESULTS.write_text(out.getvalue())
     return 0
+
+
+RESULTS = Path(__file__).resolve().parent / "results" / "quilting.txt"
+
+
+class _Tee:
+    """Write to several streams (the terminal and the results file's buffer)."""
+
+    def __init__(self, *streams):
+        self.streams = streams
+
+    def write(self, text: str) -> None:
+        for s in self.streams:
+            s.write(text)
+
+    def flush(self) -> None:
+        for s in self.streams:
+            s.flush()
+
+
+def _provenance() -> str:
+    """Date, commit and machine load, for the first line of the results file."""
+    import datetime
+    import subprocess
+
+    try:
+        commit = subprocess.run(
+            ["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, check=True
+        ).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        commit = "unknown"
+    load = ", ".join(f"{v:.1f}" for v in os.getloadavg())
+    return (
+        f"# measured {datetime.date.today()} on this {os.cpu_count()}-core machine at commit "
+        f"{commit}; load average {load}"
+    )
 
 
 if __name__ == "__main__":

@@ -81,13 +81,16 @@ def box_reduce(a: np.ndarray) -> np.ndarray:
     return out
 
 
-def pyramid_levels(shape, block, overlap: int, *, coarse_area: int = COARSE_AREA) -> int:
+def pyramid_levels(
+    shape, block, overlap: int, *, coarse_area: int = COARSE_AREA, min_block: int = 4
+) -> int:
     """Number of 2× reductions for a sample of ``shape`` (H, W) and blocks ``block`` (bh, bw)
     with ``overlap`` (0: search exactly).
 
     Enough to bring the sample to ``coarse_area`` pixels, but no more than keeps
-    :data:`MIN_COARSE_OVERLAP` pixels of the overlap and 4 of the block; if the top level is
-    then still over :data:`MAX_COARSE_AREA` (a thin overlap on a huge sample), as many as
+    :data:`MIN_COARSE_OVERLAP` pixels of the overlap and ``min_block`` of the block (texture
+    transfer, which matches whole blocks, passes the block as the overlap and 2); if the top
+    level is then still over :data:`MAX_COARSE_AREA` (a thin overlap on a huge sample), as many as
     bring it down while the block keeps 2 pixels (the overlap's weights become fractions of a
     pixel: a weaker top level, but a bounded one)."""
     h, w = int(shape[0]), int(shape[1])
@@ -105,7 +108,7 @@ def pyramid_levels(shape, block, overlap: int, *, coarse_area: int = COARSE_AREA
     need = 0
     while (h >> need) * (w >> need) > coarse_area:
         need += 1
-    lev = most(MIN_COARSE_OVERLAP, 4)
+    lev = most(MIN_COARSE_OVERLAP, min_block)
     if (h >> lev) * (w >> lev) > MAX_COARSE_AREA:
         lev = max(lev, most(0, 2))
     return lev

@@ -17,7 +17,13 @@ iteration is a full raster pass on a fresh canvas and, from i = 2, matches whole
 the *frozen* result of iteration i − 1 (a separate read-only array, never overwritten [FIX]).
 
 With α = 1 and one iteration the correspondence and previous terms vanish: the cost is the
-plain overlap SSD and the output is exactly :func:`engine.quilting.quilt`'s for the same seed.
+plain overlap SSD and the output of the exact search is exactly :func:`engine.quilting.quilt`'s
+for the same seed.
+
+Large samples (``mode="auto"``/``"fast"``) take the coarse-to-fine search of
+:mod:`engine.pyramid`, the correspondence map reduced with the colours as one more channel:
+the same three-term cost, written as a weighted SSD against one target per pixel plus a
+constant, ranks the candidates at every level and re-ranks them exactly at full resolution.
 """
 
 from __future__ import annotations

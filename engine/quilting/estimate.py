@@ -245,7 +245,10 @@ def plan(
         mem += conc * (H - bh + 1) * (W - bw + 1) * 4  # the error map of the whole sample
         exact = ("tiled fft", n_blocks * per, mem)
 
-    levels = pyramid_levels((H, W), (bh, bw), ov)
+    if terms == "overlap":
+        levels = pyramid_levels((H, W), (bh, bw), ov)
+    else:  # transfer matches every pixel of a block: reduce as far as the block allows
+        levels = pyramid_levels((H, W), (bh, bw), min(bh, bw), min_block=2)
     if levels:
         lh, lw = H >> levels, W >> levels
         coarse = _fft_query_seconds((lh, lw), cm + groups)

@@ -216,3 +216,24 @@ def test_second_iteration_cost_with_the_previous_term_by_brute_force(cobbles):
             y : y + h, x : x + w
         ][~r.keep_old if r.keep_old is not None else ...]
         filled[y0 : y0 + h, x0 : x0 + w] = True
+
+
+def test_large_sample_transfer_takes_the_pyramid_identically_on_any_thread_count(monkeypatch):
+    """A sample over 256² in fast mode: the coarse-to-fine search with the correspondence map as
+    one more channel; every pass's cost re-ranked exactly, the same output on 1 and 2 threads,
+    and the correspondence improves as on the exact search."""
+    from engine.quilting import Estimated
+    from engine.transfer import iter_transfer
+    from tests.engine.helpers import events_and_result, smooth_texture
+
+    monkeypatch.setattr(scheduler, "POOL_MIN_SAMPLE_AREA", 0)
+    s = smooth_texture((320, 320), seed=2, sigma=3.0)
+    target = disc(90, 90)
+    kw = dict(block=24, iterations=2, rng=5, mode="fast")
+    events, a = events_and_result(iter_transfer(s, target, threads=1, **kw))
+    assert events[0].plan.search == "pyramid" and isinstance(events[0], Estimated)
+    b = transfer(s, target, threads=2, **kw)
+    np.testing.assert_array_equal(a.image, b.image)
+    exact = transfer(s, target, block=24, iterations=2, rng=5, mode="exact")
+    err = [it.correspondence_error for it in a.iterations]
+    assert err[-1] <= 1.25 * exact.iterations[-1].correspondence_error
