@@ -26,6 +26,7 @@ import scipy.fft as sfft
 
 from engine.budget import check_memory, format_bytes
 from engine.events import Item
+from engine.matching import WEIGHT_CACHE_BYTES
 from engine.pyramid import CHILDREN, SEED_NEIGHBOURS, pyramid_levels
 from engine.quilting.layout import grid_rects
 
@@ -234,6 +235,8 @@ def plan(
 
     # exhaustive: whole-sample spectra, or tiles when they do not fit the budget
     whole = spectra_bytes((H, W), cm + groups) + conc * exact_query_bytes((H, W), cm + groups)
+    entry = spectra_bytes((H, W), 1)  # the cached weight term of one overlap mask
+    whole += entry * min(10, WEIGHT_CACHE_BYTES // entry)  # up to ten masks, within the cap
     if whole + fixed <= SEARCH_BUDGET:
         exact = ("fft", n_blocks * _fft_query_seconds((H, W), cm + groups), whole)
     else:
