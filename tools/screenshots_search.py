@@ -4,8 +4,8 @@
 
 ``watch_search.png``: *Watch the search* on the bundled sample's tile, mid-way (the paper's
 oscillating search drawing its improvements, the criterion falling in the chart).
-``template_sweep.png``: *Find best tile* with a tile size range, caught during its first
-horizontal phase: the rectangles scored so far drawn faintly, the best so far highlighted.
+``template_sweep.png``: *Find best tile* with a tile size range, caught during a horizontal
+phase: the rectangles scored so far drawn faintly, the best so far highlighted.
 """
 
 from __future__ import annotations
@@ -27,14 +27,14 @@ def main() -> int:
     out = ROOT / "docs"
     doc = w.doc
 
-    # -- the template sweep, caught in its first horizontal phase
+    # -- the template sweep, caught in a horizontal phase with 60 rectangles on screen
     doc.set_params({"tile_size": params.ANY, "tile_min": 96, "tile_max": 256})
     wait_until(idle)
     sweep = w.source_view.sweep
     caught = []
 
     def catch(event) -> None:
-        if not caught and event.round == 0 and event.phase == "horizontal" and sweep.events > 12:
+        if not caught and event.phase == "horizontal" and len(sweep.recent) >= 60:
             sweep._rebuild()
             app.processEvents()
             w.grab().save(str(out / "template_sweep.png"))

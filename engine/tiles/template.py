@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import math
 import numbers
+import time
 import warnings
 from dataclasses import dataclass
 
@@ -51,6 +52,7 @@ __all__ = [
 ]
 
 _CHUNK = 8  # shifts per kernel call between cancel checks / progress events
+SWEEP_INTERVAL = 1 / 30  # seconds between sweep events at least (no display redraws faster)
 JOINT_WEIGHT = 0.5  # λ: weight of the natural wrap joint's step G next to the strip mismatch D
 
 
@@ -70,7 +72,9 @@ class TemplateSweep(Item):
 
     ``rects`` (n, 4) holds (x, y, w, h) tile rectangles in source pixels (as
     :attr:`Template.rect`; a phase scores them all at once over its rows or columns), ``costs``
-    their criterion; ``best`` / ``best_cost`` the phase's best so far. ``phase`` is
+    their criterion; ``best`` / ``best_cost`` the best of the phase's sampled rectangles so far,
+    and in the phase's last event (whose one rectangle it is) the phase's own best, which the
+    search goes on with. ``phase`` is
     ``"horizontal"`` or ``"vertical"``, ``round`` 0 for the search and 1.. for the refinement
     rounds, ``coarse`` True on the reduced image of a large source (coordinates scaled back).
     """
@@ -313,15 +317,29 @@ class _Scan:
         out[:, :n] = np.where(ok, d, np.inf)
         return out
 
-
-def _sample(costs: np.ndarray, n: int) -> np.ndarray:
-    """Flat indices of ``n`` finite entries of ``costs`` spread evenly over them, and the
-    smallest."""
-    finite = np.flatnonzero(np.isfinite(costs))
-    if finite.size == 0:
-        return finite
-    pick = finite[np.linspace(0, finite.size - 1, min(n, finite.size)).astype(np.int64)]
-    return np.union1d(pick, [int(np.argmin(costs))])
+    def sampled(self, feasible_run, k0: int, k1: int, n: int):
+        """About ``n`` scored pairs of shifts k0..k1 for the sweep: (shift indices, positions,
+        costs), spread evenly over the shifts and over each shift's positions (offset from call
+        to call), invalid ones left out. Costs as :meth:`costs`, for these pairs alone."""
+        W = self.sum.shape[1]
+        w = self.overlap
+        if self._G is None:
+            self._G = self.joint_weight * _joint_steps(self.S, self.valid, self.rows)
+        ks = np.linspace(k0, k1 - 1, n).astype(np.int64)
+        out = []
+        for j, k in enumerate(ks.tolist()):
+            a = int(self.shifts[k])
+            m = W - a - w + 1  # positions with the whole footprint inside
+            if m <= 0:
+                continue
+            x = int(((j + k0) * 0.618034 % 1.0) * m)
+            c = self.cnt[k, x : x + w].sum()
+            if c > 0 and (feasible_run is None or feasible_run[x] >= a + w):
+                out.append((k, x, self.sum[k, x : x + w].sum() / c + self._G[x + a]))
+        if not out:
+            return np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0)
+        k, x, cost = zip(*out, strict=True)
+        return np.array(k, np.int64), np.array(x, np.int64), np.array(cost, np.float64)
 
 
 def _argmin(costs: np.ndarray, shifts: np.ndarray) -> tuple[int, int, float] | None:
@@ -462,9 +480,12 @@ def iter_find_template(
         so the wrap does not fall on an edge of the texture (module docstring). 0 searches
         the strip mismatch alone (the paper's criterion).
     sweep : int
-        0 (default): no sweep events. n > 0: after every chunk of widths (or heights) a
-        :class:`TemplateSweep` with about n of the rectangles just scored (spread evenly over
-        them, plus the chunk's best) and the phase's best so far, for drawing the search.
+        0 (default): no sweep events. n > 0: a :class:`TemplateSweep` with about n of the
+        rectangles scored since the last one (spread evenly over the widths or heights and their
+        positions, their costs computed for the sample alone) and the best shown so far, at most
+        every :data:`SWEEP_INTERVAL` seconds (no display redraws faster, and the sampling costs
+        the search little); at the end of each phase one more with the phase's own best. For
+        drawing the search (the editor draws them faintly); how many arrive depends on timing.
     cancel : CancelToken or None
         Once a first rectangle exists the search returns the best so far; before that it
         raises :class:`engine.cancel.Cancelled`.
@@ -627,27 +648,31 @@ def _phases(
     def scan(St, vt, rows, shifts, feasible, what, to_rect):
         """``to_rect(positions, shifts)`` -> (n, 4) rects of a phase's scored pairs."""
         sc = _Scan(St, vt, rows, shifts, overlap, lam)
-        top = (np.inf, None)
-        for k0, k1 in sc.chunks():
-            if sweep:
-                c = sc.costs(feasible, k0, k1)
-                flat = _sample(c, sweep)
-                kk, pos = np.unravel_index(flat, c.shape)
-                rects = to_rect(pos, shifts[k0 + kk]) * scale
-                if flat.size and c.flat[flat].min() < top[0]:
-                    i = int(np.argmin(c.flat[flat]))
-                    top = (float(c.flat[flat[i]]), tuple(int(v) for v in rects[i]))
-                if top[1] is not None:
-                    yield TemplateSweep(
-                        phase=what,
-                        round=_round,
-                        coarse=bool(label),
-                        rects=frozen_array(rects),
-                        costs=frozen_array(c.flat[flat]),
-                        best=top[1],
-                        best_cost=top[0],
-                        overlap=overlap * scale,
-                    )
+        top = [np.inf, None]  # the best rectangle the sweep has shown in this phase
+
+        def swept(pos, kk, cost, final=False):
+            rects = to_rect(pos, shifts[kk]) * scale
+            i = int(np.argmin(cost))
+            if cost[i] < top[0] or final:
+                top[:] = [float(cost[i]), tuple(int(v) for v in rects[i])]
+            return TemplateSweep(
+                phase=what,
+                round=_round,
+                coarse=bool(label),
+                rects=frozen_array(rects),
+                costs=frozen_array(cost),
+                best=top[1],
+                best_cost=top[0],
+                overlap=overlap * scale,
+            )
+
+        shown = [-np.inf, 0]  # time of the last sweep event, the shifts it covered
+        for _k0, k1 in sc.chunks():
+            if sweep and time.perf_counter() - shown[0] >= SWEEP_INTERVAL:
+                kk, pos, cost = sc.sampled(feasible, shown[1], k1, sweep)
+                shown[:] = [time.perf_counter(), k1]
+                if cost.size:
+                    yield swept(pos, kk, cost)
             yield Progress(
                 min(prog["done"] + k1, prog["total"]),
                 prog["total"],
@@ -656,7 +681,12 @@ def _phases(
             if is_cancelled(cancel):
                 return None
         prog["done"] += shifts.size
-        return _argmin(sc.costs(feasible), shifts)
+        found = _argmin(sc.costs(feasible), shifts)
+        if sweep and found is not None:  # the phase's own best, what the search goes on with
+            x, a, c = found
+            k = int(np.flatnonzero(shifts == a)[0])
+            yield swept(np.array([x]), np.array([k]), np.array([c]), final=True)
+        return found
 
     def horizontal_rects(r0, r1):
         return lambda x, a: np.stack(

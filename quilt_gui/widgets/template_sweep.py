@@ -7,8 +7,7 @@ scored (:class:`engine.tiles.TemplateSweep`); :class:`SweepItem` draws the recen
 (blue: horizontal phase, pink: vertical; each phase replaces the last), the phase's best so
 far in white, and names the phase. The engine samples, so drawing costs the search
 little (``benchmarks/template_sweep.py`` measures it); the item keeps at most :data:`KEEP`
-rectangles and builds one path per batch of events, at most ~30 a second (the job's delivery
-rate).
+rectangles and redraws at most every :data:`REDRAW_MS` milliseconds.
 """
 
 from __future__ import annotations
@@ -28,6 +27,9 @@ from quilt_gui.widgets.canvas import cosmetic_pen
 
 #: rectangles kept on screen (the most recent ones)
 KEEP = 400
+#: milliseconds between redraws of the sweep at least: each repaints the whole source view,
+#: work the GUI thread would otherwise take from the search (benchmarks/template_sweep.py)
+REDRAW_MS = 100
 PHASE_COLORS = {"horizontal": "#3fc1ff", "vertical": "#ff5fd2"}
 BEST_COLOR = "#ffffff"
 
@@ -56,9 +58,9 @@ class SweepItem(QGraphicsPathItem):
         self.label.setBrush(QColor(BEST_COLOR))
         self.events = 0  # TemplateSweep events received since the search started
         self._last = None
-        self._redraw = QTimer()  # one rebuild per batch of events
+        self._redraw = QTimer()  # one rebuild per REDRAW_MS, however many events came
         self._redraw.setSingleShot(True)
-        self._redraw.setInterval(0)
+        self._redraw.setInterval(REDRAW_MS)
         self._redraw.timeout.connect(self._rebuild)
         self.hide()
 
@@ -89,7 +91,8 @@ class SweepItem(QGraphicsPathItem):
         self.recent.extend((event.phase, tuple(r)) for r in event.rects.tolist())
         self.events += 1
         self._last = event
-        self._redraw.start()
+        if not self._redraw.isActive():
+            self._redraw.start()
 
     def _rebuild(self) -> None:
         last = self._last

@@ -45,7 +45,7 @@ def test_sweep_events_sample_the_scored_rectangles():
     for a, b in zip(sweeps, sweeps[1:], strict=False):
         if (a.phase, a.round) == (b.phase, b.round):
             assert b.best_cost <= a.best_cost
-    # the first horizontal phase ends on the search's first choice of columns
+    # each phase ends with its own best, the search's choice (here the first one's columns)
     first = [e for e in sweeps if (e.phase, e.round) == ("horizontal", 0)][-1]
     assert first.best[0] == updates[0].rect[0] and first.best[2] == updates[0].rect[2]
 
