@@ -301,7 +301,10 @@ def check_folder(
     def fail(code: int, why: str):
         raise OutputError(code, f"cannot {action} {shown}: {why}")
 
-    real = out.resolve()
+    try:
+        real = out.resolve()
+    except (RuntimeError, OSError):  # Python reports a symbolic link loop as RuntimeError
+        fail(errno.ELOOP, "it is a symbolic link loop")
     if real.exists() and _holds(real, Path.cwd().resolve()):
         fail(
             errno.EINVAL,
@@ -309,7 +312,11 @@ def check_folder(
             "whole; choose another folder, or run from its parent folder",
         )
     for p in inputs:
-        if p is not None and _holds(real, Path(os.path.abspath(os.fspath(p))).resolve().parent):
+        try:
+            folder = Path(os.path.abspath(os.fspath(p))).resolve().parent if p else None
+        except (RuntimeError, OSError):  # an input that is a link loop is refused when read
+            folder = None
+        if folder is not None and _holds(real, folder):
             fail(
                 errno.EINVAL,
                 f"it holds the input {os.fspath(p)}, which must never be "

@@ -2,13 +2,15 @@
 signal and warning, never a traceback.
 
 Exit codes: 0 done, 1 refused or failed (the line says why: bad input, bad option, an output
-that cannot be written, not enough memory), 2 bad command line (argparse), 130 interrupted
+that cannot be written, not enough memory; or a bug, reported as an internal error — set
+``QUILT_DEBUG=1`` for its traceback), 2 bad command line (argparse), 130 interrupted
 (Ctrl+C, SIGINT), 143 terminated (SIGTERM). Every output is written atomically, so an error or
 a signal never leaves a half-written file or folder behind.
 """
 
 from __future__ import annotations
 
+import os
 import signal
 import sys
 import threading
@@ -96,7 +98,7 @@ def run_command(args) -> int:
             return 143 if term else 130
         return code
     except (ImageError, ValueError, TypeError, OSError) as exc:  # engine validation errors
-        print(f"{name}: error: {exc}", file=sys.stderr)
+        print(f"{name}: error: {exc or type(exc).__name__}", file=sys.stderr)
         return 1
     except MemoryError:
         print(
@@ -110,3 +112,12 @@ def run_command(args) -> int:
     except KeyboardInterrupt:
         print(f"{name}: interrupted; {kept}", file=sys.stderr)
         return 130
+    except Exception as exc:  # noqa: BLE001 - a bug: one line (QUILT_DEBUG=1 shows where)
+        if os.environ.get("QUILT_DEBUG"):
+            raise
+        print(
+            f"{name}: internal error, please report it: {type(exc).__name__}: {exc} "
+            f"({kept}; QUILT_DEBUG=1 shows the traceback)",
+            file=sys.stderr,
+        )
+        return 1

@@ -305,3 +305,33 @@ def tmpfs(tmp_path):
     yield mount
     for point in mounted:
         subprocess.run(["umount", str(point)], capture_output=True)
+
+
+# ---------------------------------------------------------------- D15: messages
+
+
+def test_d15_output_folder_that_is_a_link_loop(project, tmp_path, capsys):
+    loop = tmp_path / "loop"
+    loop.symlink_to(tmp_path / "loop2")
+    (tmp_path / "loop2").symlink_to(loop)
+    code, err = run(capsys, "export", project, "--out", loop)
+    assert code == 1 and err.strip().endswith(
+        f"cannot export to {loop}: it is a symbolic link loop"
+    )
+
+
+def test_d15_a_bug_is_one_line_naming_it_and_debug_shows_the_traceback(
+    sample, tmp_path, capsys, monkeypatch
+):
+    import engine.cli.seam as seam_cli
+
+    def broken(args):
+        raise KeyError("albedo")
+
+    monkeypatch.setattr(seam_cli, "run", broken)
+    code, err = run(capsys, "seam", sample, sample)
+    assert code == 1 and err.count("\n") == 1
+    assert "quilt-studio seam: internal error, please report it: KeyError: 'albedo'" in err
+    monkeypatch.setenv("QUILT_DEBUG", "1")
+    with pytest.raises(KeyError):
+        main(["seam", str(sample), str(sample)])
