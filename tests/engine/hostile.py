@@ -51,6 +51,34 @@ def peak_traced():
         tracemalloc.stop()
 
 
+def refused_by(read, error, path, reasons, peak_mib: float) -> str:
+    """``read(path)`` raises ``error`` whose message starts with the path and holds every
+    reason, allocating at most ``peak_mib`` MiB (traced) on the way; returns the message."""
+    import pytest
+
+    with peak_traced() as mem, pytest.raises(error) as info:
+        read(path)
+    msg = str(info.value)
+    assert msg.startswith(f"{path}: "), msg
+    for r in reasons:
+        assert r in msg, msg
+    assert mem["peak"] < peak_mib * 2**20, (mem["peak"] / 2**20, msg)
+    return msg
+
+
+def sample_png(folder: Path, name: str = "sample.png"):
+    """The cobblestones sample as an 8-bit PNG in ``folder``; returns (path, uint8 pixels)."""
+    import numpy as np
+
+    import resources
+    from engine.io import load_image
+    from engine.png import encode_png
+
+    q = np.round(load_image(resources.sample_path("cobblestones")).pixels * 255).astype(np.uint8)
+    (folder / name).write_bytes(encode_png(q))
+    return folder / name, q
+
+
 def project_zip(path: Path, doc: dict, entries: dict[str, bytes], *, compress=True) -> Path:
     """A .quiltproj zip holding ``doc`` as project.json and raw ``entries``."""
     method = zipfile.ZIP_DEFLATED if compress else zipfile.ZIP_STORED

@@ -484,32 +484,6 @@ def test_unwritable_system_folder_real():
     assert not Path("/sys/fs/quilt_bundle").exists()
 
 
-@pytest.fixture
-def tmpfs(tmp_path):
-    """Mount small tmpfs file systems under ``tmp_path`` (root only; unmounted afterwards):
-    a real full disk and a real read-only folder, which root's permissions cannot fake."""
-    import subprocess
-
-    if not hasattr(os, "geteuid") or os.geteuid() != 0:
-        pytest.skip("mounting a tmpfs needs root (the permission-based tests cover other users)")
-    mounted = []
-
-    def mount(name: str, options: str) -> Path:
-        point = tmp_path / name
-        point.mkdir()
-        res = subprocess.run(
-            ["mount", "-t", "tmpfs", "-o", options, "tmpfs", str(point)], capture_output=True
-        )
-        if res.returncode:
-            pytest.skip(f"cannot mount a tmpfs here: {res.stderr.decode().strip()}")
-        mounted.append(point)
-        return point
-
-    yield mount
-    for point in mounted:
-        subprocess.run(["umount", str(point)], capture_output=True)
-
-
 def test_real_full_disk_and_read_only_file_system(tmpfs):
     tiles = make_tiles(12, h=64, w=64)  # ~300 kB of PNGs
     full = tmpfs("full", "size=128k")

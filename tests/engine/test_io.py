@@ -1,8 +1,5 @@
 """Image I/O: modes and bit depths kept, exact 16-bit round trips, EXIF orientation, bad input."""
 
-import struct
-import zlib
-
 import numpy as np
 import pytest
 import tifffile
@@ -10,6 +7,7 @@ from PIL import Image
 
 from engine.io import ImageError, load_image, save_image
 from engine.png import encode_png
+from tests.engine.hostile import chunk, png_header
 
 MODES = {1: "L", 2: "LA", 3: "RGB", 4: "RGBA"}
 
@@ -17,20 +15,6 @@ MODES = {1: "L", 2: "LA", 3: "RGB", 4: "RGBA"}
 def random_uint(shape, depth, seed=0):
     rng = np.random.default_rng(seed)
     return rng.integers(0, 2**depth, shape, dtype=np.uint16 if depth == 16 else np.uint8)
-
-
-def chunk(tag, body):
-    return struct.pack(">I", len(body)) + tag + body + struct.pack(">I", zlib.crc32(tag + body))
-
-
-def png_with_header(width, height, depth=8, ctype=2, idat=b""):
-    ihdr = struct.pack(">IIBBBBB", width, height, depth, ctype, 0, 0, 0)
-    return (
-        b"\x89PNG\r\n\x1a\n"
-        + chunk(b"IHDR", ihdr)
-        + chunk(b"IDAT", zlib.compress(idat))
-        + chunk(b"IEND", b"")
-    )
 
 
 # ----------------------------------------------------------------------------- round trips
@@ -167,7 +151,7 @@ def test_truncated(tmp_path, kind):
 
 
 def test_zero_sized(tmp_path):
-    (tmp_path / "zero.png").write_bytes(png_with_header(0, 5))
+    (tmp_path / "zero.png").write_bytes(png_header(0, 5))
     with pytest.raises(ImageError, match=r"zero\.png: the image is zero-sized \(0x5\)"):
         load_image(tmp_path / "zero.png")
 
@@ -182,7 +166,7 @@ def test_over_the_pixel_limit(tmp_path):
         load_image(tmp_path / "big.png", max_pixels=1000)
     assert load_image(tmp_path / "big.png", max_pixels=1200).pixels.shape == (30, 40, 3)
     # a bomb: 50000 x 50000 declared, a few bytes of data; refused before decoding
-    (tmp_path / "bomb.png").write_bytes(png_with_header(50000, 50000, idat=b"\x00" * 100))
+    (tmp_path / "bomb.png").write_bytes(png_header(50000, 50000, idat=b"\x00" * 100))
     with pytest.raises(ImageError, match=r"bomb\.png: 50000x50000 .* decompression bomb"):
         load_image(tmp_path / "bomb.png")
     tifffile.imwrite(tmp_path / "big16.tif", np.zeros((30, 40, 3), np.uint16), photometric="rgb")

@@ -17,7 +17,7 @@ from PIL import Image
 
 from engine.io import MAX_FILE_BYTES, ImageError, ImageWarning, load_image
 from engine.png import encode_png
-from tests.engine.hostile import cli, peak_traced, png_header
+from tests.engine.hostile import cli, png_header, refused_by
 
 MiB = 2**20
 
@@ -25,14 +25,7 @@ MiB = 2**20
 def refused(path, *reasons, peak_mib: float = 8):
     """load_image(path) raises ImageError naming the file and every reason, allocating at most
     ``peak_mib`` MiB on the way."""
-    with peak_traced() as mem, pytest.raises(ImageError) as info:
-        load_image(path)
-    msg = str(info.value)
-    assert msg.startswith(f"{path}: "), msg
-    for r in reasons:
-        assert r in msg, msg
-    assert mem["peak"] < peak_mib * MiB, (mem["peak"], msg)
-    return msg
+    return refused_by(load_image, ImageError, path, reasons, peak_mib)
 
 
 # ---------------------------------------------------------------- not regular files (D4, D12)

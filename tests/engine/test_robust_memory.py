@@ -9,11 +9,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import resources
 from engine.cli import main
-from engine.io import load_image
 from engine.png import encode_png
-from tests.engine.hostile import cli
+from tests.engine.hostile import cli, sample_png
 
 GiB = 2**30
 
@@ -21,9 +19,7 @@ GiB = 2**30
 @pytest.fixture(scope="module")
 def files(tmp_path_factory):
     d = tmp_path_factory.mktemp("mem")
-    S = load_image(resources.sample_path("cobblestones")).pixels
-    q = np.round(S * 255).astype(np.uint8)
-    (d / "s.png").write_bytes(encode_png(q))
+    _, q = sample_png(d, "s.png")
     mask = np.zeros(q.shape[:2], np.uint8)
     mask[200:260, 200:260] = 255
     (d / "m.png").write_bytes(encode_png(mask))

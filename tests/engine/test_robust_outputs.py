@@ -281,32 +281,6 @@ def test_d17_min_block_larger_than_block(sample, tmp_path, capsys):
     assert not (tmp_path / "o.png").exists()
 
 
-# ---------------------------------------------------------------- the tmpfs fixture
-
-
-@pytest.fixture
-def tmpfs(tmp_path):
-    """Mount a small tmpfs under ``tmp_path`` (root only; unmounted afterwards)."""
-    if not hasattr(os, "geteuid") or os.geteuid() != 0:
-        pytest.skip("mounting a tmpfs needs root")
-    mounted = []
-
-    def mount(name: str, options: str):
-        point = tmp_path / name
-        point.mkdir()
-        res = subprocess.run(
-            ["mount", "-t", "tmpfs", "-o", options, "tmpfs", str(point)], capture_output=True
-        )
-        if res.returncode:
-            pytest.skip(f"cannot mount a tmpfs here: {res.stderr.decode().strip()}")
-        mounted.append(point)
-        return point
-
-    yield mount
-    for point in mounted:
-        subprocess.run(["umount", str(point)], capture_output=True)
-
-
 # ---------------------------------------------------------------- D15: messages
 
 

@@ -18,10 +18,10 @@ from engine.project import ProjectError, load_project
 from tests.engine.hostile import (
     candidate,
     cli,
-    peak_traced,
     png_header,
     project_doc,
     project_zip,
+    refused_by,
 )
 
 MiB = 2**20
@@ -29,14 +29,7 @@ SMALL = encode_png(np.zeros((8, 8, 3), np.uint8))
 
 
 def refused(path, *reasons, peak_mib: float = 16) -> str:
-    with peak_traced() as mem, pytest.raises(ProjectError) as info:
-        load_project(path)
-    msg = str(info.value)
-    assert msg.startswith(f"{path}: "), msg
-    for r in reasons:
-        assert r in msg, msg
-    assert mem["peak"] < peak_mib * MiB, (mem["peak"] / MiB, msg)
-    return msg
+    return refused_by(load_project, ProjectError, path, reasons, peak_mib)
 
 
 # ---------------------------------------------------------------- D1: amplification

@@ -16,24 +16,25 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import resources
 from engine._fs import check_folder
 from engine.cli import main
 from engine.cli.tileset_output import tileset_files
 from engine.export import bundle_files
-from engine.io import load_image
 from engine.png import decode_png, encode_png
 from engine.project import project_from_tileset, save_project
-from tests.engine.hostile import SIGNALS, signal_and_wait, start_cli, wait_for_line
+from tests.engine.hostile import (
+    SIGNALS,
+    sample_png,
+    signal_and_wait,
+    start_cli,
+    wait_for_line,
+)
 
 
 @pytest.fixture(scope="module")
 def inputs(tmp_path_factory):
     d = tmp_path_factory.mktemp("inputs")
-    S = load_image(resources.sample_path("cobblestones")).pixels
-    q = np.round(S * 255).astype(np.uint8)
-    (d / "sample.png").write_bytes(encode_png(q))
-    (d / "small.png").write_bytes(encode_png(q[:96, :96]))
+    _, q = sample_png(d)
     mask = np.zeros(q.shape[:2], np.uint8)
     mask[150:350, 150:350] = 255
     (d / "mask.png").write_bytes(encode_png(mask))
