@@ -140,4 +140,6 @@ def save_project_option(args, *, into=None, **project_kwargs) -> None:
     from engine.project import project_from_tileset, save_project
 
     save_project(into or path, project_from_tileset(**project_kwargs))
-    print(f"quilt-studio {args.command}: wrote project {path}", file=sys.stderr)
+    print(
+        f"quilt-studio {getattr(args, 'command', 'tileset')}: wrote project {path}", file=sys.stderr
+    )
