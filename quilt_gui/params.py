@@ -186,9 +186,20 @@ def output_shape(p: dict, source_shape) -> tuple[int, int]:
     )
 
 
+#: the settings fields :func:`tileset_settings` makes from parameters of other names
+_SET_HERE = {"tile_size", "tile_min", "tile_max", "overlap", "seam", "template_blend"}
+_SET_HERE |= {"patch_size", "patch_overlap", "preview", "exclude_color"}
+#: the settings fields no editor parameter shows: a project's values of them are kept under
+#: this key of the parameters and used as they are (an option added to TilesetSettings before
+#: the editor has a control for it still travels from the command line to the editor and back)
+KEPT = "tileset_kept"
+KEPT_FIELDS = _FIELDS - _SET_HERE - {_RENAMED.get(k, k) for k in BY_KEY}
+
+
 def tileset_settings(p: dict, shape=None) -> TilesetSettings:
     """The :class:`engine.tiles.TilesetSettings` of the editor's parameters ``p`` (``shape``
     (H, W) of the source settles the Auto tile size; without it Auto searches a range)."""
+    base = settings_from_parameters({"tileset": p.get(KEPT) or {}})
     values = {_RENAMED.get(k, k): p[k] for k in BY_KEY if _RENAMED.get(k, k) in _FIELDS}
     lo, hi = p["tile_min"] or None, p["tile_max"] or None
     if lo is not None and hi is not None:
@@ -205,7 +216,7 @@ def tileset_settings(p: dict, shape=None) -> TilesetSettings:
         preview=(p["preview_rows"], p["preview_cols"]),
         exclude_color=colour_range_around(p["exclude_color"], p["exclude_tolerance"]),
     )
-    return TilesetSettings(**values)
+    return base.replace(**values)
 
 
 def settings_params(s: TilesetSettings) -> dict:
@@ -251,7 +262,7 @@ def project_parameters(p: dict, shape=None) -> dict:
     editor's own parameters."""
     return {
         "tileset": tileset_settings(p, shape).to_dict(),
-        "editor": {k: v for k, v in p.items() if k not in TILESET_KEYS},
+        "editor": {k: v for k, v in p.items() if k not in TILESET_KEYS and k != KEPT},
     }
 
 
@@ -264,6 +275,8 @@ def from_project_parameters(parameters: dict, seeds: dict | None = None) -> dict
     for k, v in settings_params(settings).items():
         with contextlib.suppress(TypeError, ValueError):
             out[k] = BY_KEY[k].coerce(v)
+    values = settings.to_dict()
+    out[KEPT] = {f: values[f] for f in sorted(KEPT_FIELDS)}
     if isinstance(own, dict) and own.get("tile_size") == AUTO:
         out["tile_size"] = AUTO  # the settings hold the size Auto chose for that source
     return out

@@ -155,6 +155,7 @@ class Pipeline(QObject):
             doc.source.main,
             label="Finding the best tile",
             exclusion=self.exclusion(),
+            flatten=self.flatten_scale(),
             tile_min=lo,
             tile_max=hi,
             overlap=s.overlap or doc.tileset.overlap(),
@@ -213,6 +214,7 @@ class Pipeline(QObject):
             overlap=doc.tileset.overlap(),
             waypoints=wps or None,
             seam=self.seam_spec(),
+            flatten=self.flatten_scale(),
             **self._maps(),
         )
         inputs = (
@@ -248,7 +250,7 @@ class Pipeline(QObject):
         self._seamless_pending = inputs
         self.jobs.start(
             "seamless",
-            iter_make_seamless,
+            flattening(iter_make_seamless),
             *args,
             label="Stitching the tile",
             on_event=self._on_seamless_event,
@@ -280,6 +282,14 @@ class Pipeline(QObject):
         """The tile set's :class:`engine.tiles.TilesetSettings`, from the parameters."""
         return self.doc.tileset.settings()
 
+    def flatten_scale(self) -> int | None:
+        """The scale the tiles' source is flattened at (TilesetSettings.flatten), or None."""
+        from engine.tiles.pipeline import flatten_scale_for
+
+        if self.doc.source is None:
+            return None
+        return flatten_scale_for(self.settings(), self.doc.source.shape)
+
     def seam_spec(self):
         """The seamless tile's cut (the candidates' is ``settings().seam``)."""
         return self.settings().template_seam
@@ -298,9 +308,12 @@ class Pipeline(QObject):
         s = self.settings()
         return dict(
             exclusion=self.exclusion(),
+            flatten=self.flatten_scale(),
             patch_size=s.patch_size,
             patch_overlap=s.patch_overlap,
             margin=s.margin,
+            patch_search=s.patch_search,
+            min_distance=s.min_distance,
             seam=s.seam,
             **self._maps(),
         )
@@ -657,13 +670,34 @@ def _job_mask(sample, exclusion):
 
 def excluding(fn):
     """``fn(source, *args, excluded=mask, **options)`` as a job body taking ``exclusion``
-    (:meth:`Pipeline.exclusion`): the mask is built in the worker, not the GUI thread."""
+    (:meth:`Pipeline.exclusion`) and ``flatten`` (:meth:`Pipeline.flatten_scale`): the mask
+    (from the source's own colours) and the flattened source are made in the worker."""
 
-    def job(source, *args, exclusion, **options):
-        return fn(source, *args, excluded=_job_mask(source, exclusion), **options)
+    def job(source, *args, exclusion, flatten=None, **options):
+        mask = _job_mask(source, exclusion)
+        return fn(_flattened(source, flatten), *args, excluded=mask, **options)
 
     job.__name__ = job.__qualname__ = f"excluding_{fn.__name__}"
     return job
+
+
+def flattening(fn):
+    """``fn(source, ...)`` as a job body taking ``flatten`` (:meth:`Pipeline.flatten_scale`):
+    the source's lighting is flattened in the worker first when it is a scale."""
+
+    def job(source, *args, flatten=None, **options):
+        return fn(_flattened(source, flatten), *args, **options)
+
+    job.__name__ = job.__qualname__ = f"flattening_{fn.__name__}"
+    return job
+
+
+def _flattened(source, scale):
+    if scale is None:
+        return source
+    from engine.tone import flatten_lighting
+
+    return flatten_lighting(source, scale=scale)
 
 
 def quilt_job(sample, out_shape, *, exclusion, cancel=None, **options):

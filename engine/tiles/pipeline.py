@@ -26,7 +26,15 @@ from engine.tiles.layout import assemble_maps, random_layout
 from engine.tiles.seamless import MAIN, SeamlessTile, iter_make_seamless
 from engine.tiles.template import default_overlap, iter_find_template, template_cost
 
-__all__ = ["TilesetResult", "TilesetSettings", "iter_tileset", "resolve", "tileset"]
+__all__ = [
+    "TilesetResult",
+    "TilesetSettings",
+    "flatten_scale_for",
+    "iter_tileset",
+    "resolve",
+    "tileset",
+    "working_source",
+]
 
 
 @dataclass(frozen=True)
@@ -113,14 +121,32 @@ def iter_tileset(
     return _iter_tileset(source, s, rect, maps, weights, excluded, picks, workers, cancel)
 
 
+def flatten_scale_for(settings: TilesetSettings, shape) -> int | None:
+    """The scale (px) :func:`engine.tone.flatten_lighting` flattens at for a source of
+    ``shape`` (from the largest tile side), None without ``settings.flatten``."""
+    if not settings.flatten:
+        return None
+    from engine.tone import flatten_scale
+
+    return flatten_scale(settings.tile_range(shape)[1])
+
+
+def working_source(source, settings: TilesetSettings):
+    """The image the tiles are taken from: ``source``, or with ``settings.flatten`` the source
+    with its large-scale lighting flattened (:mod:`engine.tone`; the albedo only: material
+    maps are never relit)."""
+    scale = flatten_scale_for(settings, np.shape(source)[:2])
+    if scale is None:
+        return source
+    from engine.tone import flatten_lighting
+
+    return flatten_lighting(source, scale=scale)
+
+
 def _iter_tileset(source, s, rect, maps, weights, excluded, picks, workers, cancel):
     H, W = np.shape(source)[:2]
     notes: list[str] = []
-    if s.flatten:  # the albedo only: material maps are never relit
-        from engine.tone import flatten_lighting, flatten_scale
-
-        scale = flatten_scale(s.tile_range((H, W))[1])  # the largest tile side
-        source = flatten_lighting(source, scale=scale)
+    source = working_source(source, s)
     if rect is not None:
         overlap = s.overlap or default_overlap((rect[3], rect[2]))
         cost = template_cost(

@@ -43,6 +43,9 @@ FLAGS = {
     "--neighbourhood": "2",
     "--preview": "3x4",
     "--exclude-color": "0,0,0:0.12,0.12,0.12",
+    "--patch-search": "local",  # the editor has no control for these three yet: they are
+    "--min-distance": "7",  # kept with the project and used as they are
+    "--flatten": None,
 }
 
 
@@ -54,7 +57,9 @@ def _q(pixels):
 def _argv(flags: dict) -> list[str]:
     out = []
     for flag, value in flags.items():
-        for v in value if isinstance(value, list) else [value]:
+        if value is None:  # a switch
+            out.append(flag)
+        for v in value if isinstance(value, list) else [] if value is None else [value]:
             out += [flag, v]
     return out
 
@@ -81,6 +86,7 @@ def test_cli_project_with_every_option_reopens_in_the_editor_with_all_of_them(qt
     proj, manifest = _cli_project(tmp_path)
     cli = load_project(proj)
     settings = TilesetSettings.from_dict(manifest["resolved"])
+    assert settings.flatten and settings.patch_search == "local" and settings.min_distance == 7
     assert settings.seam == SeamSpec(
         "oscillating",
         {"o_max": 5, "variant": "faithful", "init": "argmin"},
