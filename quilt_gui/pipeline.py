@@ -214,13 +214,13 @@ class Pipeline(QObject):
             overlap=doc.tileset.overlap(),
             waypoints=wps or None,
             seam=self.seam_spec(),
-            flatten=self.flatten_scale(),
             **self._maps(),
         )
         inputs = (
             doc.tileset.template_rect,
             tuple(sorted((k, repr(v)) for k, v in kwargs.items() if k != "maps")),
             tuple(doc.source.extra_maps),
+            self.flatten_scale(),
         )
         return (doc.source.main, doc.tileset.template_rect), kwargs, inputs
 
@@ -252,6 +252,7 @@ class Pipeline(QObject):
             "seamless",
             flattening(iter_make_seamless),
             *args,
+            flatten=inputs[-1],
             label="Stitching the tile",
             on_event=self._on_seamless_event,
             on_done=self._on_seamless_done,
