@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.fft as sfft
@@ -43,8 +43,9 @@ __all__ = [
 ]
 
 AUTO_EXACT_SECONDS = 10.0
-"""``mode="auto"`` searches exhaustively when that is estimated to take at most this long (or
-no longer than the fast search), else it takes the coarse-to-fine search."""
+"""``mode="auto"`` searches exhaustively when the cost model (at the development machine's
+speed, whatever this machine's load) gives it at most this long or no longer than the fast
+search, else it takes the coarse-to-fine search."""
 
 SEARCH_BUDGET = 2 * 2**30
 """Memory the run plans to stay under (bytes): above it an exact search works on tiles of the
@@ -169,7 +170,8 @@ def _fft_shape(h: int, w: int) -> tuple[int, int]:
 def _fft_query_seconds(shape, channels: int) -> float:
     hp, wp = _fft_shape(*shape)
     n = hp * (wp // 2 + 1)
-    return FFT_NS * channels * n * math.log2(n)
+    cache = 1 + max(0.0, math.log2(n) - 21) / 2  # past a few MB the transforms wait on memory
+    return FFT_NS * channels * n * math.log2(n) * cache
 
 
 def spectra_bytes(shape, channels: int) -> int:
@@ -208,7 +210,6 @@ def plan(
         n_blocks = len(grid_rects(opts["out_shape"], opts["block"], ov, opts["tileable"]))
     conc = max(1, threads)
     gain = min(conc, THREAD_GAIN) if conc > 1 else 1.0
-    factor = machine_factor()
     overlap_px = (bh * bw) if terms == "block" else (bh * ov + bw * ov - ov * ov)
 
     # what every run holds: the canvas, masks, records and streamed pixels, the sample copy
@@ -224,7 +225,7 @@ def plan(
     )
 
     def finish(mode, search, levels, seconds, peak):
-        secs = (place + seconds) * factor / gain
+        secs = (place + seconds) / gain  # the model's seconds; shown scaled by the machine
         return Plan(mode, search, levels, n_blocks, secs, int(fixed + peak))
 
     if opts["select"] in ("random", "bhatia"):
@@ -274,9 +275,12 @@ def plan(
 
     as_exact = finish("exact", exact[0], 0, exact[1], exact[2])
     as_fast = finish("fast", fast[0], fast[1], fast[2], fast[3])
+    chosen = as_exact if opts["mode"] == "exact" else as_fast
     if opts["mode"] == "auto":
+        # decided on the model alone, never on the machine's load: the same inputs always take
+        # the same search (and so give the same output for a seed)
         cheap = exact[0] == "fft" and (
             as_exact.seconds <= AUTO_EXACT_SECONDS or as_exact.seconds <= as_fast.seconds
         )
-        return as_exact if cheap else as_fast
-    return as_exact if opts["mode"] == "exact" else as_fast
+        chosen = as_exact if cheap else as_fast
+    return replace(chosen, seconds=chosen.seconds * machine_factor())
