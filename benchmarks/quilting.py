@@ -44,7 +44,7 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from benchmarks import quilting_large  # noqa: E402
-from benchmarks._util import format_table, median_time  # noqa: E402
+from benchmarks._util import format_table, median_time, provenance  # noqa: E402
 from engine.errormap import error_map  # noqa: E402
 from engine.io import load_image  # noqa: E402
 from engine.matching import ZERO_ERROR_FRACTION, error_floor, select_within_tolerance  # noqa: E402
@@ -428,7 +428,7 @@ def main(argv=None) -> int:
     args.large_jobs = [j.strip().upper() for j in args.large_jobs.split(",") if j.strip()]
     out = io.StringIO()
     with contextlib.redirect_stdout(_Tee(sys.stdout, out)):
-        print(f"{_provenance()}\npython -m benchmarks.quilting {' '.join(argv or sys.argv[1:])}\n")
+        print(f"{provenance()}\npython -m benchmarks.quilting {' '.join(argv or sys.argv[1:])}\n")
         if not args.skip_speed:
             speed(args)
             streaming(args)
@@ -461,25 +461,3 @@ class _Tee:
     def flush(self) -> None:
         for s in self.streams:
             s.flush()
-
-
-def _provenance() -> str:
-    """Date, commit and machine load, for the first line of the results file."""
-    import datetime
-    import subprocess
-
-    try:
-        commit = subprocess.run(
-            ["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, check=True
-        ).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        commit = "unknown"
-    load = ", ".join(f"{v:.1f}" for v in os.getloadavg())
-    return (
-        f"# measured {datetime.date.today()} on this {os.cpu_count()}-core machine at commit "
-        f"{commit}; load average {load}"
-    )
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

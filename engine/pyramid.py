@@ -131,6 +131,15 @@ def reduce_target(target: np.ndarray, weights: np.ndarray, group_of: np.ndarray)
 
 
 @njit(cache=True, nogil=True)
+def _weighs(weights, u, v) -> bool:  # pragma: no cover - compiled
+    """Whether pixel (u, v) has a nonzero weight in any channel."""
+    for ch in range(weights.shape[2]):  # noqa: SIM110 (numba: no generator in any())
+        if weights[u, v, ch] != 0:
+            return True
+    return False
+
+
+@njit(cache=True, nogil=True)
 def _gather_weighted_ssd(sample, anchors, weights, target, out):  # pragma: no cover - compiled
     """out[k] = Σ_{u, v, c} weights[u, v, c] (sample[anchor k + (u, v), c] − target[u, v, c])²
     in float64, summed row-major over the pixels of nonzero weight, channels innermost (for
@@ -145,22 +154,12 @@ def _gather_weighted_ssd(sample, anchors, weights, target, out):  # pragma: no c
     for u in range(h):
         v = 0
         while v < w:
-            nz = False
-            for ch in range(c):
-                if weights[u, v, ch] != 0:
-                    nz = True
-            if not nz:
+            if not _weighs(weights, u, v):
                 v += 1
                 continue
             v1 = v
             start = nv
-            while v1 < w:
-                nz = False
-                for ch in range(c):
-                    if weights[u, v1, ch] != 0:
-                        nz = True
-                if not nz:
-                    break
+            while v1 < w and _weighs(weights, u, v1):
                 for ch in range(c):
                     wts[nv] = weights[u, v1, ch]
                     vals[nv] = target[u, v1, ch]
