@@ -24,12 +24,12 @@ all positions. Per block this costs one query of a ≤ ``COARSE_AREA`` sample pl
 ``keep × 9`` exact SSDs per level: independent of the sample's area beyond the pyramid's
 construction (linear, once) and its memory (a third of the sample's).
 
-Why this search (measured in ``benchmarks/quilting.py``, README): PatchMatch-style propagation
-alone keeps copying the neighbours' continuations (its random search finds little in 16 M
-positions per block), and the principal-component index of the fast mode stores K numbers per
-sample position (1.6 GB at 4096², K = 24) and scans them all per block. The pyramid's top level is
-a small exhaustive search, so no region of the sample is missed, and its candidates are exact
-after re-ranking.
+Why this search (README, "How the large search works and why"): the principal-component index
+of the fast mode stores K numbers per sample position (1.6 GB at 4096², K = 24) and scans them all
+per block, so it grows with the area; the pyramid's top level is a small exhaustive search, so no
+region of the sample is missed, and its candidates are exact after re-ranking. The measured
+choices (the 2-pixel floor of the overlap, 128 top-level places, 3 × 3 children) are in the
+README.
 """
 
 from __future__ import annotations

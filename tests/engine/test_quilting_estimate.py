@@ -59,15 +59,21 @@ def test_small_samples_stay_exact_in_auto():
     assert res.params["mode"] == "exact" and res.params["search"] == "fft"
 
 
+@pytest.fixture(scope="module")
+def warm():
+    """Every search's kernels loaded before memory is traced (numba's loading allocates)."""
+    s = smooth_texture((300, 300))
+    for mode in ("exact", "fast"):
+        quilt(s, (100, 100), block=32, overlap=6, mode=mode, rng=0, threads=2)
+
+
 @pytest.mark.parametrize(
     "size, out, mode, threads",
-    [(600, 300, "fast", 2), (600, 300, "exact", 2), (1200, 300, "fast", 1), (400, 256, "exact", 1)],
+    [(600, 300, "fast", 2), (600, 300, "exact", 2), (1200, 300, "fast", 1)],
 )
-def test_peak_memory_estimate_matches_tracemalloc(size, out, mode, threads):
+def test_peak_memory_estimate_matches_tracemalloc(warm, size, out, mode, threads):
     """Stated tolerance: the traced peak lies within 60-125 % of the estimate (numpy's
     allocations are traced; the estimate also counts a fixed 2 MiB for what is not)."""
-    warm = smooth_texture((300, 300))
-    quilt(warm, (100, 100), block=32, overlap=6, mode=mode, rng=0, threads=threads)  # numba
     s = smooth_texture((size, size), seed=1)
     tracemalloc.start()
     try:
