@@ -7,9 +7,10 @@ Run through ``python -m benchmarks.quilting`` (``--skip-large``, ``--large-quali
   first, then ``--repeats`` timed runs), so its peak resident memory (``VmHWM``: the whole
   process, interpreter, sample and run) is the job's own. Jobs: L4 — 2048² from a 4096² photo,
   block 96, overlap 16, best + dp, ``mode="auto"`` (target ≤ 15 s, ≤ 2 GB); L8 — the same from
-  an 8192² photo (≤ 30 s, ≤ 2 GB); T4 — texture transfer of a 1024² target from a 4096² sample,
-  3 passes from block 64 (≤ 30 s). The "photo" is the bundled cobblestones photo upscaled
-  (bilinear); the plan's estimate is printed beside the measured figures.
+  an 8192² photo (≤ 30 s, ≤ 2 GB); T4 — texture transfer of a 1024² target (the cat photo's
+  fur) from a 4096² sample, 3 passes from block 96 (the quilting jobs' block; 96, 64, 43 px:
+  1371 blocks; ≤ 30 s). The "photo" is the bundled cobblestones photo upscaled (bilinear); the
+  plan's estimate is printed beside the measured figures.
 * **Quality** (``--quality``): the grid border ratio of ``auto`` (the coarse-to-fine search at
   this size) against the exhaustive search's, on every bundled sample and two real photos
   (scikit-image's coffee: the wooden table; chelsea: the cat's fur) upscaled to 4096², with
@@ -119,7 +120,7 @@ def worker(spec: dict) -> dict:
             ratio = block_grid_border_ratio(res)
         else:
             target = np.load(sample_file("chelsea-fur", spec["out"]))
-            gen = iter_transfer(sample, target, block=64, iterations=3, rng=k, mode="auto")
+            gen = iter_transfer(sample, target, block=BLOCK, iterations=3, rng=k, mode="auto")
             drain(gen, keep_plan)
         times.append(time.perf_counter() - t0)
     plan = plans[0]
@@ -170,7 +171,7 @@ def large(args) -> None:
         what = (
             f"{job['out']}² from {job['side']}², block {BLOCK}, overlap {OVERLAP}"
             if job["kind"] == "quilt"
-            else f"transfer {job['out']}² from {job['side']}², 3 passes from block 64"
+            else f"transfer {job['out']}² from {job['side']}², 3 passes from block {BLOCK}"
         )
         met = t <= job["target_s"] and (job["kind"] == "transfer" or rss <= TARGET_BYTES)
         rows.append(
