@@ -228,9 +228,6 @@ class PyramidSearch:
         Reductions (:func:`pyramid_levels`); must be >= 1.
     groups : sequence of sequences of int, optional
         Channel groups sharing one weight map (as :class:`engine.matching.SampleSpectrum`).
-    valid : (H - bh + 1, W - bw + 1) bool ndarray, optional
-        Anchors a full block may use (None: all); blocks of other shapes get theirs from
-        ``valid_for``.
     keep : int
         Candidates kept per level (coarse places, then the best child of each).
     workers : int
@@ -248,6 +245,22 @@ class PyramidSearch:
         self.levels = [s]
         for _ in range(levels):
             self.levels.append(box_reduce(self.levels[-1]))
+        self._setup(groups, keep, coarse_keep, workers)
+
+    def shallower(self, levels: int) -> PyramidSearch:
+        """The same pyramid searched from level ``levels`` (<= :attr:`depth`): the levels are
+        shared, only the top level's spectrum is new (texture transfer's passes, whose blocks
+        shrink, reuse one pyramid)."""
+        if not 1 <= levels <= self.depth:
+            raise ValueError(f"levels must lie in 1..{self.depth}, got {levels}")
+        if levels == self.depth:
+            return self
+        out = object.__new__(PyramidSearch)
+        out.levels = self.levels[: levels + 1]
+        out._setup(self.coarse.groups, self.keep, self.coarse_keep, self.coarse.workers)
+        return out
+
+    def _setup(self, groups, keep, coarse_keep, workers) -> None:
         self.coarse = SampleSpectrum(self.levels[-1], groups=groups, workers=workers)
         self.group_of = self.coarse.group_of
         self.n_groups = len(self.coarse.groups)

@@ -40,6 +40,7 @@ from engine.cancel import check
 from engine.errormap import colour_channels
 from engine.events import Progress, Snapshot, drain
 from engine.matching import ZERO_ERROR_FRACTION, error_floor
+from engine.pyramid import PyramidSearch
 from engine.quilting.core import BlockWork, Quilter
 from engine.quilting.estimate import Estimated, check_plan, plan
 from engine.quilting.layout import grid_rects
@@ -138,18 +139,36 @@ def _check_alpha(alpha):
 class _TransferQuilter(Quilter):
     """One transfer pass: the quilting engine with the α-weighted three-term cost."""
 
-    def __init__(self, *, corr_sample, corr_target, previous, alpha, corr_floor, **kw):
+    def __init__(self, *, corr_sample, corr_target, previous, alpha, corr_floor, shared, **kw):
         super().__init__(**kw)
         self.corr_sample = corr_sample
         self.corr_target = corr_target
         self.previous = previous
         self.alpha = alpha
         self.corr_floor = corr_floor
+        self.shared = shared  # what every pass searches alike: stack, floor, pyramid
+        self.floor = shared.get("floor", 0.0)
+
+    def prepare(self) -> None:
+        super().prepare()
+        self.shared["floor"] = self.floor
 
     def search_sample(self):
         c = self.match_sample.shape[2]
-        stack = np.concatenate([self.match_sample, self.corr_sample[:, :, None]], axis=2)
-        return stack, (tuple(range(c)), (c,))
+        if "stack" not in self.shared:
+            self.shared["stack"] = np.concatenate(
+                [self.match_sample, self.corr_sample[:, :, None]], axis=2
+            )
+        return self.shared["stack"], (tuple(range(c)), (c,))
+
+    def make_pyramid(self):
+        """One pyramid, as deep as the deepest pass needs, shared by the passes."""
+        if "pyramid" not in self.shared:
+            stack, groups = self.search_sample()
+            self.shared["pyramid"] = PyramidSearch(
+                stack, levels=self.shared["levels"], groups=groups, workers=self.threads
+            )
+        return self.shared["pyramid"].shallower(self.plan.levels)
 
     def load(self, wk: BlockWork) -> None:
         super().load(wk)
@@ -354,6 +373,7 @@ def _iter_transfer(s, t, plans, passes, total, sched, kind, sigma, seed, cancel,
     corr_s = correspondence_map(s, kind=kind, sigma=sigma)
     corr_t = correspondence_map(t, kind=kind, sigma=sigma)
     corr_floor = error_floor(corr_s[:, :, None])
+    shared = {"levels": max(p.levels for p in passes)}
     previous = None
     done_iters = []
     records: tuple = ()
@@ -368,6 +388,7 @@ def _iter_transfer(s, t, plans, passes, total, sched, kind, sigma, seed, cancel,
             previous=previous,
             alpha=a,
             corr_floor=corr_floor,
+            shared=shared,
             seed=it_seed,
             cancel=cancel,
             threads=threads,

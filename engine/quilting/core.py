@@ -74,7 +74,7 @@ class Quilter:
         self.match_sample = np.ascontiguousarray(colour_channels(sample))
         self.canvas = np.zeros((*out_shape, sample.shape[2]), np.float32)
         self.filled = np.zeros(out_shape, dtype=bool)
-        self.floor = 0.0  # error_floor, measured in prepare (after the plan is out)
+        self.floor = 0.0  # error_floor, measured in prepare (after the plan is out) if not given
         self._valid: dict[tuple[int, int], tuple[np.ndarray | None, np.ndarray]] = {}
         self._spectrum = None
         self._pca = None
@@ -85,14 +85,11 @@ class Quilter:
 
     def prepare(self) -> None:
         """Build the structures every search shares (before any thread reads them)."""
-        self.floor = error_floor(self.match_sample)
+        self.floor = self.floor or error_floor(self.match_sample)
         if self.select != "best":
             return
         if self.plan.search == "pyramid":
-            stack, groups = self.search_sample()
-            self._pyramid = PyramidSearch(
-                stack, levels=self.plan.levels, groups=groups, workers=self.threads
-            )
+            self._pyramid = self.make_pyramid()
             self.origin = np.full((*self.out_shape, 2), -1, np.int32)
             return
         _ = self.spectrum
@@ -123,6 +120,10 @@ class Quilter:
         if self.plan.search == "tiled fft":
             return TiledSpectrum(stack, groups=groups, workers=self.threads, tile=TILE)
         return SampleSpectrum(stack, groups=groups, workers=self.threads)
+
+    def make_pyramid(self) -> PyramidSearch:
+        stack, groups = self.search_sample()
+        return PyramidSearch(stack, levels=self.plan.levels, groups=groups, workers=self.threads)
 
     def search_sample(self) -> tuple[np.ndarray, tuple | None]:
         """The channels the search matches and their groups (None: one group): the colours."""
