@@ -59,8 +59,8 @@ class Quilter:
     :func:`engine.quilting.scheduler.run_levels` drives it: :meth:`prepare` once, then per
     batch of blocks :meth:`run_batch`: :meth:`load` (read the canvas under them), :meth:`search`
     and :meth:`place` (choose, cut, paste), on any thread. Texture transfer subclasses it and
-    overrides :meth:`search_sample`, :meth:`load`, :meth:`zero_level_for` and :meth:`search`
-    (its α-weighted cost).
+    overrides :meth:`search_sample`, :meth:`make_pyramid`, :meth:`load`, :meth:`zero_level_for`
+    and :meth:`search` (its α-weighted cost).
     """
 
     def __init__(self, *, seed: int, cancel, threads: int, plan: Plan, **options):
