@@ -49,6 +49,10 @@ from engine.quilting.records import BlockRecord
 from engine.quilting.scheduler import run_levels
 
 CORRESPONDENCES = ("luminance", "blurred")
+PYRAMID_KEEP = 12
+"""Candidates the coarse-to-fine search carries per level in transfer (quilting: 24). Every
+pixel of a transfer block weighs in its exact re-ranking, so each candidate costs the whole
+block; the correspondence term is smooth, and half the candidates give the same result."""
 
 __all__ = [
     "CORRESPONDENCES",
@@ -166,7 +170,11 @@ class _TransferQuilter(Quilter):
         if "pyramid" not in self.shared:
             stack, groups = self.search_sample()
             self.shared["pyramid"] = PyramidSearch(
-                stack, levels=self.shared["levels"], groups=groups, workers=self.threads
+                stack,
+                levels=self.shared["levels"],
+                groups=groups,
+                keep=PYRAMID_KEEP,
+                workers=self.threads,
             )
         return self.shared["pyramid"].shallower(self.plan.levels)
 
