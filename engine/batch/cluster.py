@@ -43,6 +43,20 @@ def connect(address: str):
         raise ClusterError(f"cannot reach the Dask scheduler at {address}: {exc}") from None
 
 
+def local_cluster(workers: int = 2):
+    """A ``distributed.LocalCluster`` of ``workers`` single-threaded worker processes on the
+    loopback address: what the tests and the benchmark run the batch on."""
+    from distributed import LocalCluster
+
+    return LocalCluster(
+        n_workers=workers,
+        threads_per_worker=1,
+        processes=True,
+        host="127.0.0.1",
+        dashboard_address=":0",  # a free port: several clusters may run at once
+    )
+
+
 def _threads(client) -> int:
     workers = client.scheduler_info().get("workers", {})
     return max(1, sum(int(w.get("nthreads", 1)) for w in workers.values()))

@@ -41,6 +41,7 @@ from quilt_gui import jobs
 SORT_ROLE = Qt.ItemDataRole.UserRole + 1
 ENTRY_ROLE = Qt.ItemDataRole.UserRole + 2
 THUMB = 64
+NOTES_WIDTH = 300
 WARN_COLOR = QColor(200, 110, 0)
 FAIL_COLOR = QColor(200, 40, 40)
 
@@ -166,18 +167,16 @@ class LibraryView(QWidget):
         self.table.activated.connect(self._on_activated)
         self.summary = QLabel("No library open: File ▸ Open library…")
         self.summary.setWordWrap(True)
-        self.open_button = QPushButton("&Open")
-        self.open_button.setToolTip("Open the selected photo's project (double-click, Enter)")
-        self.open_button.clicked.connect(self.open_current)
-        self.next_button = QPushButton("&Next")
-        self.next_button.setToolTip("Open the project of the next photo in the list")
-        self.next_button.clicked.connect(self.open_next)
-        self.reload_button = QPushButton("Reload")
-        self.reload_button.setToolTip("Read the library folder again")
-        self.reload_button.clicked.connect(self.reload)
-        self.index_button = QPushButton("Contact sheet")
-        self.index_button.setToolTip("Open index.html in the web browser")
-        self.index_button.clicked.connect(self.open_index)
+        self.open_button = _button(
+            "&Open", "Open the selected photo's project (double-click, Enter)", self.open_current
+        )
+        self.next_button = _button(
+            "&Next", "Open the project of the next photo in the list", self.open_next
+        )
+        self.reload_button = _button("Reload", "Read the library folder again", self.reload)
+        self.index_button = _button(
+            "Contact sheet", "Open index.html in the web browser", self.open_index
+        )
         buttons = QHBoxLayout()
         for b in (self.open_button, self.next_button, self.reload_button, self.index_button):
             buttons.addWidget(b)
@@ -223,6 +222,8 @@ class LibraryView(QWidget):
                 "warnings. Double-click a photo to open its project; Next opens the following."
             )
         self.table.resizeColumnsToContents()
+        notes = [k for k, _ in HEADERS].index("notes")  # long: elided, whole in the tooltip
+        self.table.setColumnWidth(notes, min(self.table.columnWidth(notes), NOTES_WIDTH))
         if entries:
             self.table.selectRow(0)
         self._update_buttons()
@@ -284,3 +285,10 @@ class LibraryView(QWidget):
         self.index_button.setEnabled(
             self.folder is not None and (self.folder / INDEX_HTML).is_file()
         )
+
+
+def _button(text: str, tip: str, slot) -> QPushButton:
+    b = QPushButton(text)
+    b.setToolTip(tip)
+    b.clicked.connect(slot)
+    return b

@@ -151,7 +151,7 @@ def test_dask_is_imported_only_with_a_scheduler():
 
 
 def test_dask_cluster_makes_byte_identical_tiles(tmp_path, capsys):
-    distributed = pytest.importorskip("distributed")
+    pytest.importorskip("distributed")
     write_photos(tmp_path / "in", names=("brick", "gravel"))
     corrupt, tiny = write_bad_photos(tmp_path / "in")
     tiny.unlink()
@@ -159,13 +159,9 @@ def test_dask_cluster_makes_byte_identical_tiles(tmp_path, capsys):
     local.mkdir()
     for ph in find_photos([str(tmp_path / "in")])[0]:
         run_photo(ph, SMALL, local, threads=2)  # the local pool's task, in this process
-    with distributed.LocalCluster(
-        n_workers=2,
-        threads_per_worker=1,
-        processes=True,
-        host="127.0.0.1",
-        dashboard_address=None,
-    ) as cluster:
+    from engine.batch.cluster import local_cluster
+
+    with local_cluster(2) as cluster:
         code, err = batch(
             tmp_path / "in",
             "--out",
