@@ -24,6 +24,7 @@ from engine.batch.settings import BatchSettings
 from engine.batch.task import PhotoRecord, store_failed
 
 STOP_GRACE = 10.0  # seconds a worker gets to unwind after SIGINT before SIGKILL
+INTERRUPTED = 130  # a worker's exit code after Ctrl-C: the batch stops, the photo is not failed
 
 
 def default_jobs() -> int:
@@ -48,9 +49,10 @@ def _die_with_parent(parent: int) -> None:
 
 
 def _interrupt_once(signum, frame):
-    """Ctrl-C reaches a worker from the terminal and again from the batch stopping it: the
-    second must not interrupt the clean-up of the first."""
+    """Ctrl-C (or SIGTERM) reaches a worker from the terminal and again from the batch
+    stopping it: the second must not interrupt the clean-up of the first."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
     raise KeyboardInterrupt
 
 
@@ -59,14 +61,17 @@ def _worker_main(conn, parent: int, settings: BatchSettings, library: str, threa
 
     _die_with_parent(parent)
     signal.signal(signal.SIGINT, _interrupt_once)
+    signal.signal(signal.SIGTERM, _interrupt_once)
     try:
         while True:
             photo = conn.recv()
             if photo is None:
                 return
             conn.send(run_photo(photo, settings, library, threads=threads))
-    except (EOFError, BrokenPipeError, KeyboardInterrupt):
+    except (EOFError, BrokenPipeError):
         return
+    except KeyboardInterrupt:
+        raise SystemExit(INTERRUPTED) from None
 
 
 def _death(code: int | None) -> str:
@@ -132,6 +137,8 @@ def iter_local(
                         pass
                 if record is None and not w.process.is_alive():
                     w.process.join()
+                    if w.process.exitcode == INTERRUPTED:  # Ctrl-C reached the worker first
+                        raise KeyboardInterrupt
                     photo = w.photo
                     record = PhotoRecord(
                         photo.key, photo.path, "failed", _death(w.process.exitcode)

@@ -206,6 +206,7 @@ def _make(args, settings, lib, photos, dupes, plan) -> int:
     )
     failed: list = []
     made = 0
+    reported: set[str] = set()
     interrupted: KeyboardInterrupt | None = None
     broken = None
     t0 = time.perf_counter()
@@ -213,6 +214,7 @@ def _make(args, settings, lib, photos, dupes, plan) -> int:
     records = iter_batch(work.todo, settings, lib, jobs=args.jobs, scheduler=args.scheduler)
     try:
         for r in records:
+            reported.add(r.key)
             if r.failed:
                 failed.append(r)
             else:
@@ -228,6 +230,8 @@ def _make(args, settings, lib, photos, dupes, plan) -> int:
     finally:
         records.close()
         bar.close()
+    if interrupted is not None or broken is not None:
+        made += _finished_unheard(lib, settings, work.todo, reported)
     superseded = remove_superseded(lib, photos)
     if superseded:
         _say(
@@ -249,6 +253,17 @@ def _make(args, settings, lib, photos, dupes, plan) -> int:
         _say("interrupted: the photos made so far are kept; run the same command to finish")
         return TERMINATED if isinstance(interrupted, Terminated) else INTERRUPTED
     return SOME_FAILED if failed else 0
+
+
+def _finished_unheard(lib, settings, todo, reported) -> int:
+    """Photos a worker finished (its folder is in place) whose record the stopped batch did
+    not receive: counted as made, as the next run will find them done."""
+    from engine.batch.task import folder_state
+
+    digest = settings.digest()
+    return sum(
+        folder_state(lib / ph.key, digest) == "done" for ph in todo if ph.key not in reported
+    )
 
 
 def _finish_index(lib, write_index):

@@ -180,3 +180,27 @@ def test_dask_cluster_makes_byte_identical_tiles(tmp_path, capsys):
     assert {k: v["status"] for k, v in photo_folders(local).items()} == {
         k: v["status"] for k, v in photo_folders(remote).items()
     }
+
+
+def test_a_worker_stopped_by_ctrl_c_stops_the_batch_and_fails_no_photo(tmp_path):
+    """Ctrl-C reaches the workers and the batch at once; when the batch hears of the stopped
+    worker first, it stops (interrupted) rather than marking that photo failed."""
+    import multiprocessing as mp
+
+    from engine.batch.pool import iter_local
+
+    photos, _, _ = find_photos(
+        [str(p) for p in write_photos(tmp_path / "in", names=("brick", "gravel", "lichen"))]
+    )
+    lib = tmp_path / "lib"
+    lib.mkdir()
+    records = iter_local(photos, SMALL, lib, jobs=1)
+    first = next(records)
+    (worker,) = mp.active_children()
+    os.kill(worker.pid, signal.SIGINT)  # the worker only: the batch hears it from the pool
+    with pytest.raises(KeyboardInterrupt):
+        for _ in records:
+            pass
+    assert not worker.is_alive() and worker.exitcode == 130
+    assert {k: v["status"] for k, v in photo_folders(lib).items()} == {first.key: "done"}
+    assert temporaries(lib) == []
