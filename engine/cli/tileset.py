@@ -42,6 +42,7 @@ from engine.cli.tileset_output import (
     VERSION,
     Reporter,
     check_out,
+    check_sizes,
     csv_text,
     load_inputs,
     map_weights,
@@ -378,49 +379,6 @@ def run(args) -> int:
     return code
 
 
-def _check_sizes(args, settings: TilesetSettings, S, rect, maps) -> TilesetSettings:
-    """The preview within :data:`engine.export.MAX_PREVIEW_PIXELS` (a default grid shrinks with
-    a warning, a given ``--preview`` is refused) and the whole run within the memory available,
-    before any work; the settings to run with."""
-    import warnings
-
-    from engine.budget import check_memory, tileset_bytes
-    from engine.export import MAX_PREVIEW_PIXELS
-
-    H, W = S.shape[:2]
-    th, tw = (rect[3], rect[2]) if rect else settings.tile_range((H, W))[1]
-    rows, cols = settings.preview
-    if rows * th * cols * tw > MAX_PREVIEW_PIXELS:
-        size = f"{cols * tw}x{rows * th} px, over the limit of {MAX_PREVIEW_PIXELS:,} pixels"
-        if args.preview is not None:
-            raise ValueError(
-                f"--preview {rows}x{cols}: a preview of tiles up to {tw}x{th} would be {size}; "
-                "choose a smaller grid"
-            )
-        r, c = rows, cols
-        while r * th * c * tw > MAX_PREVIEW_PIXELS and (r > 1 or c > 1):
-            r, c = max(1, r - 1), max(1, c - 1)
-        warnings.warn(
-            f"the {rows}x{cols} preview of tiles up to {tw}x{th} would be {size}; "
-            f"using {r}x{c} (--preview sets it)",
-            stacklevel=2,
-        )
-        settings = settings.replace(preview=(r, c))
-    check_memory(
-        tileset_bytes(
-            S.shape,
-            (th, tw),
-            candidates=settings.candidates,
-            preview=settings.preview,
-            map_channels=[m.shape[2] for m in maps.values()],
-        ),
-        what=f"a tile set from this {W}x{H} source",
-        way_out="use a smaller source, a smaller --tile-max, fewer --candidates or a smaller "
-        "--preview",
-    )
-    return settings
-
-
 def _events(say, n: int):
     """The progress line of each event worth one."""
     from engine.events import Progress
@@ -450,7 +408,8 @@ def _run(args, settings: TilesetSettings, rect) -> int:
     say = Reporter()
     S, depth, maps, weights, excluded = load_inputs(args, settings, say)
     H, W = S.shape[:2]
-    settings = _check_sizes(args, settings, S, rect, maps)
+    tile_hw = (rect[3], rect[2]) if rect else settings.tile_range((H, W))[1]
+    settings = check_sizes(args, settings, S, tile_hw, maps, tiles=settings.candidates)
     if rect is not None:
         say(f"template: fixed rectangle {rect}")
     result = drain(

@@ -182,3 +182,48 @@ def csv_text(cells) -> str:
 
 def write_text(path: Path, text: str) -> None:
     write_bytes_atomically(path, text.encode("utf-8"))
+
+
+def check_sizes(
+    args, settings: TilesetSettings, S, tile_hw, maps, *, tiles: int
+) -> TilesetSettings:
+    """The preview of tiles up to ``tile_hw`` within :data:`engine.export.MAX_PREVIEW_PIXELS`
+    (a default grid shrinks with a warning, a given ``--preview`` is refused) and the whole run
+    of ``tiles`` tiles within the memory available, before any work; the settings to run with.
+    Shared by the template and the Wang workflows."""
+    import warnings
+
+    from engine.budget import check_memory, tileset_bytes
+    from engine.export import MAX_PREVIEW_PIXELS
+
+    H, W = S.shape[:2]
+    th, tw = tile_hw
+    rows, cols = settings.preview
+    if rows * th * cols * tw > MAX_PREVIEW_PIXELS:
+        size = f"{cols * tw}x{rows * th} px, over the limit of {MAX_PREVIEW_PIXELS:,} pixels"
+        if args.preview is not None:
+            raise ValueError(
+                f"--preview {rows}x{cols}: a preview of tiles up to {tw}x{th} would be {size}; "
+                "choose a smaller grid"
+            )
+        r, c = rows, cols
+        while r * th * c * tw > MAX_PREVIEW_PIXELS and (r > 1 or c > 1):
+            r, c = max(1, r - 1), max(1, c - 1)
+        warnings.warn(
+            f"the {rows}x{cols} preview of tiles up to {tw}x{th} would be {size}; "
+            f"using {r}x{c} (--preview sets it)",
+            stacklevel=2,
+        )
+        settings = settings.replace(preview=(r, c))
+    check_memory(
+        tileset_bytes(
+            S.shape,
+            (th, tw),
+            candidates=tiles,
+            preview=settings.preview,
+            map_channels=[m.shape[2] for m in maps.values()],
+        ),
+        what=f"a tile set from this {W}x{H} source",
+        way_out="use a smaller source, a smaller tile size, fewer tiles or a smaller --preview",
+    )
+    return settings

@@ -132,6 +132,7 @@ def run_wang(args, settings, rect=None) -> int:
         FORMAT,
         VERSION,
         Reporter,
+        check_sizes,
         csv_text,
         load_inputs,
         source_name,
@@ -146,6 +147,8 @@ def run_wang(args, settings, rect=None) -> int:
     S, depth, maps, weights, excluded = load_inputs(args, settings, say)
     s = resolve_wang(settings, S.shape[:2])
     count = s.wang_variants * s.wang**4
+    settings = check_sizes(args, settings, S, s.tile_min, maps, tiles=count)
+    s = resolve_wang(settings, S.shape[:2])
     say(f"Wang set: {s.wang} colours per edge direction, {count} tiles of {s.tile_min[0]} px")
     result = drain(
         iter_wang_tileset(

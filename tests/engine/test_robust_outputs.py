@@ -120,6 +120,19 @@ def test_d6_tileset_preview_and_synth_size(sample, tmp_path, capsys):
     assert "--threads: must be at most 256" in capsys.readouterr().err
 
 
+def test_d6_wang_preview_and_memory_are_checked_before_any_work(
+    sample, tmp_path, capsys, monkeypatch
+):
+    args = ["tileset", sample, "--out", tmp_path / "t", "--wang", "2", "--tile-size", "32"]
+    code, err = run(capsys, *args, "--preview", "100000x100000")
+    assert code == 1 and "--preview 100000x100000: a preview of tiles up to 32x32" in err
+    assert "edge sample" not in err and not (tmp_path / "t").exists()
+    monkeypatch.setenv("QUILT_MEMORY_LIMIT", "1M")
+    code, err = run(capsys, *args)
+    assert code == 1 and "a tile set from this" in err and "fewer tiles" in err
+    assert "edge sample" not in err and not (tmp_path / "t").exists()
+
+
 def test_d6_default_preview_shrinks_to_the_limit_with_a_warning(
     sample, tmp_path, capsys, monkeypatch
 ):
