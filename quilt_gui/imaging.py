@@ -41,6 +41,8 @@ def display_uint8(pixels: np.ndarray) -> np.ndarray:
 
 
 def _forget(key: int) -> None:
+    if _cache is None:  # interpreter shutdown: the module's globals are gone already
+        return
     with _cache_lock:
         entry = _cache.get(key)
         if entry is not None and entry[0]() is None:
