@@ -3,7 +3,10 @@ end a running job with exit code 130 / 143, one line saying so and no output or 
 ``kill -9`` in the middle of writing leaves the previous output (or none), never a torn one,
 and the next run removes what the killed one left.
 
-Real processes are needed here; each job is signalled as soon as it reports it has started."""
+Real processes are needed here; each job is signalled as soon as it reports it has started.
+The cases fork their process from a warm one that has the engine imported (tests/engine/
+warm_cli.py: a case pays for its job, not for a fresh interpreter); one fresh ``quilt-studio``
+process per signal checks the whole program's way out."""
 
 from __future__ import annotations
 
@@ -29,6 +32,14 @@ from tests.engine.hostile import (
     start_cli,
     wait_for_line,
 )
+from tests.engine.warm_cli import WarmCli
+
+
+@pytest.fixture(scope="module")
+def warm():
+    server = WarmCli()
+    yield server
+    server.close()
 
 
 @pytest.fixture(scope="module")
@@ -48,8 +59,11 @@ def inputs(tmp_path_factory):
     return d
 
 
-def commands(d: Path, out: Path) -> dict[str, tuple[list, str]]:
-    """Sub-command -> (arguments, a stderr text that shows the work has started)."""
+def commands(d: Path, out: Path, *, long=True) -> dict[str, tuple[list, str]]:
+    """Sub-command -> (arguments, a stderr text that shows the work has started). ``long``:
+    seconds of work left after that text even on a quiet machine (the signal must find the job
+    running); else a tile set small enough to be made whole first (the kill -9 case)."""
+    n, preview = ("40", "16x16") if long else ("12", "6x6")
     return {
         "tileset": (
             [
@@ -58,13 +72,13 @@ def commands(d: Path, out: Path) -> dict[str, tuple[list, str]]:
                 "--out",
                 out,
                 "--candidates",
-                "12",
+                n,
                 "--tile-min",
                 "128",
                 "--preview",
-                "6x6",
+                preview,
             ],
-            "template:",
+            f"(1/{n}):",  # the first candidate: every lazy import of the command is done
         ),  # fmt: skip
         "synth": (
             [
@@ -105,13 +119,23 @@ COMMANDS = ("tileset", "synth", "transfer", "export", "seam", "heal")
 
 @pytest.mark.parametrize("name", ["SIGINT", "SIGTERM"])
 @pytest.mark.parametrize("command", COMMANDS)
-def test_interrupt_and_terminate_end_cleanly(inputs, tmp_path, command, name):
+def test_interrupt_and_terminate_end_cleanly(warm, inputs, tmp_path, command, name):
+    _interrupt_and_terminate(warm.start, inputs, tmp_path, command, name)
+
+
+@pytest.mark.parametrize("name", ["SIGINT", "SIGTERM"])
+def test_a_fresh_process_ends_cleanly(inputs, tmp_path, name):
+    """The whole program (interpreter, imports, exit), once per signal."""
+    _interrupt_and_terminate(start_cli, inputs, tmp_path, "tileset", name)
+
+
+def _interrupt_and_terminate(start, inputs, tmp_path, command, name):
     sig, code, word = SIGNALS[name]
     out = tmp_path / "out"
     if command not in ("tileset", "export"):
         out.mkdir()
     argv, started = commands(inputs, out)[command]
-    proc = start_cli(*argv)
+    proc = start(*argv)
     wait_for_line(proc, started)
     time.sleep(0.3)  # as a person would: not in the middle of a lazy import (see outcome.py)
     rc, rest = signal_and_wait(proc, sig)
@@ -142,12 +166,12 @@ def kill_when(proc, appears, timeout=120):
 
 
 @pytest.mark.parametrize("command", ["tileset", "export"])
-def test_kill_9_while_writing_a_folder_leaves_the_old_one_whole(inputs, tmp_path, command):
+def test_kill_9_while_writing_a_folder_leaves_the_old_one_whole(warm, inputs, tmp_path, command):
     out = tmp_path / "out"
-    argv, _ = commands(inputs, out)[command]
+    argv, _ = commands(inputs, out, long=False)[command]
     assert main([str(a) for a in argv]) == 0
     before = {p.name: p.read_bytes() for p in out.iterdir()}
-    proc = start_cli(*argv, *(["--overwrite"] if command == "export" else []))
+    proc = warm.start(*argv, *(["--overwrite"] if command == "export" else []))
     kill_when(proc, lambda: any(".out.tmp-" in n for n in os.listdir(tmp_path)))
     assert {p.name: p.read_bytes() for p in out.iterdir()} == before  # never a mix
     assert temporaries(tmp_path)  # the killed run's half-written folder...
@@ -161,11 +185,11 @@ def test_kill_9_while_writing_a_folder_leaves_the_old_one_whole(inputs, tmp_path
 
 
 @pytest.mark.parametrize("command", ["synth", "transfer", "heal", "seam"])
-def test_kill_9_never_leaves_a_torn_image(inputs, tmp_path, command):
+def test_kill_9_never_leaves_a_torn_image(warm, inputs, tmp_path, command):
     out = tmp_path / "out"
     out.mkdir()
     argv, started = commands(inputs, out)[command]
-    proc = start_cli(*argv)
+    proc = warm.start(*argv)
     wait_for_line(proc, started)
     time.sleep(0.2)
     os.kill(proc.pid, signal.SIGKILL)
