@@ -67,3 +67,18 @@ def provenance() -> str:
         f"# measured {datetime.date.today()} on this {os.cpu_count()}-core machine at commit "
         f"{commit}; load average {load}"
     )
+
+
+class Tee:
+    """Write to several streams (the terminal and a results file's buffer)."""
+
+    def __init__(self, *streams):
+        self.streams = streams
+
+    def write(self, text: str) -> None:
+        for s in self.streams:
+            s.write(text)
+
+    def flush(self) -> None:
+        for s in self.streams:
+            s.flush()

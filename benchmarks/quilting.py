@@ -44,7 +44,7 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from benchmarks import quilting_large  # noqa: E402
-from benchmarks._util import format_table, median_time, provenance  # noqa: E402
+from benchmarks._util import Tee, format_table, median_time, provenance  # noqa: E402
 from engine.errormap import error_map  # noqa: E402
 from engine.io import load_image  # noqa: E402
 from engine.matching import ZERO_ERROR_FRACTION, error_floor, select_within_tolerance  # noqa: E402
@@ -156,6 +156,43 @@ print(json.dumps(times))
 """
 
 
+START_COMMIT = "a219639"
+"""The commit issue 15's work started from (the "× start" column's reference)."""
+
+
+def start_checkout(arg: str | None) -> str | None:
+    """The folder of the start commit's files: ``arg`` itself, or with ``"auto"`` a copy
+    extracted once by ``git archive`` into the temporary folder (None when git or the commit is
+    not at hand: the column is then left out, with a note)."""
+    import subprocess
+    import tarfile
+    import tempfile
+
+    if arg is None or arg.lower() == "none":
+        return None
+    if arg != "auto":
+        return arg
+    folder = Path(tempfile.gettempdir()) / f"quilt-bench-start-{START_COMMIT}"
+    if (folder / "engine").is_dir():
+        return str(folder)
+    repo = Path(__file__).resolve().parents[1]
+    try:
+        archive = subprocess.run(
+            ["git", "-C", str(repo), "archive", "--format=tar", START_COMMIT],
+            capture_output=True,
+            check=True,
+        ).stdout
+    except (OSError, subprocess.CalledProcessError) as exc:
+        print(f"(no start column: git archive {START_COMMIT} failed: {exc})\n")
+        return None
+    partial = folder.with_name(folder.name + ".partial")
+    partial.mkdir(parents=True, exist_ok=True)
+    with tarfile.open(fileobj=io.BytesIO(archive)) as tar:
+        tar.extractall(partial, filter="data")
+    partial.rename(folder)
+    return str(folder)
+
+
 def start_time(start_dir: str, sample: np.ndarray, j: dict, threads: int, repeats: int) -> float:
     """Median seconds of the exact search (then the only one) of job ``j`` in a checkout of the
     commit issue 15's work started from (``--start DIR``), in a process of its own."""
@@ -214,7 +251,7 @@ def speed(args) -> None:
                 rows.append(
                     [
                         job,
-                        f"exact at the start ({Path(args.start).name})",
+                        f"exact at the start ({START_COMMIT})",
                         threads,
                         f"{start[job, threads]:.3f}",
                         f"{base_t / start[job, threads]:.2f}",
@@ -408,10 +445,11 @@ def main(argv=None) -> int:
     p.add_argument("--seeds", type=int, default=2, help="seeds averaged in the quality tables")
     p.add_argument(
         "--start",
-        default=None,
+        default="auto",
         metavar="DIR",
-        help="a checkout of the commit issue 15 started from (a219639): its exact search is "
-        "timed on jobs A and B too (git worktree add /tmp/start a219639)",
+        help="a checkout of the commit issue 15 started from (a219639), whose exact search is "
+        "timed on jobs A and B too; default 'auto': extracted once from this repository's git "
+        "history into the temporary folder; 'none' skips it",
     )
     p.add_argument("--skip-speed", action="store_true")
     p.add_argument("--skip-quality", action="store_true")
@@ -425,10 +463,12 @@ def main(argv=None) -> int:
     quilting_large.add_arguments(p)
     args = p.parse_args(argv)
     args.jobs = [j for j in args.jobs.upper() if j in JOBS]
+    args.start = start_checkout(args.start)
     args.large_jobs = [j.strip().upper() for j in args.large_jobs.split(",") if j.strip()]
+    args.quality_samples = [n.strip() for n in args.quality_samples.split(",") if n.strip()]
     out = io.StringIO()
-    with contextlib.redirect_stdout(_Tee(sys.stdout, out)):
-        print(f"{provenance()}\npython -m benchmarks.quilting {' '.join(argv or sys.argv[1:])}\n")
+    with contextlib.redirect_stdout(Tee(sys.stdout, out)):
+        print(f"{provenance()}\npython benchmarks/quilting.py {' '.join(argv or sys.argv[1:])}\n")
         if not args.skip_speed:
             speed(args)
             streaming(args)
@@ -448,16 +488,5 @@ def main(argv=None) -> int:
 RESULTS = Path(__file__).resolve().parent / "results" / "quilting.txt"
 
 
-class _Tee:
-    """Write to several streams (the terminal and the results file's buffer)."""
-
-    def __init__(self, *streams):
-        self.streams = streams
-
-    def write(self, text: str) -> None:
-        for s in self.streams:
-            s.write(text)
-
-    def flush(self) -> None:
-        for s in self.streams:
-            s.flush()
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,7 +1,8 @@
 """Issue 15's large jobs: quilting and transfer from 4096² and 8192² samples, auto vs exact.
 
-Run through ``python -m benchmarks.quilting`` (``--skip-large``, ``--large-quality``), or alone:
-``python -m benchmarks.quilting_large [--repeats 3] [--quality] [--quality-out 1024]``.
+Run through ``python benchmarks/quilting.py`` (``--skip-large``, ``--large-quality``), or alone:
+``python benchmarks/quilting_large.py [--repeats 3] [--quality] [--quality-out 1024]
+[--quality-samples a,b]`` (printed and written to ``benchmarks/results/quilting_large.txt``).
 
 * **Speed and memory**: each job runs in a process of its own (a warm-up on a small sample
   first, then ``--repeats`` timed runs), so its peak resident memory (``VmHWM``: the whole
@@ -24,6 +25,8 @@ Samples are made once and cached as ``.npy`` files in the temporary folder.
 from __future__ import annotations
 
 import argparse
+import contextlib
+import io
 import json
 import os
 import subprocess
@@ -37,7 +40,7 @@ import numpy as np
 if __package__ in (None, ""):  # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from benchmarks._util import format_table  # noqa: E402
+from benchmarks._util import Tee, format_table, provenance  # noqa: E402
 
 CACHE = Path(tempfile.gettempdir()) / "quilt-bench-samples"
 
@@ -223,7 +226,8 @@ def large_quality(args) -> None:
     folder = Path(tempfile.gettempdir()) / "quilt-bench-outputs"
     folder.mkdir(exist_ok=True)
     rows = []
-    for name in [*SAMPLE_NAMES, *PHOTOS]:
+    names = args.quality_samples or [*SAMPLE_NAMES, *PHOTOS]
+    for name in names:
         s = np.load(sample_file(name, side))
         ratio, secs = {}, {}
         for mode in ("auto", "exact"):
@@ -273,6 +277,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--quality-out", type=int, default=1024, help="output side of the quality comparison"
     )
+    p.add_argument(
+        "--quality-samples",
+        default="",
+        help="samples of the quality comparison, comma-separated (default: every bundled sample "
+        f"and the photos {', '.join(PHOTOS)})",
+    )
 
 
 def main(argv=None) -> int:
@@ -281,16 +291,28 @@ def main(argv=None) -> int:
     p.add_argument("--repeats", type=int, default=3, help="timed runs per job (default 3)")
     p.add_argument("--quality", action="store_true", help="also compare auto with exact")
     p.add_argument("--seeds", type=int, default=1, help="seeds of the quality comparison")
+    p.add_argument("--skip-large", action="store_true", help="only the quality comparison")
     add_arguments(p)
     args = p.parse_args(argv)
     if args.worker:
         print(json.dumps(worker(json.loads(args.worker))))
         return 0
     args.large_jobs = [j.strip().upper() for j in args.large_jobs.split(",") if j.strip()]
-    large(args)
-    if args.quality:
-        large_quality(args)
+    args.quality_samples = [n.strip() for n in args.quality_samples.split(",") if n.strip()]
+    out = io.StringIO()
+    with contextlib.redirect_stdout(Tee(sys.stdout, out)):
+        command = " ".join(["python benchmarks/quilting_large.py", *(argv or sys.argv[1:])])
+        print(f"{provenance()}\n{command}\n")
+        if not args.skip_large:
+            large(args)
+        if args.quality:
+            large_quality(args)
+    RESULTS.parent.mkdir(exist_ok=True)
+    RESULTS.write_text(out.getvalue())
     return 0
+
+
+RESULTS = Path(__file__).resolve().parent / "results" / "quilting_large.txt"
 
 
 if __name__ == "__main__":
