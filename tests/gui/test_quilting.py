@@ -147,3 +147,17 @@ def test_painted_exclusion_is_one_undo_step_and_never_copied(qtbot):
         assert not mask[y : y + bh, x : x + bw].any()
     w.doc.undo_stack.undo()
     assert w.doc.exclude_painted is None and not w.quilt_view.excluded.isVisible()
+
+
+def test_quilting_job_carries_the_engine_estimate_for_the_status_bar(qtbot):
+    w = make_window(qtbot)
+    open_sample(qtbot, w)
+    small(w)
+    w.act_quilt.trigger()
+    job = w.jobs.get("quilt")
+    assert job is not None
+    qtbot.waitUntil(lambda: job.estimate != "", timeout=10_000)
+    # the plan's words (search, time, memory) are what the status bar shows until a rate is known
+    assert job.estimate.startswith("estimate: ") and "search" in job.estimate
+    assert "about" in job.estimate and "peak memory" in job.estimate
+    wait_idle(qtbot, w)
