@@ -10,7 +10,7 @@ Run through ``python benchmarks/quilting.py`` (``--skip-large``, ``--large-quali
   block 96, overlap 16, best + dp, ``mode="auto"`` (target ≤ 15 s, ≤ 2 GB); L8 — the same from
   an 8192² photo (≤ 30 s, ≤ 2 GB); T4 — texture transfer of a 1024² target (the cat photo's
   fur) from a 4096² sample, 3 passes from block 96 (the quilting jobs' block; 96, 64, 43 px:
-  1371 blocks; ≤ 30 s). The "photo" is the bundled cobblestones photo upscaled (bilinear); the
+  1143 blocks; ≤ 30 s). The "photo" is the bundled cobblestones photo upscaled (bilinear); the
   plan's estimate is printed beside the measured figures.
 * **Quality** (``--quality``): the grid border ratio of ``auto`` (the coarse-to-fine search at
   this size) against the exhaustive search's, on every bundled sample and two real photos
