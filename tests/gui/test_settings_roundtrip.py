@@ -8,11 +8,14 @@ settings type (the CLI's and the editor's old keys) still open with their option
 
 from __future__ import annotations
 
+import argparse
+import dataclasses
 import json
 
 import numpy as np
 
 from engine.bitdepth import quantize
+from engine.cli import build_parser
 from engine.cli import main as cli_main
 from engine.io import load_image
 from engine.png import encode_png
@@ -149,6 +152,90 @@ def test_cli_project_with_every_option_reopens_in_the_editor_with_all_of_them(qt
         assert mine.patch_origin == theirs.patch_origin
         assert np.array_equal(_q(mine.tile), _q(theirs.tile))
         assert np.array_equal(_q(mine.maps["height"]), _q(theirs.maps["height"]))
+
+
+#: tileset options the test above does not put in FLAGS, and why
+NOT_IN_FLAGS = {
+    "--out": "the output folder",
+    "--project": "the project file itself",
+    "--settings": "reads a whole earlier run's settings (tests/engine/test_settings.py)",
+    "--workers": "threads of this run, not a setting of the set",
+    "--source-name": "hidden: the batch's source path in the manifest",
+    "--rect": "a fixed template rectangle: arrives as the project's template rectangle",
+    "--map": "given above (a height map)",
+    "--weight": "given above",
+    "--exclude-mask": "given above (the painted mask)",
+    "--pick": "given above",
+    "--equal-neighbours": "given above",
+    # a Wang set is another workflow; its settings fields are in EVERY_FIELD below
+    "--wang": "Wang",
+    "--tile-size": "Wang",
+    "--variants": "Wang",
+    "--interior": "Wang",
+    "--wang-band": "Wang",
+    "--outward": "Wang",
+    "--wang-min-distance": "Wang",
+    "--wang-tolerance": "Wang",
+}
+
+
+def test_the_round_trip_above_gives_every_tileset_option():
+    """A new ``tileset`` option must join FLAGS (or say here why not)."""
+    parser = build_parser(command="tileset")
+    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    options = {
+        o
+        for a in sub.choices["tileset"]._actions
+        for o in a.option_strings
+        if o.startswith("--") and o != "--help"
+    }
+    assert options - set(FLAGS) - set(NOT_IN_FLAGS) == set()
+    assert set(FLAGS) <= options and set(NOT_IN_FLAGS) <= options  # no stale names
+
+
+#: every TilesetSettings field away from its default (the Wang fields too)
+EVERY_FIELD = TilesetSettings(
+    tile_size=(128, 128),
+    tile_min=(88, 88),
+    tile_max=(104, 104),
+    overlap=12,
+    joint_weight=1.5,
+    seam=SeamSpec("oscillating", {"o_max": 5}, metric="lab", blend="feather", width=6, rho=5),
+    template_blend="adaptive",
+    candidates=4,
+    seed=7,
+    patch_size=(80, 80),
+    patch_overlap=9,
+    margin=3,
+    neighbourhood=2,
+    patch_search="local",
+    min_distance=7,
+    flatten=True,
+    preview=(3, 4),
+    no_equal_neighbours=False,
+    layout_seed=9,
+    exclude_color=((0.0, 0.0, 0.0), (0.12, 0.12, 0.12)),
+    wang=3,
+    wang_variants=2,
+    wang_interior="diamonds",
+    wang_band=5,
+    wang_outward=0.5,
+    wang_tolerance=0.2,
+    wang_min_distance=4.0,
+)
+
+
+def test_every_settings_field_travels_project_to_editor_to_project():
+    """Each field, whether the editor shows it or only keeps it (params.KEPT); the excluded
+    colour arrives as excluded pixels instead (the first test)."""
+    default = TilesetSettings()
+    names = [f.name for f in dataclasses.fields(TilesetSettings)]
+    assert [n for n in names if getattr(EVERY_FIELD, n) == getattr(default, n)] == []
+    expected = EVERY_FIELD.replace(exclude_color=None)
+    p = params.from_project_parameters({"tileset": EVERY_FIELD.to_dict()}, {})
+    assert params.tileset_settings(p) == expected
+    again = params.from_project_parameters(params.project_parameters(p), {})
+    assert params.tileset_settings(again) == expected
 
 
 def test_editor_project_keeps_its_settings_and_own_parameters(qtbot, tmp_path):
