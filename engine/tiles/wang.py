@@ -330,9 +330,10 @@ def choose_sample(source, samples, axis: str, colour: int, *, tile_size: int, rn
         raise ValueError(f"colour must be < {setup.K}, got {colour}")
     other = "v" if axis == "h" else "h"
     others = [s for s in current if s.axis == other]
+    same = [s for s in current if s.axis == axis and s.colour != colour]
     placed = setup.role_anchors([s for s in current if (s.axis, s.colour) != (axis, colour)])
     gen = rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng)
-    return setup.choose(axis, colour, others, placed, gen)
+    return setup.choose(axis, colour, others, placed, gen, same)
 
 
 def make_wang_tile(

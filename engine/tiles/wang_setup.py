@@ -23,6 +23,8 @@ from engine.tiles.template import default_overlap, excluded_mask, flat_warning
 from engine.tiles.wang_cut import CUTS, frame_cut, frame_reach, ramp_reach
 from engine.tiles.wang_types import (
     AXES,
+    CORNER_QUANTILE,
+    CORNER_STEPS,
     DETAIL_QUANTILE,
     INTERIORS,
     PATCH_LABEL,
@@ -103,6 +105,12 @@ class WangSetup:
         self.bands = _band_pixels(T, self.band)
         self._calm: dict[str, np.ndarray] = {}
         self._detail: dict[tuple[int, int], np.ndarray] = {}
+        self._energy_sat: np.ndarray | None = None
+        step = np.diff(colour_channels(self.S), axis=1)
+        #: mean squared colour step between horizontally adjacent source pixels
+        self.natural_step = float(np.einsum("yxc,yxc->", step, step, dtype=np.float64)) / (
+            step.shape[0] * step.shape[1]
+        )
         r, c = np.mgrid[0:T, 0:T]
         d = np.minimum.reduce([r, c, T - 1 - r, T - 1 - c])
         self.outward = _nonneg_float(outward, "outward")
@@ -171,8 +179,8 @@ class WangSetup:
                 oy, ox = o.offset(theirs, T)
                 target = self.S[oy + rows, ox + cols]  # (n, C)
                 wy, wx = _window_coords(mine, rows, cols, T, self.reach)
-                np.add.at(wts, (wy, wx), 1.0)
-                np.add.at(kern, (slice(None), wy, wx), target.T)
+                wts[wy, wx] += 1.0  # a band's pixels are distinct: no repeated index
+                kern[:, wy, wx] += target.T
                 const += float(np.sum(target.astype(np.float64) ** 2))
         if not others:
             H, W = self.S.shape[:2]
@@ -203,16 +211,19 @@ class WangSetup:
         favours flat regions (they match anything calm), and flat samples or interiors
         read as blurred patches in a layout."""
         if shape not in self._detail:
-            lum = colour_channels(self.S).mean(axis=2, dtype=np.float64)
-            lap = np.zeros_like(lum)
-            lap[1:-1, 1:-1] = (
-                lum[:-2, 1:-1]
-                + lum[2:, 1:-1]
-                + lum[1:-1, :-2]
-                + lum[1:-1, 2:]
-                - 4 * lum[1:-1, 1:-1]
-            )
-            sat = np.pad(np.cumsum(np.cumsum(lap * lap, axis=0), axis=1), ((1, 0), (1, 0)))
+            if self._energy_sat is None:  # once per run: every window shape shares it
+                lum = colour_channels(self.S).mean(axis=2, dtype=np.float32)
+                lap = np.zeros(lum.shape, np.float64)
+                lap[1:-1, 1:-1] = (
+                    lum[:-2, 1:-1]
+                    + lum[2:, 1:-1]
+                    + lum[1:-1, :-2]
+                    + lum[1:-1, 2:]
+                    - 4 * lum[1:-1, 1:-1]
+                )
+                np.square(lap, out=lap)
+                self._energy_sat = np.pad(lap.cumsum(axis=0).cumsum(axis=1), ((1, 0), (1, 0)))
+            sat = self._energy_sat
             h, w = shape
             energy = sat[h:, w:] - sat[:-h, w:] - sat[h:, :-w] + sat[:-h, :-w]
             self._detail[shape] = energy >= np.quantile(energy, DETAIL_QUANTILE)
@@ -226,8 +237,9 @@ class WangSetup:
         if axis not in self._calm:
             S = self.S if axis == "h" else self.S.transpose(1, 0, 2)
             T, h = self.T, self.reach
-            d = np.sum(np.diff(S.astype(np.float64), axis=0) ** 2, axis=2)  # d[y] = S[y+1]-S[y]
-            run = np.cumsum(np.pad(d, ((0, 0), (1, 0))), axis=1)
+            step = S[1:] - S[:-1]
+            d = np.einsum("yxc,yxc->yx", step, step)  # d[y] = |S[y+1] - S[y]|²
+            run = np.pad(d.cumsum(axis=1, dtype=np.float64), ((0, 0), (1, 0)))
             rows = (run[:, T:] - run[:, :-T]) / T  # mean over T columns, by first column
             # window anchor (y, x): joint between source rows y + h - 1 and y + h; the
             # window's own steps are rows y .. y + 2h - 2
@@ -248,9 +260,41 @@ class WangSetup:
             pts += [s.offset(r, self.T) for r in roles]
         return pts
 
-    def choose(self, axis, colour, others, placed, rng) -> WangSample:
+    def corner_errors(self, same: list[WangSample]) -> np.ndarray:
+        """Squared colour steps where four tiles meet, for an ``h`` sample at every window
+        anchor, with itself and with the other ``h`` samples ``same``.
+
+        A tile's rows 0 and T-1 are its N and S samples' in full, corners included, so at a
+        crossing the east end of one h sample's two edge rows (the tile on the left) touches
+        the west end of another's (the tile on the right): two pixel rows per crossing where
+        the step across the vertical tile line joins two unrelated source pixels (the
+        corner problem; every pairing of the colours occurs, a colour with itself too)."""
+        T, h = self.T, self.reach
+        S = colour_channels(self.S)
+        ny, nx = S.shape[0] - 2 * h + 1, S.shape[1] - T + 1
+        rows = S[h - 1 : h + ny]  # anchor y's edge rows are rows[y] and rows[y + 1]
+        first, last = rows[:, :nx], rows[:, T - 1 : T - 1 + nx]
+
+        def sq(a, b):
+            return np.einsum("yxc,yxc->yx", a - b, a - b)
+
+        d = sq(last, first)
+        e = d[:-1] + d[1:]  # summed over the two edge rows (and the channels)
+        for o in same:
+            oy, ox = o.origin  # its edge rows are source rows oy - 1 and oy
+            for mine, theirs in (
+                (last, S[oy - 1 : oy + 1, ox]),
+                (first, S[oy - 1 : oy + 1, ox + T - 1]),
+            ):
+                e += sq(mine[:-1], theirs[0]) + sq(mine[1:], theirs[1])
+        return e
+
+    def choose(self, axis, colour, others, placed, rng, same=()) -> WangSample:
         """Sample ``colour`` of ``axis``: best matching ``others`` within tolerance, away from
-        ``placed`` (role anchors) by ``min_distance``."""
+        ``placed`` (role anchors) by ``min_distance``; an ``h`` sample also with corner steps
+        (:meth:`corner_errors`, with itself and ``same``, the other h samples) no rougher
+        than :data:`CORNER_STEPS` x the source's own, or among the :data:`CORNER_QUANTILE`
+        of positions with the least."""
         e = self.sample_errors(axis, others).astype(np.float64)
         wh, ww = self.window_shape(axis)
         allowed = np.ones(e.shape, bool)
@@ -278,6 +322,10 @@ class WangSetup:
                 f"the source is too small for {self.K} colours at min_distance "
                 f"{self.min_distance:g}: samples are {dist:g} px apart"
             )
+        if axis == "h":
+            c = self.corner_errors(list(same))
+            natural = 2 * (1 + 2 * len(same)) * self.natural_step  # that many steps
+            ok &= c <= max(CORNER_STEPS * natural, np.quantile(c[ok], CORNER_QUANTILE))
         n_px = sum(len(r) for r, _ in self.bands.values()) * max(1, len(others))
         k, _, _ = _select(
             np.where(ok, e, np.inf),
@@ -297,9 +345,10 @@ class WangSetup:
             check(cancel)
             other = "v" if axis == "h" else "h"
             others = [s for (a, _), s in chosen.items() if a == other]
+            same = [s for (a, k), s in chosen.items() if a == axis and k != c]
             placed = self.role_anchors([s for key, s in chosen.items() if key != (axis, c)])
             rng = np.random.default_rng(wang_seed(base, 0, step))
-            chosen[(axis, c)] = self.choose(axis, c, others, placed, rng)
+            chosen[(axis, c)] = self.choose(axis, c, others, placed, rng, same)
         return [chosen[(a, c)] for a in AXES for c in range(self.K)]
 
     # ---- tiles

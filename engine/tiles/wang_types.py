@@ -34,6 +34,13 @@ PATCH_LABEL = 4  # label of the interior patch's pixels (0..3: N, E, S, W; wang_
 ROLE_AXIS = {"n": "h", "s": "h", "e": "v", "w": "v"}
 #: samples and interiors come from the source's windows at least this detailed (quantile)
 DETAIL_QUANTILE = 0.25
+#: h samples come from the positions whose corner steps (where four tiles meet) are no rougher
+#: than CORNER_STEPS x the source's own mean squared step, or from the CORNER_QUANTILE of
+#: positions with the least when fewer are; measured with ``python -m benchmarks.wang
+#: --quality public`` (corner border ratio 1.6 -> 0.8 on cobblestones, lattice unchanged
+#: within its spread over seeds, but on the periodic weave)
+CORNER_STEPS = 2.0
+CORNER_QUANTILE = 0.05
 
 #: Options of :func:`iter_wang_set` and their defaults.
 WANG_DEFAULTS = {
