@@ -106,6 +106,7 @@ class WangSetup:
         self._calm: dict[str, np.ndarray] = {}
         self._detail: dict[tuple[int, int], np.ndarray] = {}
         self._energy_sat: np.ndarray | None = None
+        self._corner: tuple | None = None
         step = np.diff(colour_channels(self.S), axis=1)
         #: mean squared colour step between horizontally adjacent source pixels
         self.natural_step = float(np.einsum("yxc,yxc->", step, step, dtype=np.float64)) / (
@@ -271,22 +272,25 @@ class WangSetup:
         corner problem; every pairing of the colours occurs, a colour with itself too)."""
         T, h = self.T, self.reach
         S = colour_channels(self.S)
-        ny, nx = S.shape[0] - 2 * h + 1, S.shape[1] - T + 1
-        rows = S[h - 1 : h + ny]  # anchor y's edge rows are rows[y] and rows[y + 1]
-        first, last = rows[:, :nx], rows[:, T - 1 : T - 1 + nx]
-
-        def sq(a, b):
-            return np.einsum("yxc,yxc->yx", a - b, a - b)
-
-        d = sq(last, first)
-        e = d[:-1] + d[1:]  # summed over the two edge rows (and the channels)
+        if self._corner is None:  # once per run: the edge rows' ends at every anchor
+            ny, nx = S.shape[0] - 2 * h + 1, S.shape[1] - T + 1
+            rows = S[h - 1 : h + ny]  # anchor y's edge rows are rows[y] and rows[y + 1]
+            first = np.ascontiguousarray(rows[:, :nx])
+            last = np.ascontiguousarray(rows[:, T - 1 : T - 1 + nx])
+            d = np.einsum("yxc,yxc->yx", last - first, last - first)
+            norms = [np.einsum("yxc,yxc->yx", a, a) for a in (first, last)]
+            self._corner = (first, last, *norms, d[:-1] + d[1:])
+        first, last, n_first, n_last, e = self._corner
+        e = e.copy()  # summed over the two edge rows (and the channels)
         for o in same:
             oy, ox = o.origin  # its edge rows are source rows oy - 1 and oy
-            for mine, theirs in (
-                (last, S[oy - 1 : oy + 1, ox]),
-                (first, S[oy - 1 : oy + 1, ox + T - 1]),
+            for mine, norm, theirs in (
+                (last, n_last, S[oy - 1 : oy + 1, ox]),  # o to the right of this sample
+                (first, n_first, S[oy - 1 : oy + 1, ox + T - 1]),  # o to its left
             ):
-                e += sq(mine[:-1], theirs[0]) + sq(mine[1:], theirs[1])
+                for r in (0, 1):  # |a - b|² = |a|² - 2 a.b + |b|², b one pixel
+                    part = slice(r, r + e.shape[0])
+                    e += norm[part] - 2 * (mine[part] @ theirs[r]) + float(theirs[r] @ theirs[r])
         return e
 
     def choose(self, axis, colour, others, placed, rng, same=()) -> WangSample:
