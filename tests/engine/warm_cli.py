@@ -141,10 +141,14 @@ class WarmCli:
         line, self._buffer = self._buffer.split(b"\n", 1)
         return line.decode()
 
-    def start(self, *args, cwd=None) -> Child:
-        if self._child is not None and self._child.poll() is None:  # (a failed test's)
+    def _end_child(self) -> None:
+        """kill -9 a child still running (a failed test's) and collect its exit."""
+        if self._child is not None and self._child.poll() is None:
             os.kill(self._child.pid, signal.SIGKILL)
             self._child.wait()
+
+    def start(self, *args, cwd=None) -> Child:
+        self._end_child()
         self._count += 1
         stderr = Path(self._dir.name) / f"stderr-{self._count}.txt"
         stderr.touch()
@@ -155,6 +159,7 @@ class WarmCli:
         return self._child
 
     def close(self) -> None:
+        self._end_child()
         self._proc.stdin.close()
         self._proc.wait(timeout=60)
         self._dir.cleanup()
