@@ -168,6 +168,18 @@ PARAMS: tuple[Param, ...] = (
         step=0.1,
         paper="Our addition to Somol & Haindl's search: λ, the weight of the wrap joint",
     ),
+    _P(
+        "detail_weight",
+        TilesetSettings().detail_weight,
+        "Avoid blurred areas",
+        "How strongly the search keeps the tile out of flat or blurred parts of the photo, "
+        "where opposite edges match easily but the tile lacks detail (0: off).",
+        "Tile",
+        0.0,
+        4.0,
+        step=0.1,
+        paper="Our addition to Somol & Haindl's search: κ, the weight of the detail term",
+    ),
     # -- seams
     _P(
         "method",

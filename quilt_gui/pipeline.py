@@ -160,6 +160,7 @@ class Pipeline(QObject):
             tile_max=hi,
             overlap=s.overlap or doc.tileset.overlap(),
             joint_weight=s.joint_weight,
+            detail_weight=s.detail_weight,
             sweep=self.sweep_samples,
             on_event=self._on_template_event,
             on_done=self._on_template_done,

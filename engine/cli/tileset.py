@@ -152,6 +152,13 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "as in the paper)",
     )
     p.add_argument(
+        "--detail-weight",
+        type=non_negative_float,
+        metavar="K",
+        help="how strongly the template search avoids flat or blurred regions, where opposite "
+        f"edges match easily (default {d.detail_weight}; 0 = off, as in the paper)",
+    )
+    p.add_argument(
         "--overlap",
         type=int_at_least(2),
         metavar="N",
@@ -274,6 +281,7 @@ _FIELDS = {
     "tile_max": "tile_max",
     "overlap": "overlap",
     "joint_weight": "joint_weight",
+    "detail_weight": "detail_weight",
     "candidates": "candidates",
     "seed": "seed",
     "patch_size": "patch_size",

@@ -150,7 +150,12 @@ def _iter_tileset(source, s, rect, maps, weights, excluded, picks, workers, canc
     if rect is not None:
         overlap = s.overlap or default_overlap((rect[3], rect[2]))
         cost = template_cost(
-            source, rect, overlap=overlap, excluded=excluded, joint_weight=s.joint_weight
+            source,
+            rect,
+            overlap=overlap,
+            excluded=excluded,
+            joint_weight=s.joint_weight,
+            detail_weight=s.detail_weight,
         )[0]
     else:
         lo, hi = s.tile_range((H, W))
@@ -161,6 +166,7 @@ def _iter_tileset(source, s, rect, maps, weights, excluded, picks, workers, canc
             overlap=s.overlap,
             excluded=excluded,
             joint_weight=s.joint_weight,
+            detail_weight=s.detail_weight,
             cancel=cancel,
         )
         rect, overlap, cost = found.rect, found.overlap, found.cost

@@ -32,7 +32,6 @@ import warnings
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 from scipy import ndimage
 
 from engine._checks import as_size
@@ -40,6 +39,15 @@ from engine._validate import as_image, positive_int
 from engine.cancel import Cancelled, is_cancelled
 from engine.errormap import colour_channels
 from engine.events import Item, Progress, Snapshot, drain, frozen_array
+from engine.tiles.detail import DETAIL_WEIGHT, DetailTerm, check_detail_weight
+from engine.tiles.stationarity import check_stationarity
+from engine.tiles.template_scan import (
+    Scan,
+    argmin_cost,
+    rect_costs,
+    runs_1d,
+    runs_right,
+)
 
 __all__ = [
     "Template",
@@ -51,7 +59,6 @@ __all__ = [
     "template_cost",
 ]
 
-_CHUNK = 8  # shifts per kernel call between cancel checks / progress events
 SWEEP_INTERVAL = 1 / 30  # seconds between sweep events at least (no display redraws faster)
 JOINT_WEIGHT = 0.5  # λ: weight of the natural wrap joint's step G next to the strip mismatch D
 
@@ -101,7 +108,8 @@ class Template:
         w_T, the width of the border regions R_L/R_R/R_T/R_B.
     cost : float
         The searched criterion: ``(cost_horizontal + cost_vertical) / 2 + joint_weight *
-        (joint_horizontal + joint_vertical) / 2`` (:func:`template_cost` gives the same).
+        (joint_horizontal + joint_vertical) / 2`` plus the detail term ``κ·C·max(0, 1 −
+        detail)`` (:mod:`engine.tiles.detail`; :func:`template_cost` gives the same).
     cost_horizontal, cost_vertical : float
         Mean RGB Euclidean distance R_L vs R_R and R_T vs R_B (the strip mismatch).
     warnings : tuple of str
@@ -111,6 +119,12 @@ class Template:
         ``y + h - 1`` and ``y + h``) over the footprint: the step across the tile's wrap.
     joint_weight : float
         λ used by the search.
+    detail : float
+        q of the footprint: its mean high-frequency energy over the mean of every window of
+        its size in the source (:mod:`engine.tiles.detail`; 1 = as detailed as the average;
+        NaN when the search ran without the detail term).
+    detail_weight : float
+        κ used by the search (0: no detail term).
     """
 
     rect: tuple[int, int, int, int]
@@ -122,6 +136,8 @@ class Template:
     joint_horizontal: float = 0.0
     joint_vertical: float = 0.0
     joint_weight: float = 0.0
+    detail: float = math.nan
+    detail_weight: float = 0.0
 
     @property
     def footprint(self) -> tuple[int, int, int, int]:
@@ -200,197 +216,21 @@ def flat_warning(source: np.ndarray) -> str | None:
     return "the source is a single flat colour: every tile (and every candidate) will be identical"
 
 
-# --------------------------------------------------------------------------- kernels
-@njit(cache=True, nogil=True)
-def _shift_sums(S, valid, use_valid, r0, r1, shifts, out_sum, out_cnt):  # pragma: no cover
-    """out_sum[k, x] = Σ_y d(S[y, x], S[y, x + shifts[k]]) over rows r0..r1-1 (valid pairs)."""
-    W = S.shape[1]
-    C = S.shape[2]
-    for k in range(shifts.shape[0]):
-        a = shifts[k]
-        for y in range(r0, r1):
-            for x in range(W - a):
-                if use_valid and not (valid[y, x] and valid[y, x + a]):
-                    continue
-                s = 0.0
-                for c in range(C):
-                    d = S[y, x, c] - S[y, x + a, c]
-                    s += d * d
-                out_sum[k, x] += math.sqrt(s)
-                out_cnt[k, x] += 1.0
-
-
-@njit(cache=True, nogil=True)
-def _runs_right(free):  # pragma: no cover
-    """Length of the run of True starting at every pixel and going right."""
-    H, W = free.shape
-    out = np.zeros((H, W), dtype=np.int64)
-    for y in range(H):
-        run = 0
-        for x in range(W - 1, -1, -1):
-            run = run + 1 if free[y, x] else 0
-            out[y, x] = run
-    return out
-
-
-def _runs_1d(free: np.ndarray) -> np.ndarray:
-    return _runs_right(np.ascontiguousarray(free[None, :]))[0]
-
-
-# --------------------------------------------------------------------------- phases
-def _sums(S, valid, rows, shifts, out_sum, out_cnt) -> None:
-    use_valid = valid is not None
-    _shift_sums(
-        S,
-        valid if use_valid else np.ones((1, 1), dtype=np.bool_),
-        use_valid,
-        rows[0],
-        rows[1],
-        shifts,
-        out_sum,
-        out_cnt,
-    )
-
-
-def _joint_steps(S, valid, rows) -> np.ndarray:
-    """G[c] = mean distance between columns c - 1 and c over ``rows`` (valid pairs); G[0] = 0."""
-    W = S.shape[1]
-    s = np.zeros((1, W))
-    c = np.zeros((1, W))
-    _sums(S, valid, rows, np.ones(1, dtype=np.int64), s, c)
-    G = np.zeros(W)
-    G[1:] = s[0, : W - 1] / np.maximum(c[0, : W - 1], 1.0)
-    return G
-
-
-class _Scan:
-    """One phase over shifts: the cost D(x, a) + λ·G(x + a) of every position and shift."""
-
-    def __init__(self, S, valid, rows, shifts, overlap, joint_weight=0.0):
-        self.S = S
-        self.valid = valid
-        self.rows = rows
-        self.shifts = np.asarray(shifts, dtype=np.int64)
-        self.overlap = overlap
-        self.joint_weight = float(joint_weight)
-        W = S.shape[1]
-        self.sum = np.zeros((self.shifts.size, W), dtype=np.float64)
-        self.cnt = np.zeros((self.shifts.size, W), dtype=np.float64)
-        self._G = None
-
-    def chunks(self):
-        """Run the kernel chunk by chunk; yields the (start, end) shifts done."""
-        for k0 in range(0, self.shifts.size, _CHUNK):
-            k1 = min(k0 + _CHUNK, self.shifts.size)
-            _sums(
-                self.S, self.valid, self.rows, self.shifts[k0:k1], self.sum[k0:k1], self.cnt[k0:k1]
-            )
-            yield k0, k1
-
-    def costs(self, feasible_run: np.ndarray | None, k0: int = 0, k1: int | None = None):
-        """(k1 - k0, W) cost of the border pair at x with shift shifts[k]; inf where invalid.
-
-        ``feasible_run[x]`` is the widest footprint allowed to start at column x.
-        """
-        k1 = self.shifts.size if k1 is None else k1
-        K, W = k1 - k0, self.sum.shape[1]
-        w = self.overlap
-        if self._G is None:
-            self._G = self.joint_weight * _joint_steps(self.S, self.valid, self.rows)
-        out = np.full((K, W), np.inf)
-        n = W - w + 1  # positions of the overlap strip
-        if K == 0 or n <= 0:
-            return out
-        cs = np.zeros((K, W + 1))
-        cc = np.zeros((K, W + 1))
-        np.cumsum(self.sum[k0:k1], axis=1, out=cs[:, 1:])
-        np.cumsum(self.cnt[k0:k1], axis=1, out=cc[:, 1:])
-        s = cs[:, w : w + n] - cs[:, :n]
-        c = cc[:, w : w + n] - cc[:, :n]
-        x = np.arange(n)[None, :]
-        a = self.shifts[k0:k1, None]
-        ok = (c > 0) & (x + a + w <= W)  # the whole footprint inside
-        if feasible_run is not None:
-            ok &= feasible_run[:n][None, :] >= a + w
-        with np.errstate(invalid="ignore", divide="ignore"):
-            d = s / np.maximum(c, 1) + self._G[np.minimum(x + a, W - 1)]
-        out[:, :n] = np.where(ok, d, np.inf)
-        return out
-
-    def sampled(self, feasible_run, k0: int, k1: int, n: int):
-        """About ``n`` scored pairs of shifts k0..k1 for the sweep: (shift indices, positions,
-        costs), spread evenly over the shifts and over each shift's positions (offset from call
-        to call), invalid ones left out. Costs as :meth:`costs`, for these pairs alone."""
-        W = self.sum.shape[1]
-        w = self.overlap
-        if self._G is None:
-            self._G = self.joint_weight * _joint_steps(self.S, self.valid, self.rows)
-        ks = np.linspace(k0, k1 - 1, n).astype(np.int64)
-        out = []
-        for j, k in enumerate(ks.tolist()):
-            a = int(self.shifts[k])
-            m = W - a - w + 1  # positions with the whole footprint inside
-            if m <= 0:
-                continue
-            x = int(((j + k0) * 0.618034 % 1.0) * m)
-            c = self.cnt[k, x : x + w].sum()
-            if c > 0 and (feasible_run is None or feasible_run[x] >= a + w):
-                out.append((k, x, self.sum[k, x : x + w].sum() / c + self._G[x + a]))
-        if not out:
-            return np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0)
-        k, x, cost = zip(*out, strict=True)
-        return np.array(k, np.int64), np.array(x, np.int64), np.array(cost, np.float64)
-
-
-def _argmin(costs: np.ndarray, shifts: np.ndarray) -> tuple[int, int, float] | None:
-    k = int(np.argmin(costs))
-    kk, x = np.unravel_index(k, costs.shape)
-    c = float(costs[kk, x])
-    if not np.isfinite(c):
-        return None
-    return int(x), int(shifts[kk]), c
-
-
-def _pair_cost(S, valid, rows, x, a, overlap) -> tuple[float, float]:
-    """Mean distance of columns [x, x+w_T) and [x+a, x+a+w_T) over ``rows``, and the joint
-    G: mean distance of columns x+a-1 and x+a (valid pairs only)."""
-    r0, r1 = rows
-    F = S[r0:r1, x : x + a + overlap].astype(np.float64)
-    d = np.sqrt(((F[:, :overlap] - F[:, a:]) ** 2).sum(axis=2))
-    g = np.sqrt(((F[:, a - 1] - F[:, a]) ** 2).sum(axis=1))
-    if valid is None:
-        return float(d.mean()), float(g.mean())
-    v = valid[r0:r1, x : x + a + overlap]
-    ok = v[:, :overlap] & v[:, a:]
-    gk = v[:, a - 1] & v[:, a]
-    return (
-        float(d[ok].mean()) if ok.any() else math.inf,
-        float(g[gk].mean()) if gk.any() else 0.0,
-    )
-
-
-def _rect_costs(S, valid, rect, overlap) -> tuple[float, float, float, float]:
-    """(D_h, D_v, G_h, G_v) of ``rect``: strip mismatches and wrap-joint steps."""
-    x, y, a, b = rect
-    St = np.ascontiguousarray(S[:, x : x + a + overlap].transpose(1, 0, 2))
-    vt = None if valid is None else np.ascontiguousarray(valid[:, x : x + a + overlap].T)
-    ch, gh = _pair_cost(S, valid, (y, y + b + overlap), x, a, overlap)
-    cv, gv = _pair_cost(St, vt, (0, a + overlap), y, b, overlap)
-    return ch, cv, gh, gv
-
-
-def _make_template(S, valid, rect, overlap, joint_weight, notes=()) -> Template:
-    ch, cv, gh, gv = _rect_costs(S, valid, rect, overlap)
+def _make_template(S, valid, rect, overlap, joint_weight, notes=(), detail=None) -> Template:
+    ch, cv, gh, gv = rect_costs(S, valid, rect, overlap)
+    q, pen = (math.nan, 0.0) if detail is None else detail.rect_detail(rect, overlap)
     return Template(
         rect=rect,
         overlap=overlap,
-        cost=(ch + cv) / 2.0 + joint_weight * (gh + gv) / 2.0,
+        cost=(ch + cv) / 2.0 + joint_weight * (gh + gv) / 2.0 + pen,
         cost_horizontal=ch,
         cost_vertical=cv,
         warnings=tuple(notes),
         joint_horizontal=gh,
         joint_vertical=gv,
         joint_weight=joint_weight,
+        detail=q,
+        detail_weight=0.0 if detail is None else detail.weight,
     )
 
 
@@ -404,23 +244,53 @@ def _joint_weight(value) -> float:
 
 # --------------------------------------------------------------------------- API
 def template_cost(
-    source, rect, *, overlap: int, excluded=None, joint_weight: float = JOINT_WEIGHT
+    source,
+    rect,
+    *,
+    overlap: int,
+    excluded=None,
+    joint_weight: float = JOINT_WEIGHT,
+    detail_weight: float = DETAIL_WEIGHT,
 ) -> tuple[float, float, float]:
     """Cost of a given (e.g. user-dragged) rectangle: ``(cost, cost_horizontal, cost_vertical)``.
 
     ``rect = (x, y, w, h)``; its footprint ``(x, y, w + overlap, h + overlap)`` must lie in
     the source. Excluded pixels are left out of the means. ``cost`` is the search's criterion
-    (strip mismatches plus ``joint_weight`` times the wrap-joint steps, as
-    :attr:`Template.cost`); ``cost_horizontal`` / ``cost_vertical`` are the strip mismatches.
+    (strip mismatches plus ``joint_weight`` times the wrap-joint steps plus the detail term
+    of ``detail_weight``, as :attr:`Template.cost`); ``cost_horizontal`` / ``cost_vertical``
+    are the strip mismatches.
     """
+    t = rect_template(
+        source,
+        rect,
+        overlap=overlap,
+        excluded=excluded,
+        joint_weight=joint_weight,
+        detail_weight=detail_weight,
+    )
+    return t.cost, t.cost_horizontal, t.cost_vertical
+
+
+def rect_template(
+    source,
+    rect,
+    *,
+    overlap: int,
+    excluded=None,
+    joint_weight: float = JOINT_WEIGHT,
+    detail_weight: float = DETAIL_WEIGHT,
+) -> Template:
+    """The :class:`Template` of a given rectangle: every figure the search would report for it
+    (costs, joint steps, detail)."""
     S = colour_channels(as_image(source, "source"))
     H, W = S.shape[:2]
     x, y, a, b = check_rect(rect, overlap, (H, W))
     ex = excluded_mask(excluded, (H, W))
-    t = _make_template(
-        S, None if ex is None else ~ex, (x, y, a, b), int(overlap), _joint_weight(joint_weight)
+    lam = _joint_weight(joint_weight)
+    term = DetailTerm.of(S, check_detail_weight(detail_weight))
+    return _make_template(
+        S, None if ex is None else ~ex, (x, y, a, b), int(overlap), lam, detail=term
     )
-    return t.cost, t.cost_horizontal, t.cost_vertical
 
 
 def check_rect(rect, overlap, shape) -> tuple[int, int, int, int]:
@@ -451,6 +321,7 @@ def iter_find_template(
     refine: bool = True,
     coarse: int | None = None,
     joint_weight: float = JOINT_WEIGHT,
+    detail_weight: float = DETAIL_WEIGHT,
     sweep: int = 0,
     cancel=None,
 ):
@@ -479,6 +350,9 @@ def iter_find_template(
         ``x + w - 1, x + w`` and row pair ``y + h - 1, y + h``) added to the strip mismatch,
         so the wrap does not fall on an edge of the texture (module docstring). 0 searches
         the strip mismatch alone (the paper's criterion).
+    detail_weight : float
+        κ >= 0: weight of the detail term (:mod:`engine.tiles.detail`), which keeps the
+        search out of flat or blurred regions, where a low strip mismatch is easy. 0: off.
     sweep : int
         0 (default): no sweep events. n > 0: a :class:`TemplateSweep` with about n of the
         rectangles scored since the last one (spread evenly over the widths or heights and their
@@ -491,7 +365,9 @@ def iter_find_template(
         raises :class:`engine.cancel.Cancelled`.
 
     Yields :class:`TemplateUpdate` for every better rectangle, :class:`TemplateSweep` (with
-    ``sweep``) and :class:`Progress`.
+    ``sweep``) and :class:`Progress`. When lighting or sharpness varies across the source
+    (:func:`engine.tiles.stationarity.check_stationarity`), the search warns and the
+    Template's ``warnings`` say so, with what to do.
     """
     S = np.ascontiguousarray(colour_channels(as_image(source, "source")))
     H, W = S.shape[:2]
@@ -514,9 +390,22 @@ def iter_find_template(
     if coarse is not None:
         positive_int(coarse, "coarse")
     lam = _joint_weight(joint_weight)
+    kappa = check_detail_weight(detail_weight)
     sweep = positive_int(sweep, "sweep", minimum=0)
     return _iter_find_template(
-        S, valid, run0, lo, hi, overlap, bool(refine), cancel, tuple(notes), coarse, lam, sweep
+        S,
+        valid,
+        run0,
+        lo,
+        hi,
+        overlap,
+        bool(refine),
+        cancel,
+        tuple(notes),
+        coarse,
+        lam,
+        sweep,
+        kappa,
     )
 
 
@@ -526,7 +415,7 @@ _BUDGET = 1.5e8  # pixel pairs of a full-resolution horizontal phase before goin
 def _feasible_run0(valid: np.ndarray, h0: int) -> np.ndarray:
     """Widest exclusion-free footprint starting at column x over some ``h0`` rows."""
     H = valid.shape[0]
-    runs = _runs_right(valid)
+    runs = runs_right(valid)
     mins = ndimage.minimum_filter1d(runs, size=h0, axis=0, mode="constant", cval=0)
     return mins[h0 // 2 : h0 // 2 + H - h0 + 1].max(axis=0)
 
@@ -550,9 +439,26 @@ def _coarse_factor(shape, n_shifts: int) -> int:
 
 
 def _iter_find_template(
-    S, valid, run0, lo, hi, overlap, refine, cancel, notes, coarse=None, lam=JOINT_WEIGHT, sweep=0
+    S,
+    valid,
+    run0,
+    lo,
+    hi,
+    overlap,
+    refine,
+    cancel,
+    notes,
+    coarse=None,
+    lam=JOINT_WEIGHT,
+    sweep=0,
+    kappa=DETAIL_WEIGHT,
 ):
     H, W = S.shape[:2]
+    term = DetailTerm.of(S, kappa)
+    uneven = check_stationarity(S, energy=None if term is None else term.E).warnings
+    for n in uneven:
+        warnings.warn(n, stacklevel=3)
+    notes = (*notes, *uneven)
     n_a = hi[1] - lo[1] + 1
     f = _coarse_factor((H, W), n_a) if coarse is None else int(coarse)
     rounds = 4 if refine else 1
@@ -566,6 +472,10 @@ def _iter_find_template(
         Sc = S[: Hc * f, : Wc * f].reshape(Hc, f, Wc, f, -1).mean(axis=(1, 3))
         Sc = np.ascontiguousarray(Sc, dtype=np.float32)
         vc = None if valid is None else valid[: Hc * f, : Wc * f].reshape(Hc, f, Wc, f).all((1, 3))
+        term_c = None
+        if term is not None:  # the full resolution's energy, pooled: still *high* frequencies
+            Ec = term.E[: Hc * f, : Wc * f].reshape(Hc, f, Wc, f).mean(axis=(1, 3))
+            term_c = DetailTerm.of(Sc, kappa, E=Ec)
         loc = (-(-lo[0] // f), -(-lo[1] // f))
         hic = (max(loc[0], hi[0] // f), max(loc[1], hi[1] // f))
         ovc = max(2, round(overlap / f))
@@ -577,6 +487,7 @@ def _iter_find_template(
                     *(Sc, vc, run0c, loc, hic, ovc, refine, cancel, notes, prog, "coarse ", lam),
                     sweep=sweep,
                     scale=f,
+                    detail=term_c,
                 )
                 if stopped:
                     raise Cancelled("cancelled before the first tile rectangle was found")
@@ -602,10 +513,13 @@ def _iter_find_template(
         xwin,
         ywin,
         sweep=sweep,
+        detail=term,
     )
     if best is None and not stopped and xwin is not None:  # the windows missed: search it all
         best, stopped = yield from _phases(
-            S, valid, run0, lo, hi, overlap, refine, cancel, notes, prog, "", lam, sweep=sweep
+            *(S, valid, run0, lo, hi, overlap, refine, cancel, notes, prog, "", lam),
+            sweep=sweep,
+            detail=term,
         )
     if best is None:
         if stopped:
@@ -634,20 +548,22 @@ def _phases(
     ywin=None,
     sweep=0,
     scale=1,
+    detail=None,
 ):
     """The two phases (+ refinement rounds); returns (best Template or None, cancelled).
 
-    ``sweep`` > 0 streams a :class:`TemplateSweep` of about that many scored rectangles per
-    chunk of shifts (coordinates times ``scale``)."""
+    ``sweep`` > 0 streams :class:`TemplateSweep` items of about that many scored rectangles
+    (coordinates times ``scale``)."""
     H, W = S.shape[:2]
     a_shifts = np.arange(lo[1], hi[1] + 1)
     b_shifts = np.arange(lo[0], hi[0] + 1)
     rounds = 4 if refine else 1
     best: Template | None = None
 
-    def scan(St, vt, rows, shifts, feasible, what, to_rect):
-        """``to_rect(positions, shifts)`` -> (n, 4) rects of a phase's scored pairs."""
-        sc = _Scan(St, vt, rows, shifts, overlap, lam)
+    def scan(St, vt, rows, shifts, feasible, what, to_rect, footprint=None):
+        """``to_rect(positions, shifts)`` -> (n, 4) rects of a phase's scored pairs;
+        ``footprint`` = (line energy, depth, reference per shift) of the detail term."""
+        sc = Scan(St, vt, rows, shifts, overlap, lam, footprint and (detail, *footprint))
         top = [np.inf, None]  # the best rectangle the sweep has shown in this phase
 
         def swept(pos, kk, cost, final=False):
@@ -681,7 +597,7 @@ def _phases(
             if is_cancelled(cancel):
                 return None
         prog["done"] += shifts.size
-        found = _argmin(sc.costs(feasible), shifts)
+        found = argmin_cost(sc.costs(feasible), shifts)
         if sweep and found is not None:  # the phase's own best, what the search goes on with
             x, a, c = found
             k = int(np.flatnonzero(shifts == a)[0])
@@ -698,8 +614,12 @@ def _phases(
     current = None
     _round = 0
     for _round in range(rounds):
+        fp = None
+        if detail is not None:
+            depth = rows[1] - rows[0]
+            fp = (detail.line_energy(rows), depth, detail.reference(depth, a_shifts + overlap))
         hx = yield from scan(
-            S, valid, rows, a_shifts, feasible_h, "horizontal", horizontal_rects(*rows)
+            S, valid, rows, a_shifts, feasible_h, "horizontal", horizontal_rects(*rows), fp
         )
         if is_cancelled(cancel):
             return best, True
@@ -712,8 +632,12 @@ def _phases(
         feasible_v = None
         if valid is not None:
             vt = np.ascontiguousarray(valid[:, band].T)
-            feasible_v = _runs_1d(valid[:, band].all(axis=1))
+            feasible_v = runs_1d(valid[:, band].all(axis=1))
         feasible_v = _window(feasible_v, H, ywin)
+        fp = None
+        if detail is not None:
+            line = detail.line_energy(None, (x, x + a + overlap), transposed=True)
+            fp = (line, a + overlap, detail.reference(b_shifts + overlap, a + overlap))
         vy = yield from scan(
             St,
             vt,
@@ -722,6 +646,7 @@ def _phases(
             feasible_v,
             "vertical",
             lambda y, b, x=x, a=a: np.stack([np.full_like(y, x), y, np.full_like(y, a), b], 1),
+            fp,
         )
         if is_cancelled(cancel):
             return best, True
@@ -732,7 +657,7 @@ def _phases(
         if rect == current:
             break
         current = rect
-        t = _make_template(S, valid, rect, overlap, lam, notes)
+        t = _make_template(S, valid, rect, overlap, lam, notes, detail)
         if best is None or t.cost < best.cost - 1e-12:
             best = t
             if not label:
@@ -747,7 +672,7 @@ def _phases(
         # refinement: the horizontal phase again on the chosen rows
         rows = (y, y + b + overlap)
         if valid is not None:
-            feasible_h = _window(_runs_1d(valid[rows[0] : rows[1]].all(axis=0)), W, xwin)
+            feasible_h = _window(runs_1d(valid[rows[0] : rows[1]].all(axis=0)), W, xwin)
     return best, False
 
 

@@ -322,6 +322,14 @@ def test_joint_weight_is_passed_to_the_search_and_recorded(src, tmp_path):
         assert man["resolved"]["joint_weight"] == float(weight)
         t = find_template(S, tile_min=48, tile_max=56, joint_weight=float(weight))
         assert man["template"]["rect"] == list(t.rect)
+    out = tmp_path / "k0"
+    assert (
+        main(["tileset", str(src["rgb8"]), "--out", str(out), *ARGS, "--detail-weight", "0"]) == 0
+    )
+    man = json.loads((out / "manifest.json").read_text())
+    assert man["resolved"]["detail_weight"] == 0.0
+    t = find_template(S, tile_min=48, tile_max=56, detail_weight=0)
+    assert man["template"]["rect"] == list(t.rect)
 
 
 def test_default_patch_ring_is_the_engines(src, tmp_path):

@@ -13,6 +13,7 @@ from engine.png import encode_png
 from engine.seams import SeamSpec
 from engine.settings import DEFAULT_SEAM, TilesetSettings, settings_from_parameters
 from engine.tiles import iter_candidates
+from engine.tiles.detail import DETAIL_WEIGHT
 from engine.tiles.pipeline import resolve
 from engine.tiles.template import JOINT_WEIGHT
 from tests.engine.helpers import smooth_texture
@@ -61,6 +62,7 @@ def test_round_trip_through_json(s):
 def test_defaults_are_the_engines():
     s = TilesetSettings()
     assert s.joint_weight == JOINT_WEIGHT
+    assert s.detail_weight == DETAIL_WEIGHT
     assert s.seam == DEFAULT_SEAM == SeamSpec(blend="adaptive")
     assert s.template_seam == SeamSpec()  # the template's cuts stay hard
     defaults = inspect.signature(iter_candidates).parameters

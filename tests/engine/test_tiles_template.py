@@ -15,7 +15,8 @@ from engine.tiles import (
     iter_find_template,
     template_cost,
 )
-from engine.tiles.template import _argmin, _pair_cost, _Scan
+from engine.tiles.detail import DETAIL_WEIGHT
+from engine.tiles.template_scan import Scan, argmin_cost, pair_cost
 from tests.engine.helpers import events_and_result
 
 
@@ -30,15 +31,70 @@ def dist(p, q):
     return np.sqrt(((p.astype(np.float64) - q) ** 2).sum(-1))
 
 
-def brute_rect_cost(S, rect, w, lam=0.0):
-    """(D_h + D_v) / 2 + λ (G_h + G_v) / 2, G the step across the natural wrap joints."""
+def brute_energy(S):
+    """Squared 4-neighbour Laplacian per channel (mirrored border), mean over channels."""
+    S = np.asarray(S, dtype=np.float64)
+    P = np.pad(S, ((1, 1), (1, 1), (0, 0)), mode="symmetric")
+    c = P[1:-1, 1:-1]
+    lap = P[:-2, 1:-1] + P[2:, 1:-1] + P[1:-1, :-2] + P[1:-1, 2:] - 4 * c
+    return (lap**2).mean(axis=2)
+
+
+def brute_unrelated(S):
+    """Mean distance of pixels a few fixed wrapped offsets apart (every 4th pixel)."""
+    sub = np.asarray(S, dtype=np.float64)[::4, ::4]
+    h, w = sub.shape[:2]
+    offsets = ((1 / 2, 1 / 2), (1 / 3, 3 / 5), (5 / 7, 1 / 4))
+    return np.mean(
+        [dist(sub, np.roll(sub, (int(h * fy), int(w * fx)), (0, 1))).mean() for fy, fx in offsets]
+    )
+
+
+def brute_starts(last):
+    """Up to 64 window starts spread evenly over 0 .. last."""
+    return sorted({int(round(v)) for v in np.linspace(0, last, min(last + 1, 64))})
+
+
+def brute_reference(E, hf, wf):
+    """The upper quartile of the window means (each by .mean()) on the starts' grid."""
+    H, W = E.shape
+    means = [
+        E[y : y + hf, x : x + wf].mean() for y in brute_starts(H - hf) for x in brute_starts(W - wf)
+    ]
+    return float(np.quantile(means, 0.75))
+
+
+_REFS: dict = {}  # per image: energy and unit; per image and size: the reference
+
+
+def brute_detail_penalty(S, rect, w, kappa):
+    """κ · C · max(0, 1 − q): q the footprint's mean energy over the upper quartile of the
+    window means of its size, C the unrelated pixels' distance."""
+    if kappa == 0:
+        return 0.0
+    x, y, a, b = rect
+    hf, wf = b + w, a + w
+    image = S.tobytes()
+    if image not in _REFS:
+        _REFS[image] = brute_energy(S), brute_unrelated(S)
+    E, unit = _REFS[image]
+    key = (image, hf, wf)
+    if key not in _REFS:
+        _REFS[key] = brute_reference(E, hf, wf)
+    q = E[y : y + hf, x : x + wf].mean() / _REFS[key]
+    return kappa * unit * min(1.0, max(0.0, 1.0 - q))
+
+
+def brute_rect_cost(S, rect, w, lam=0.0, kappa=0.0):
+    """(D_h + D_v) / 2 + λ (G_h + G_v) / 2 + the detail term, G the step across the natural
+    wrap joints."""
     x, y, a, b = rect
     rows, cols = slice(y, y + b + w), slice(x, x + a + w)
     dh = dist(S[rows, x : x + w], S[rows, x + a : x + a + w]).mean()
     dv = dist(S[y : y + w, cols], S[y + b : y + b + w, cols]).mean()
     gh = dist(S[rows, x + a - 1], S[rows, x + a]).mean()
     gv = dist(S[y + b - 1, cols], S[y + b, cols]).mean()
-    return (dh + dv) / 2 + lam * (gh + gv) / 2
+    return (dh + dv) / 2 + lam * (gh + gv) / 2 + brute_detail_penalty(S, rect, w, kappa)
 
 
 @pytest.mark.parametrize("masked", [False, True])
@@ -49,7 +105,7 @@ def test_scan_costs_match_brute_force(masked, lam):
     valid = rng.random((20, 40)) > 0.2 if masked else np.ones((20, 40), bool)
     shifts = np.arange(8, 15)
     w = 4
-    sc = _Scan(S, valid if masked else None, (3, 17), shifts, w, lam)
+    sc = Scan(S, valid if masked else None, (3, 17), shifts, w, lam)
     for _ in sc.chunks():
         pass
     costs = sc.costs(None)
@@ -64,10 +120,39 @@ def test_scan_costs_match_brute_force(masked, lam):
             gk = valid[r, x + a - 1] & valid[r, x + a]
             g = dist(S[r, x + a - 1], S[r, x + a])[gk].mean()
             assert costs[k, x] == pytest.approx(d + lam * g, rel=1e-6, abs=1e-9)
-            dd, gg = _pair_cost(S, valid if masked else None, (3, 17), x, int(a), w)
+            dd, gg = pair_cost(S, valid if masked else None, (3, 17), x, int(a), w)
             assert (dd, gg) == pytest.approx((d, g), rel=1e-6, abs=1e-9)
-    x, a, c = _argmin(costs, shifts)
+    x, a, c = argmin_cost(costs, shifts)
     assert c == pytest.approx(np.nanmin(costs))
+
+
+def test_scan_detail_term_matches_brute_force():
+    from engine.tiles.detail import DetailTerm
+
+    rng = np.random.default_rng(4)
+    S = rng.random((22, 36, 3), dtype=np.float32)
+    S[:, :14] *= 0.1  # a calm left part: its footprints lack detail
+    shifts, w, rows = np.arange(6, 12), 3, (2, 19)
+    term = DetailTerm.of(S, 2.0)
+    depth = rows[1] - rows[0]
+    fp = (term, term.line_energy(rows), depth, term.reference(depth, shifts + w))
+    sc = Scan(S, None, rows, shifts, w, 0.3, fp)
+    for _ in sc.chunks():
+        pass
+    costs = sc.costs(None)
+    plain = Scan(S, None, rows, shifts, w, 0.3)
+    for _ in plain.chunks():
+        pass
+    base = plain.costs(None)
+    penalised = 0
+    for k, a in enumerate(shifts):
+        for x in range(36 - a - w + 1):
+            rect = (x, rows[0], int(a), depth - w)
+            pen = brute_detail_penalty(S, rect, w, 2.0)
+            penalised += pen > 0
+            assert costs[k, x] == pytest.approx(base[k, x] + pen, rel=1e-6, abs=1e-9)
+            assert term.rect_detail(rect, w)[1] == pytest.approx(pen, rel=1e-6, abs=1e-12)
+    assert penalised > 10
 
 
 @pytest.mark.parametrize("dtype", [np.uint8, np.float32, np.float64])
@@ -80,8 +165,15 @@ def test_periodic_source_finds_its_period(dtype):
     x, y, w, h = t.rect
     assert (h, w) == (23, 29)
     assert (t.cost_horizontal, t.cost_vertical) == pytest.approx((0, 0), abs=1e-6)
-    assert t.cost == pytest.approx(t.joint_weight * (t.joint_horizontal + t.joint_vertical) / 2)
-    pure = find_template(src, tile_min=(18, 20), tile_max=(30, 34), overlap=4, joint_weight=0)
+    f = S if dtype != np.uint8 else src / np.float32(255)
+    detail = brute_detail_penalty(f.astype(np.float32), t.rect, 4, t.detail_weight)
+    assert t.cost == pytest.approx(
+        t.joint_weight * (t.joint_horizontal + t.joint_vertical) / 2 + detail
+    )
+    assert t.detail_weight == DETAIL_WEIGHT and 0.5 < t.detail < 2
+    pure = find_template(
+        src, tile_min=(18, 20), tile_max=(30, 34), overlap=4, joint_weight=0, detail_weight=0
+    )
     assert pure.rect[2:] == (29, 23) and pure.cost == pytest.approx(0, abs=1e-6)
     assert t.footprint == (x, y, w + 4, h + 4)
     np.testing.assert_array_equal(src, before)
@@ -89,13 +181,15 @@ def test_periodic_source_finds_its_period(dtype):
 
 def test_gray_source_and_reported_costs():
     S = periodic(channels=1)[:, :, 0] * 0.5 + np.linspace(0, 0.3, 100)[None, :]
-    for lam in (0.0, 0.5, 3.0):
-        t = find_template(S, tile_min=20, tile_max=32, overlap=4, joint_weight=lam)
-        assert t.joint_weight == lam
-        cost, ch, cv = template_cost(S, t.rect, overlap=4, joint_weight=lam)
+    for lam, kappa in ((0.0, 0.0), (0.5, 0.0), (3.0, 0.0), (0.5, 1.0), (0.0, 4.0)):
+        kw = dict(joint_weight=lam, detail_weight=kappa)
+        t = find_template(S, tile_min=20, tile_max=32, overlap=4, **kw)
+        assert t.joint_weight == lam and t.detail_weight == kappa
+        cost, ch, cv = template_cost(S, t.rect, overlap=4, **kw)
         assert cost == pytest.approx(t.cost)
         assert (ch, cv) == pytest.approx((t.cost_horizontal, t.cost_vertical))
-        assert cost == pytest.approx(brute_rect_cost(S[:, :, None], t.rect, 4, lam), rel=1e-6)
+        brute = brute_rect_cost(S[:, :, None].astype(np.float32), t.rect, 4, lam, kappa)
+        assert cost == pytest.approx(brute, rel=1e-6)
         assert (ch + cv) / 2 == pytest.approx(brute_rect_cost(S[:, :, None], t.rect, 4))
     # the default λ is the search's default: a user-fixed rectangle scores like a found one
     t = find_template(S, tile_min=20, tile_max=32, overlap=4)
@@ -112,6 +206,8 @@ def test_refine_never_worse_and_two_phase_near_brute_force():
     coarse = find_template(S, tile_min=16, tile_max=22, overlap=w, refine=False)
     fine = find_template(S, tile_min=16, tile_max=22, overlap=w, refine=True)
     assert fine.cost <= coarse.cost + 1e-12
+    coarse = find_template(S, tile_min=16, tile_max=22, overlap=w, refine=False, detail_weight=0)
+    fine = find_template(S, tile_min=16, tile_max=22, overlap=w, refine=True, detail_weight=0)
     best = min(
         brute_rect_cost(S, (x, y, a, b), w)
         for a in range(16, 23)

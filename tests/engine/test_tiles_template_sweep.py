@@ -3,20 +3,23 @@
 import numpy as np
 
 from engine.tiles import TemplateSweep, TemplateUpdate, find_template, iter_find_template
+from engine.tiles.detail import DETAIL_WEIGHT
 from tests.engine.helpers import events_and_result
-from tests.engine.test_tiles_template import dist, periodic
+from tests.engine.test_tiles_template import brute_detail_penalty, dist, periodic
 
 
 def phase_cost(S, rect, w, phase, lam):
     """The cost a phase gives ``rect``: its strip mismatch and wrap-joint step over the
-    phase's rows (horizontal) or the rectangle's footprint columns (vertical)."""
+    phase's rows (horizontal) or the rectangle's footprint columns (vertical), and the detail
+    term of its footprint."""
+    detail = brute_detail_penalty(S, rect, w, DETAIL_WEIGHT)
     x, y, a, b = rect
     if phase == "vertical":
         S = S[:, x : x + a + w].transpose(1, 0, 2)
         x, y, a, b = y, 0, b, a
     rows = slice(y, y + b + w)
     d = dist(S[rows, x : x + w], S[rows, x + a : x + a + w]).mean()
-    return d + lam * dist(S[rows, x + a - 1], S[rows, x + a]).mean()
+    return d + lam * dist(S[rows, x + a - 1], S[rows, x + a]).mean() + detail
 
 
 def test_sweep_events_sample_the_scored_rectangles():
