@@ -215,12 +215,16 @@ def test_bundled_samples_wrap_and_detail():
 def test_brick_wrap_joint_is_calm():
     """The tile's wrap joint is the natural column pair (x+w-1, x+w) of the source (row pair
     (y+h-1, y+h)); the strip mismatch alone puts it on a mortar edge of the brick wall, the
-    joint term (joint_weight) moves it where the wall is calm."""
+    joint term (joint_weight) moves it where the wall is calm. The diagnosis runs the paper's
+    criterion alone (no joint, no detail term)."""
     S = load_image(resources.sample_path("brick")).pixels
     step = np.abs(np.diff(S, axis=1)).mean()  # mean column step (gray: |d| = Euclidean)
     for lam, calm in ((0.0, False), (None, True)):
         t = find_template(
-            S, tile_min=256, tile_max=256, **({} if lam is None else {"joint_weight": lam})
+            S,
+            tile_min=256,
+            tile_max=256,
+            **({} if lam is None else {"joint_weight": lam, "detail_weight": 0}),
         )
         x, y, a, b = t.rect
         st = make_seamless(S, t)
