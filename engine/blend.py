@@ -35,7 +35,7 @@ from scipy import ndimage
 from skimage.util import img_as_float32
 
 from engine._validate import as_error_map, choice, positive_int
-from engine.seams.spec import BLEND_MODES, SeamSpec
+from engine.seams.spec import BLEND_MODES, POISSON, TILE_BLEND_MODES, SeamSpec
 
 __all__ = [
     "BLEND_MODES",
@@ -161,8 +161,10 @@ def blend_weights(
         The error map the seam was searched on (adaptive mode reads it).
     spec : engine.seams.SeamSpec, optional
         Its ``blend``, ``width`` and ``rho`` (then ``mode``, ``width``, ``rho`` are not given).
-    mode : {"none", "feather", "adaptive"}
-        Hard cut, fixed ramp of ``width`` pixels, or ρ-adaptive half-widths (§1.3).
+    mode : {"none", "feather", "adaptive", "poisson"}
+        Hard cut, fixed ramp of ``width`` pixels, or ρ-adaptive half-widths (§1.3);
+        ``"poisson"`` is a hard cut here (its gradient-domain solve comes after,
+        :mod:`engine.poisson`).
     width : float
         Feather width in pixels (half-width ``width / 2`` each side of the cut line).
     rho : int
@@ -177,14 +179,14 @@ def blend_weights(
     mode = "none" if mode is None else mode
     width = 4 if width is None else width
     rho = 3 if rho is None else rho
-    choice(mode, "mode", BLEND_MODES)
+    choice(mode, "mode", TILE_BLEND_MODES)
     mask = np.asarray(seam.mask, dtype=bool)
     e = as_error_map(error)
     if e.shape != mask.shape:
         raise ValueError(f"error must be shaped like the seam's mask {mask.shape}, got {e.shape}")
     if isinstance(width, bool) or not np.isfinite(width) or width < 0:
         raise ValueError(f"width must be a finite number >= 0, got {width!r}")
-    if mode == "none":
+    if mode in ("none", POISSON):
         return mask.astype(np.float32)
     if mode == "feather":
         b_rows = np.full(mask.shape[0], float(width) / 2.0)

@@ -54,7 +54,7 @@ from engine.matching import (
 )
 from engine.quilting.cut import blend_alpha, cut_overlap
 from engine.quilting.layout import arms_of
-from engine.seams.spec import SeamSpec, as_seam_spec
+from engine.seams.spec import SeamSpec, as_seam_spec, check_blend
 
 __all__ = ["HEAL_SEAM", "HealBlock", "HealResult", "default_block", "heal", "iter_heal"]
 
@@ -190,7 +190,7 @@ def iter_heal(
         if ex.shape != (H, W):
             raise ValueError(f"excluded must be shaped {(H, W)} like the image, got {ex.shape}")
         bad |= ex.astype(bool)
-    spec = as_seam_spec(seam, default=HEAL_SEAM)
+    spec = check_blend(as_seam_spec(seam, default=HEAL_SEAM), "heal")
     tolerance = non_negative_number(tolerance, "tolerance")
     auto = block is None
     b = default_block((H, W), m) if auto else positive_int(block, "block", minimum=MIN_BLOCK)

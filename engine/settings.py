@@ -36,7 +36,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 from engine._checks import as_size, choice, non_negative_number, positive_int
-from engine.seams.spec import BLEND_MODES, SeamSpec
+from engine.seams.spec import TILE_BLEND_MODES, SeamSpec
 
 __all__ = [
     "DEFAULT_SEAM",
@@ -91,7 +91,7 @@ def patch_search_mode(value, name):
 
 
 def blend_mode(value, name):
-    return choice(value, name, BLEND_MODES)
+    return choice(value, name, TILE_BLEND_MODES)
 
 
 def colour_range(value, name):

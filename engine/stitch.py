@@ -39,7 +39,7 @@ from engine.errormap import error_map
 from engine.seams._result import Seam
 from engine.seams.graph import graph_path
 from engine.seams.search import MINIMAX_METRIC, find_seam
-from engine.seams.spec import SeamSpec, as_seam_spec
+from engine.seams.spec import POISSON, SeamSpec, as_seam_spec
 
 ORIENTATIONS = ("right", "left", "bottom", "top")
 GRAPH_METHODS = ("dijkstra", "minimax")
@@ -639,7 +639,7 @@ def patch_cut(
     labels, _ = ndimage.label(~barrier)
     border = np.concatenate([labels[0], labels[-1], labels[:, 0], labels[:, -1]])
     mask = ~np.isin(labels, np.unique(border[border > 0]))
-    hard = spec.blend == "none"
+    hard = spec.blend in ("none", POISSON)
     alpha = mask.astype(np.float32) if hard else _ring_ramp(mask, barrier, b_at, wp)
     if m:
         alpha[:m] = 0
@@ -690,7 +690,7 @@ def _ring_ramp(mask: np.ndarray, barrier: np.ndarray, b_at: np.ndarray, ring: in
 def _side_half_widths(seam: Seam, ce: np.ndarray, spec: SeamSpec):
     """Per canonical row half-widths of one side (§1.3 per side, clamped inside the ring)."""
     h = ce.shape[0]
-    if spec.blend == "none":
+    if spec.blend in ("none", POISSON):
         return np.zeros(h)
     b = (
         np.full(h, spec.width / 2.0)

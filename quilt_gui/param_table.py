@@ -13,7 +13,14 @@ import re
 from dataclasses import dataclass
 from typing import Any
 
-from engine.seams.spec import BLEND_MODES, METHODS, METRICS, MINIMAX_VARIANTS, OSCILLATING_VARIANTS
+from engine.seams.spec import (
+    BLEND_MODES,
+    METHODS,
+    METRICS,
+    MINIMAX_VARIANTS,
+    OSCILLATING_VARIANTS,
+    TILE_BLEND_MODES,
+)
 from engine.settings import TilesetSettings
 
 SAME = "same"  # template_blend: as the patches' blending
@@ -45,6 +52,7 @@ _BLEND_LABELS = {
     "none": "Hard cut",
     "feather": "Soft, fixed width",
     "adaptive": "Soft where needed",
+    "poisson": "Gradient domain (evens out tone)",
 }
 _METRIC_LABELS = {"euclid": "Colour distance", "ssd": "Squared distance", "lab": "Perceptual (Lab)"}
 
@@ -203,12 +211,13 @@ PARAMS: tuple[Param, ...] = (
         "blend",
         "adaptive",
         "Seam blending",
-        "After the cut: a hard edge, a soft edge of fixed width, or a soft edge only where the "
-        "two sides differ.",
+        "After the cut: a hard edge, a soft edge of fixed width, a soft edge only where the "
+        "two sides differ, or a hard edge whose tone step is spread smoothly over both sides "
+        "(gradient domain: no blur).",
         "Seams",
         basic=True,
-        paper="none / feather / adaptive blending (Somol & Haindl)",
-        **_choices(BLEND_MODES, _BLEND_LABELS),
+        paper="none / feather / adaptive blending (Somol & Haindl); poisson: Pérez et al. 2003",
+        **_choices(TILE_BLEND_MODES, _BLEND_LABELS),
     ),
     _P(
         "width",
@@ -239,7 +248,7 @@ PARAMS: tuple[Param, ...] = (
         "Blending of the seamless tile's own two seams: as Seam blending, or its own.",
         "Seams",
         paper="quilt-studio tileset keeps the template's cuts hard by default",
-        **_choices((SAME, *BLEND_MODES), {SAME: "As Seam blending", **_BLEND_LABELS}),
+        **_choices((SAME, *TILE_BLEND_MODES), {SAME: "As Seam blending", **_BLEND_LABELS}),
     ),
     # -- candidates
     _P(

@@ -51,7 +51,7 @@ from engine.cli.tileset_output import (
     write_set,
     write_text,
 )
-from engine.seams.spec import BLEND_MODES, METHODS, METRICS
+from engine.seams.spec import METHODS, METRICS, TILE_BLEND_MODES
 from engine.settings import TilesetSettings
 
 
@@ -215,7 +215,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--metric", choices=METRICS, help=f"error metric (default {d.seam.metric})")
     p.add_argument(
         "--blend",
-        choices=BLEND_MODES,
+        choices=TILE_BLEND_MODES,
         help=f"blending of every cut (default: {d.template_blend} for the template, "
         f"{d.seam.blend} for the patches)",
     )

@@ -15,7 +15,7 @@ from engine.quilting.bhatia import bhatia_anchors
 from engine.quilting.layout import check_torus_axis, torus_overlap
 from engine.seams import SeamSpec
 from engine.seams.spec import METHODS as SEAM_METHODS
-from engine.seams.spec import STRAIGHT
+from engine.seams.spec import STRAIGHT, check_blend
 
 SELECTIONS = ("best", "random", "sampled", "bhatia")
 MODES = ("auto", "exact", "fast")
@@ -111,6 +111,7 @@ def check_options(
             "seam must be an engine.seams.SeamSpec (e.g. SeamSpec('dp', metric='ssd')), "
             f"got {type(seam).__name__}"
         )
+    check_blend(seam, "quilting")
     choice(mode, "mode", MODES)
     if overlap is None:
         overlap = max(1, min(bh, bw) // (2 if seam.method == "minimax" else 6))

@@ -44,6 +44,10 @@ STRAIGHT = "straight"
 METRICS = ("euclid", "ssd", "lab")
 #: blending after the cut (:func:`engine.blend.blend_weights`)
 BLEND_MODES = ("none", "feather", "adaptive")
+#: gradient-domain blending along a hard cut (:mod:`engine.poisson`): tile sets only
+POISSON = "poisson"
+#: the blends a tile set's cuts take (:class:`SeamSpec` accepts them all)
+TILE_BLEND_MODES = (*BLEND_MODES, POISSON)
 #: variants of the minimax method: which path metric the graph search minimises
 MINIMAX_VARIANTS = ("exact", "lm", "sorted")
 #: variants of the oscillating search (restart after an improvement, or continue)
@@ -66,6 +70,8 @@ OPTIONS: dict[str, dict[str, object]] = {
 
 __all__ = [
     "BLEND_MODES",
+    "POISSON",
+    "TILE_BLEND_MODES",
     "CYCLIC_METHODS",
     "INITS",
     "METHODS",
@@ -77,6 +83,7 @@ __all__ = [
     "STRAIGHT",
     "SeamSpec",
     "as_seam_spec",
+    "check_blend",
     "check_option_names",
 ]
 
@@ -136,8 +143,10 @@ class SeamSpec:
         ``spec.options`` always holds all of them and equal specs compare equal.
     metric : {"euclid", "ssd", "lab"}
         Error metric of the map the seam runs through.
-    blend : {"none", "feather", "adaptive"}
-        Blending after the cut: hard, a ramp of ``width`` pixels, or ρ-adaptive (``rho``).
+    blend : {"none", "feather", "adaptive", "poisson"}
+        Blending after the cut: hard, a ramp of ``width`` pixels, ρ-adaptive (``rho``), or
+        in the gradient domain along a hard cut (``"poisson"``, :mod:`engine.poisson`; tile
+        sets only: quilting, heal and the seam command refuse it, :func:`check_blend`).
     width : float
         Feather width in pixels (>= 0).
     rho : int
@@ -159,7 +168,7 @@ class SeamSpec:
             raise TypeError(f"options must be a mapping, got {type(self.options).__name__}")
         opts = check_options(self.method, dict(self.options))
         choice(self.metric, "metric", METRICS)
-        choice(self.blend, "blend", BLEND_MODES)
+        choice(self.blend, "blend", TILE_BLEND_MODES)
         set_ = object.__setattr__
         set_(self, "options", MappingProxyType(opts))
         set_(self, "width", non_negative_number(self.width, "width"))
@@ -217,6 +226,17 @@ class SeamSpec:
         if isinstance(values.get("width"), numbers.Integral):
             values["width"] = float(values["width"])
         return cls(**values)
+
+
+def check_blend(spec: SeamSpec, what: str) -> SeamSpec:
+    """``spec`` if its blend is one of :data:`BLEND_MODES`; ValueError naming ``what`` (e.g.
+    "quilting") for the tile sets' gradient-domain blend."""
+    if spec.blend not in BLEND_MODES:
+        raise ValueError(
+            f"blend {spec.blend!r} (gradient domain) is for tile sets; {what} takes "
+            f"{', '.join(BLEND_MODES)}"
+        )
+    return spec
 
 
 def as_seam_spec(value, name: str = "seam", *, default: SeamSpec | None = None) -> SeamSpec:

@@ -49,7 +49,8 @@ from engine.events import Item, Progress, drain, frozen_array
 from engine.exclusion import valid_anchors
 from engine.matching import ZERO_ERROR_FRACTION, SampleSpectrum, error_floor
 from engine.materials import apply_cut
-from engine.seams.spec import SeamSpec, as_seam_spec
+from engine.poisson import solve_maps
+from engine.seams.spec import POISSON, SeamSpec, as_seam_spec
 from engine.stitch import PATCH_SEAM, patch_cut
 from engine.tiles.seamless import MAIN, SeamlessTile, as_maps, check_weights, seam_error
 from engine.tiles.template import as_size, excluded_mask, flat_warning
@@ -72,6 +73,9 @@ TOLERANCE = 0.25  # global search: draw within (1 + TOLERANCE) x the best remain
 QUALITY = 2.0  # global search: never use a ring match worse than (1 + QUALITY) x the best
 SAME_CONTENT = 2.0 / 255  # patch windows closer than this (mean abs luminance) are the same
 OUTWARD = 0.5  # bias of the closed cut toward the outer margin, in units of the mean error
+#: blend "poisson": the correction fades over about this many rings' widths from the cut (a
+#: screened solve), so a patch keeps its own tone inside instead of taking the shared ring's
+POISSON_REACH = 2.0
 PATCH_RING_FLOOR = 8  # px: narrower rings leave the closed cut no room (default_patch_overlap)
 
 
@@ -90,13 +94,20 @@ def check_ring(patch_overlap, margin, *, min_margin: int = 0) -> tuple[int, int]
 def stitch_patch(q, u, *, ring, margin, seam, weights, outward, depth, cancel=None):
     """Window ``q`` ({map: image}) stitched into ``u`` along a closed cut in the ring (its
     error the maps' weighted error, drawn toward the outer margin by ``outward`` x the mean
-    error x ``depth``): ``({map: result}, PatchCut)``. Candidates and Wang interiors."""
+    error x ``depth``): ``({map: result}, PatchCut)``. Candidates and Wang interiors.
+
+    ``seam.blend == "poisson"``: the hard cut blended in the gradient domain
+    (:func:`engine.poisson.solve_maps`, screened at :data:`POISSON_REACH` x ``ring``), the
+    outer ``margin`` pixels (at least 1) kept bit for bit."""
     err = seam_error(q, u, weights, seam.metric)
     bias = (outward * float(err.mean())) * depth if outward else None
     cut = patch_cut(
         q[MAIN], u[MAIN], ring=ring, margin=margin, seam=seam, error=err, bias=bias, cancel=cancel
     )
     check(cancel)
+    if seam.blend == POISSON:
+        reach = POISSON_REACH * ring
+        return solve_maps(q, u, cut.mask, fixed=max(1, margin), reach=reach), cut
     return apply_cut(q, u, cut.alpha), cut
 
 
@@ -313,6 +324,10 @@ class _Setup:
             raise ValueError(
                 f"no {pw}x{ph} patch fits outside the excluded region: paint a smaller "
                 "exclusion or use a smaller patch_size"
+            )
+        if self.seam.blend == POISSON and self.margin == 0:
+            raise ValueError(
+                "blend 'poisson' keeps the outer margin fixed: margin must be at least 1"
             )
         self.notes = []
         if self.margin == 0 and (ph, pw) == (th, tw):

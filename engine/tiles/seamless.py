@@ -9,6 +9,11 @@ join the interior without a step.
 
 Material maps (normal, roughness...) follow the same cuts: the seam is searched on
 :func:`engine.materials.material_error` and applied with :func:`engine.materials.apply_cut`.
+
+With ``blend="poisson"`` both cuts are hard and the tile is then solved in the gradient domain
+on the torus (:func:`engine.poisson.solve_torus_maps`): every pixel is traced to its source
+position, and the edges whose two pixels are not neighbours in the source (the cuts) take the
+source's natural gradient, so a tone step along a cut is spread over the whole tile.
 """
 
 from __future__ import annotations
@@ -27,7 +32,7 @@ from engine.events import Progress, Snapshot, drain, frozen_array
 from engine.materials import apply_cut, material_error
 from engine.seams._result import Seam
 from engine.seams.search import SeamUpdate, iter_find_seam
-from engine.seams.spec import CYCLIC_METHODS, SeamSpec, as_seam_spec
+from engine.seams.spec import CYCLIC_METHODS, POISSON, SeamSpec, as_seam_spec
 from engine.tiles.template import Template, check_rect, flat_warning
 
 __all__ = [
@@ -329,6 +334,11 @@ def _iter_make_seamless(S, extra, rect, wT, spec: SeamSpec, wps, wts, cancel, no
     tiles = {k: v[:b].copy() for k, v in inner.items()}
     for k in tiles:
         tiles[k][:wT] = band[k]
+    if spec.blend == POISSON:  # the hard cuts, then the gradient-domain solve on the torus
+        from engine.poisson import solve_torus_maps
+
+        coords = _traced(rect, wT, alpha_h, alpha_v)
+        tiles = solve_torus_maps(tiles, coords, stack)
     up_v = _update("vertical", seam_v, True, (y, x), drawn_v, transpose=True)
     yield up_v
     yield Progress(2, 2, "seamless: done")
@@ -363,6 +373,17 @@ def _iter_make_seamless(S, extra, rect, wT, spec: SeamSpec, wps, wts, cancel, no
         seam=spec,
         warnings=notes,
     )
+
+
+def _traced(rect, wT: int, alpha_h: np.ndarray, alpha_v: np.ndarray) -> np.ndarray:
+    """(h, w, 2) source (row, col) of every pixel of the tile the two hard cuts made."""
+    x, y, a, b = rect
+    F = np.stack(np.mgrid[y : y + b + wT, x : x + a + wT], axis=2)
+    inner = F[:, :a].copy()
+    inner[:, :wT] = np.where(alpha_h[..., None] >= 1, F[:, a : a + wT], F[:, :wT])
+    tile = inner[:b].copy()
+    tile[:wT] = np.where(alpha_v[..., None] >= 1, inner[b : b + wT], inner[:wT])
+    return tile
 
 
 def _alpha(seam: Seam, error: np.ndarray, spec: SeamSpec, cyclic: bool = False) -> np.ndarray:

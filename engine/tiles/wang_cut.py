@@ -40,7 +40,7 @@ from engine.blend import adaptive_half_widths, blend_weights, clamped_half_width
 from engine.cancel import check
 from engine.materials import apply_cut
 from engine.seams.search import find_seam
-from engine.seams.spec import SeamSpec
+from engine.seams.spec import POISSON, SeamSpec
 
 __all__ = ["CUTS", "Frame", "frame_cut", "frame_reach", "ramp_reach"]
 
@@ -57,7 +57,7 @@ LABELS = {"n": 0, "e": 1, "s": 2, "w": 3}
 
 def ramp_reach(seam: SeamSpec) -> int:
     """How far (px) the blend ramp of ``seam`` can reach past its cut."""
-    if seam.blend == "none":
+    if seam.blend in ("none", POISSON):  # the frame's cuts stay hard with "poisson"
         return 0
     if seam.blend == "feather":
         return math.ceil(seam.width / 2) + 1
@@ -170,7 +170,7 @@ def _cut_alpha(seam, e, inside, band: int, T: int, spec: SeamSpec) -> np.ndarray
     n = e.shape[0]
     filled = np.where(inside, e, e[inside].mean() if inside.any() else 0.0)
     cols = cut_columns(seam.mask)
-    if spec.blend == "none" or cols is None:
+    if spec.blend in ("none", POISSON) or cols is None:
         alpha = blend_weights(seam, filled, spec=spec)
     else:
         b = (

@@ -332,6 +332,21 @@ def test_joint_weight_is_passed_to_the_search_and_recorded(src, tmp_path):
     assert man["template"]["rect"] == list(t.rect)
 
 
+def test_blend_poisson_reaches_the_template_and_the_patches(src, tmp_path):
+    """--blend poisson: both cuts hard, then solved in the gradient domain (engine.poisson);
+    the tiles still share the template's outer margin bit for bit."""
+    out = tmp_path / "poisson"
+    assert main(["tileset", str(src["rgb8"]), "--out", str(out), *ARGS, "--blend", "poisson"]) == 0
+    man = json.loads((out / "manifest.json").read_text())
+    assert man["resolved"]["template_blend"] == "poisson"
+    assert man["resolved"]["seam"]["blend"] == "poisson"
+    template = png(out / "template.png")
+    for i in range(len(man["tiles"])):
+        tile = png(out / f"tile_{i:03d}.png")
+        np.testing.assert_array_equal(tile[0], template[0])
+        np.testing.assert_array_equal(tile[:, -1], template[:, -1])
+
+
 def test_default_patch_ring_is_the_engines(src, tmp_path):
     """Without --patch-overlap the CLI uses engine.tiles.default_patch_overlap(w_T) (w_T 20 ->
     w_P 10, not 20): the manifest says so and the tiles are the engine's defaults' tiles."""
