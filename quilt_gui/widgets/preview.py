@@ -1,7 +1,10 @@
-"""The preview: picked tiles assembled by the random index matrix, with its grid score."""
+"""The preview: picked tiles assembled by the random index matrix, with its grid score and the
+set's interior figures (issue 10: frame, ring tone, duplicates, lattice, template share) and their
+warnings in words, measured in the background."""
 
 from __future__ import annotations
 
+import numpy as np
 from PySide6.QtCore import QLineF, Qt, Slot
 from PySide6.QtGui import QColor
 from PySide6.QtWidgets import (
@@ -14,13 +17,43 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from quilt_gui import settings
+from quilt_gui import jobs, settings
 from quilt_gui.document import Document
 from quilt_gui.widgets.canvas import ImageCanvas, cosmetic_pen
 
+WARN_STYLE = "color: #e8a33d;"  # the warnings' colour (readable on the light and dark themes)
+
+
+def set_quality(tiles, source, template, settings, *, cancel=None) -> dict:
+    """:func:`engine.metrics.tileset_quality` of the picked tiles and its ``warnings`` in words
+    (worker thread); ``settings`` are the resolved TilesetSettings (ring w_P, margin, and
+    flatten: tiles of a flattened source are compared with it). ``{"error": text}`` when the
+    source has nothing to measure (flat)."""
+    from engine.metrics import quality_warnings, tileset_quality
+    from engine.tiles.pipeline import working_source
+
+    source = working_source(source, settings)
+    ring, margin = int(settings.patch_overlap), int(settings.margin)
+    try:
+        q = tileset_quality(tiles, source, template=template, ring=ring, margin=margin)
+    except ValueError as exc:
+        return {"error": str(exc)}
+    q["warnings"] = quality_warnings(q)
+    return q
+
+
+def quality_text(q: dict) -> str:
+    """One line of the set's figures (what the CLI summary prints)."""
+    return (
+        f"frame {q['frame']:.2f} · ring tone {q['ring_tone']:.2f} · duplicates "
+        f"{q['duplicates']} · lattice {q['lattice']:+.1f} dB · template share "
+        f"{q['template_share']:.0%}"
+    )
+
 
 class PreviewView(QWidget):
-    """Canvas of ``doc.tileset.preview`` with an optional tile grid and the grid score."""
+    """Canvas of ``doc.tileset.preview`` with an optional tile grid, the grid score and the
+    picked set's interior figures with their warnings (:func:`set_quality`)."""
 
     def __init__(self, doc: Document, reroll_action=None, grid_action=None, parent=None) -> None:
         super().__init__(parent)
@@ -48,14 +81,28 @@ class PreviewView(QWidget):
         self.info.setWordWrap(True)  # long texts must not widen the window
         self.info.setToolTip(
             "Grid score: autocorrelation at one tile period minus the source's "
-            "own (0 = no visible grid; one tile repeated scores about 1)."
+            "own (0 = no visible grid; one tile repeated scores about 1).\n"
+            "Frame: edge-to-centre sharpness profile of the tiles vs. random crops of the "
+            "photo (1 = no frame).\nRing tone: how much the shared ring differs in tone "
+            "from the centres, vs. crops (1 = as anywhere in the photo).\nDuplicates: tiles "
+            "equal to the template or to each other.\nLattice: power at the tile period in "
+            "an 8×8 layout, dB above what any set sharing a border reaches.\nTemplate share: "
+            "the part of each tile that is the template's."
         )
         bar.addWidget(self.info, 1)
+        self.quality: dict | None = None  # the last figures measured (None: none yet)
+        self.warnings = QLabel()
+        self.warnings.setWordWrap(True)
+        self.warnings.setStyleSheet(WARN_STYLE)
+        self.warnings.setContentsMargins(6, 0, 6, 2)
+        self.warnings.setVisible(False)
         lay = QVBoxLayout(self)
         lay.setContentsMargins(0, 0, 0, 0)
         lay.addLayout(bar)
+        lay.addWidget(self.warnings)
         lay.addWidget(self.canvas, 1)
         self._shape = None
+        self._cells = ""
         doc.tileset.preview_changed.connect(self._on_preview_changed)
         self._on_preview_changed()
 
@@ -83,10 +130,44 @@ class PreviewView(QWidget):
             score = self.doc.tileset.grid_score
             s = "n/a" if score is None else f"{score:.3f}"
             rows, cols = lay.shape if lay is not None else (0, 0)
-            self.info.setText(
+            self._cells = (
                 f"grid score {s} · {rows}×{cols} cells from {n} picked tile{'s' if n != 1 else ''}"
             )
+            self.info.setText(f"{self._cells} · measuring the set…")
+        self._measure()
         self._draw_grid()
+
+    def _measure(self) -> None:
+        """Start measuring the picked tiles (superseding an earlier measurement)."""
+        self.quality = None
+        self.warnings.setVisible(False)
+        doc = self.doc
+        picks, st = doc.tileset.picked_entries(), doc.tileset.seamless
+        if doc.tileset.preview is None or not picks or st is None or doc.source is None:
+            return
+        from engine.tiles.pipeline import resolve
+
+        s = resolve(doc.tileset.settings(), doc.source.shape, overlap=doc.tileset.overlap())
+        jobs.start(
+            "set_quality",
+            set_quality,
+            [np.asarray(c.tile) for c in picks],
+            doc.source.main,
+            np.asarray(st.tile),
+            s,
+            label="Measuring the tile set",
+            on_done=self._on_quality,
+        )
+
+    def _on_quality(self, q: dict) -> None:
+        self.quality = q
+        if "error" in q:
+            self.info.setText(self._cells)
+            return
+        self.info.setText(f"{self._cells}\n{quality_text(q)}")
+        warn = q["warnings"]
+        self.warnings.setText("\n".join(f"⚠ {w[0].upper()}{w[1:]}" for w in warn))
+        self.warnings.setVisible(bool(warn))
 
     def _draw_grid(self) -> None:
         for item in self._lines:

@@ -114,7 +114,9 @@ class MessageBar(QWidget):
 
 
 #: Jobs that run beside a long one without taking the status bar from it.
-BACKGROUND_KEYS = frozenset({"autosave", "warmup", "tile_metrics", "preview", "save"})
+BACKGROUND_KEYS = frozenset(
+    {"autosave", "warmup", "tile_metrics", "set_quality", "preview", "save"}
+)
 
 
 def time_left(job: jobs.Job, now: float | None = None) -> float | None:

@@ -89,6 +89,13 @@ def test_tile_set_workflow_open_to_reopen(qtbot, tmp_path):
     assert np.array_equal(doc.tileset.preview[th : 2 * th, 2 * tw : 3 * tw], tile)
     assert w.preview_view.canvas.array is doc.tileset.preview
     assert "grid score" in w.preview_view.info.text() and doc.tileset.grid_score is not None
+    # the picked set's interior figures (issue 10), measured in the background, and warnings
+    qtbot.waitUntil(lambda: w.preview_view.quality is not None, timeout=20_000)
+    q = w.preview_view.quality
+    assert {"frame", "ring_tone", "duplicates", "lattice", "template_share"} <= set(q)
+    assert f"frame {q['frame']:.2f}" in w.preview_view.info.text()
+    assert q["duplicates"] == 0
+    assert w.preview_view.warnings.isVisibleTo(w.preview_view) == bool(q["warnings"])
     old_layout = doc.tileset.layout.copy()
     w.act_reroll_layout.trigger()
     wait_idle(qtbot, w)
