@@ -291,7 +291,11 @@ def apply_cut(
                 raise ValueError(f"normal map {name!r} needs 3 channels, got {a.shape[2]}")
             out[name] = blend_normals(a, b, al)
         else:
-            al3 = al[..., None]
-            mix = (al3 * a + (1 - al3) * b).astype(np.float32)
-            out[name] = np.where(al3 >= 1, a, np.where(al3 <= 0, b, mix))
+            # hard pixels copied, the soft ones (a patch cut's ring) mixed: the same values
+            res = np.where(al[..., None] >= 1, a, b)
+            soft = (al > 0) & (al < 1)
+            if soft.any():
+                s = al[soft][:, None]
+                res[soft] = (s * a[soft] + (1 - s) * b[soft]).astype(np.float32)
+            out[name] = res
     return out
