@@ -80,17 +80,21 @@ class TileSetDocument(QObject):
 
     def connects_to_template(self, entry: CandidateTile) -> bool:
         """True when ``entry`` was made from the current seamless template (same size and
-        outer margin), i.e. it connects to tiles made from it."""
+        outer margin), i.e. it connects to tiles made from it.
+
+        The borders are compared as saved: within one step of the source's bit depth, since a
+        reopened project's candidates come back rounded to it while the template is
+        recomputed exactly."""
         if self.seamless is None:
             return False
         template = np.asarray(self.seamless.tile)
         tile, m = np.asarray(entry.tile), max(1, int(self.root.params["margin"]))
-        return tile.shape == template.shape and bool(
-            np.array_equal(tile[:m], template[:m])
-            and np.array_equal(tile[-m:], template[-m:])
-            and np.array_equal(tile[:, :m], template[:, :m])
-            and np.array_equal(tile[:, -m:], template[:, -m:])
-        )
+        if tile.shape != template.shape:
+            return False
+        depth = self.root.source.bit_depth if self.root.source is not None else 8
+        step = 1.0 / (2**depth - 1)
+        sides = (np.s_[:m], np.s_[-m:], np.s_[:, :m], np.s_[:, -m:])
+        return all(np.abs(tile[s] - template[s]).max() <= step for s in sides)
 
     @property
     def candidates_outdated(self) -> bool:

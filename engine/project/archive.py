@@ -309,7 +309,7 @@ def _load_images(project, reader: _Reader, fail, max_pixels, max_decoded_bytes, 
     main = project.main_map
     tiles = [c.images(main) for c in project.candidates]  # the candidates' images, by map
     wang = [c.images(main) for c in project.wang_tiles]
-    groups = [project.sources, project.template, project.preview, *tiles, *wang]
+    groups = [project.sources, project.template, project.preview, project.outputs, *tiles, *wang]
     slots = [(g, key) for g in groups if g is not None for key in g]
     heads: dict[str, PNGHeader] = {}
     total = 0

@@ -113,9 +113,14 @@ def check_project(p: Project, where: str) -> None:
         for m, a in p.preview.items():
             if len(np.shape(a)) != 3 or np.shape(a)[2] != shapes[m][2]:
                 raise ValueError(f"{where}: preview[{m!r}] is shaped {np.shape(a)}")
-    for key in ("parameters", "seeds", "extra"):
+    for key in ("parameters", "seeds", "extra", "outputs"):
         if not isinstance(getattr(p, key), dict):
             raise ValueError(f"{where}: {key} must be a dict")
+    for k, a in p.outputs.items():
+        if not isinstance(k, str) or not SAFE_NAME.match(k):
+            raise ValueError(f"{where}: outputs keys must be simple names, got {k!r}")
+        if len(np.shape(a)) != 3 or not 1 <= np.shape(a)[2] <= 4 or 0 in np.shape(a):
+            raise ValueError(f"{where}: outputs[{k!r}] is shaped {np.shape(a)}")
     if p.wang is not None or p.wang_tiles:
         check_project_wang(p, where, shapes)
 

@@ -54,6 +54,7 @@ def to_doc(project: Project, put: Callable[[np.ndarray, str], str]) -> dict:
         if project.preview is None
         else {m: put(a, f"images/preview_{m}.png") for m, a in project.preview.items()},
         "extra": project.extra,
+        "outputs": {k: put(a, f"images/output_{k}.png") for k, a in project.outputs.items()},
         "wang": project.wang,
         "wang_tiles": [
             _candidate_doc(c, i, project.main_map, put, "wang")
@@ -218,6 +219,10 @@ def from_doc(doc, fail: Callable[[str], None], image: Callable[[object], object]
         if set(prev_d) - set(maps):
             fail("project.json: preview keys must be map names")
         preview = {m: image(v) for m, v in prev_d.items()}
+    outputs_d = s.get(doc, "outputs", dict, "", optional=True, default={})
+    if not all(isinstance(k, str) and SAFE_NAME.match(k) for k in outputs_d):
+        fail("project.json: outputs keys must be simple names")
+    outputs = {k: image(v) for k, v in outputs_d.items()}
 
     def candidates(key, entries):
         out = []
@@ -271,6 +276,7 @@ def from_doc(doc, fail: Callable[[str], None], image: Callable[[object], object]
         waypoints=waypoints,
         preview=preview,
         extra=s.get(doc, "extra", dict, "", optional=True, default={}),
+        outputs=outputs,
         wang=s.get(doc, "wang", dict, "", optional=True),
         wang_tiles=wang_tiles,
     )

@@ -51,6 +51,9 @@ class Project:
     waypoints: dict[str, list[tuple[int, int]]] = field(default_factory=dict)  # per seam key
     preview: dict[str, np.ndarray] | None = None
     extra: dict = field(default_factory=dict)  # any JSON the editor wants to keep
+    # other images of the session, by simple name: the editor keeps its quilting or transfer
+    # output ("quilt") and the transfer target ("transfer_target") here; any size
+    outputs: dict[str, np.ndarray] = field(default_factory=dict)
     # a Wang set (engine.tiles.wang), beside the candidates: its record {"colours": K,
     # "tile_size": T, "variants": V, "samples": [{"axis", "colour", "origin": [row, col],
     # "error"}...], "layout": [[tile index...]...] or None, ...} and its tiles, whose params
