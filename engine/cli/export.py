@@ -66,6 +66,12 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     )
     p.add_argument("--overwrite", action="store_true", help="replace a non-empty --out folder")
     p.add_argument(
+        "--seamless",
+        action="store_true",
+        help="write only the seamless tile, one file per map: DIR/NAME_seamless.png "
+        "(+ NAME_seamless_MAP.png), the usual 'make it tile' deliverable",
+    )
+    p.add_argument(
         "--wang",
         action="store_true",
         default=None,
@@ -91,6 +97,8 @@ def run(args) -> int:
     project = load_project(args.project)
     if args.name is not None:
         project.name = args.name
+    if args.seamless:
+        return _export_seamless(project, args)
     print(f"quilt-studio export: writing {args.project} as a bundle to {args.out}", file=sys.stderr)
     manifest = export_project(
         project,
@@ -111,6 +119,39 @@ def run(args) -> int:
     print(
         f"quilt-studio export: wrote {manifest['tile_count']} tiles x {len(manifest['maps'])} maps "
         f"({manifest['tile_w']}x{manifest['tile_h']}, {manifest['bit_depth']}-bit) to {args.out}",
+        file=sys.stderr,
+    )
+    return 0
+
+
+def _export_seamless(project, args) -> int:
+    """``--seamless``: the project's seamless tile per map into ``--out``."""
+    from pathlib import Path
+
+    from engine.export.seamless import export_seamless, seamless_paths
+
+    if not project.template:
+        raise ValueError(
+            f"{args.project}: the project has no seamless tile (make one in the editor or with "
+            "quilt-studio tileset)"
+        )
+    path = Path(args.out) / f"{project.name}_seamless.{args.tile_format}"
+    if not args.overwrite:
+        taken = [str(p) for p in seamless_paths(project.template, path).values() if p.exists()]
+        if taken:
+            raise ValueError(f"{taken[0]} exists (pass --overwrite to replace it)")
+    written = export_seamless(
+        project.template,
+        path,
+        bit_depth=args.bit_depth or project.bit_depth,
+        dither=args.dither,
+        source_bit_depth=project.bit_depth,
+        rng=args.seed,
+    )
+    h, w = next(iter(project.template.values())).shape[:2]
+    print(
+        f"quilt-studio export: wrote the {w}x{h} seamless tile ({len(written)} map"
+        f"{'s' if len(written) > 1 else ''}) to {path}",
         file=sys.stderr,
     )
     return 0
