@@ -106,6 +106,7 @@ class Document(QObject):
 
     def mark_saved(self, path: str | None = None) -> None:
         self._dirty = False
+        self.quilting.unsaved = False  # a finished output is kept in the project
         for stack in self.stacks:
             stack.setClean()
         if path is not None and path != self.project_path:

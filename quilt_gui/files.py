@@ -1,5 +1,5 @@
 """Opening and saving: images, projects, material maps, the transfer target, recent files,
-autosave and crash recovery.
+autosave and crash recovery; the quilting output and the seamless tile as image files.
 
 :class:`ProjectFiles` does the file work of the main window: reads and writes run as
 background jobs, errors become messages (:attr:`ProjectFiles.message`), never tracebacks.
@@ -34,6 +34,7 @@ from quilt_gui.model import Source, safe_name
 from resources import sample_path
 
 IMAGE_FILTER = "Images (" + " ".join(f"*{s}" for s in READ_SUFFIXES) + ")"
+SAVE_FILTER = "PNG (*.png);;TIFF (*.tif *.tiff);;JPEG (*.jpg);;WebP (*.webp);;BMP (*.bmp)"
 PROJECT_FILTER = f"Quilt Studio projects (*{PROJECT_SUFFIX})"
 OPEN_FILTER = (
     "Images and projects (" + " ".join(f"*{s}" for s in (*READ_SUFFIXES, PROJECT_SUFFIX)) + ")"
@@ -71,6 +72,39 @@ def read_project(path: str):
     return project
 
 
+HIGH_DEPTH = (".png", ".tif", ".tiff")  # formats that keep 16 bits
+
+
+def save_image(path, image, *, bit_depth: int, source_bit_depth: int):
+    """Worker: write one image (dithered when a 16-bit source is written at 8 bits)."""
+    from engine.bitdepth import quantize
+    from engine.io import save_image as write
+
+    if bit_depth < source_bit_depth:
+        image = quantize(image, bit_depth, dither=True, rng=0)
+    return write(path, image, bit_depth=bit_depth)
+
+
+def _export_seamless(path, maps, *, bit_depth: int, source_bit_depth: int):
+    from engine.export.seamless import export_seamless
+
+    return export_seamless(maps, path, bit_depth=bit_depth, source_bit_depth=source_bit_depth)
+
+
+def default_folder(doc, key: str) -> str:
+    """Where a file dialog starts (the same rule for saving and exporting): the folder last
+    used for this kind of file (settings ``key``), else the source's folder, else the
+    project's, else the home folder."""
+    for folder in (
+        settings.get(key),
+        str(Path(doc.source.path).parent) if doc.source is not None and doc.source.path else "",
+        str(Path(doc.project_path).parent) if doc.project_path else "",
+    ):
+        if folder and Path(folder).is_dir():
+            return folder
+    return str(Path.home())
+
+
 def recovery_dir() -> Path:
     """Folder of the untitled-project recovery file (next to the settings file)."""
     return Path(QSettings().fileName()).parent / "recovery"
@@ -100,10 +134,11 @@ class ProjectFiles(QObject):
     # ------------------------------------------------------------------ questions (patchable)
     def ask_save_changes(self) -> str:
         """ "save", "discard" or "cancel" for unsaved changes (tests replace this)."""
+        output = " (and its quilting output)" if self.doc.quilting.unsaved else ""
         box = QMessageBox(
             QMessageBox.Icon.Warning,
             settings.APP_NAME,
-            f"Save the changes to “{self.doc.name}” before closing?",
+            f"Save the changes to “{self.doc.name}”{output} before closing?",
             QMessageBox.StandardButton.Save
             | QMessageBox.StandardButton.Discard
             | QMessageBox.StandardButton.Cancel,
@@ -131,12 +166,34 @@ class ProjectFiles(QObject):
 
     def ask_save_path(self) -> str:
         start = self.doc.project_path or os.path.join(
-            settings.get("last_project_dir"), self.doc.name + PROJECT_SUFFIX
+            self.default_folder("last_project_dir"), self.doc.name + PROJECT_SUFFIX
         )
         path, _ = QFileDialog.getSaveFileName(self.parent(), "Save project", start, PROJECT_FILTER)
         if path and not path.endswith(PROJECT_SUFFIX):
             path += PROJECT_SUFFIX
         return path
+
+    def ask_image_path(self, caption: str, name: str) -> str:
+        """A file to write an image to (PNG by default), starting beside the source."""
+        start = os.path.join(self.default_folder("last_export_dir"), name)
+        path, _ = QFileDialog.getSaveFileName(self.parent(), caption, start, SAVE_FILTER)
+        if path and not Path(path).suffix:
+            path += ".png"
+        return path
+
+    def ask_discard_output(self) -> bool:
+        """True when the unsaved quilting output may be replaced (tests replace this)."""
+        answer = QMessageBox.question(
+            self.parent(),
+            settings.APP_NAME,
+            "The quilting output is not saved. Replace it by a new one?",
+            QMessageBox.StandardButton.Discard | QMessageBox.StandardButton.Cancel,
+            QMessageBox.StandardButton.Cancel,
+        )
+        return answer == QMessageBox.StandardButton.Discard
+
+    def default_folder(self, key: str) -> str:
+        return default_folder(self.doc, key)
 
     def confirm_discard(self) -> bool:
         """True when the current work may be replaced (saved, discarded or unchanged)."""
@@ -365,6 +422,67 @@ class ProjectFiles(QObject):
 
     def _on_save_error(self, path: str, exc) -> None:
         self._say("error", f"The project was not saved. {error_text(exc)}")
+
+    # ------------------------------------------------------------------ images out
+    def save_output(self, *_args, path: str | None = None) -> jobs.Job | None:
+        """File ▸ Save output: the finished quilting / transfer output as an image at the
+        source's bit depth (8 bits where the format has no 16)."""
+        out = self.doc.quilting.finished_output
+        if out is None:
+            self._say("warning", "Nothing to save yet: synthesize a texture first.")
+            return None
+        path = path or self.ask_image_path("Save output", f"{self.doc.name}_quilted.png")
+        if not path:
+            return None
+        return self._write_image("save_output", save_image, path, out, self._on_output_saved)
+
+    def _on_output_saved(self, path: str, _result) -> None:
+        self.doc.quilting.unsaved = False
+        h, w = self.doc.quilting.output.shape[:2]
+        self._say("info", f"Saved the {w}×{h} output to {Path(path).name}.")
+
+    def export_seamless(self, *_args, path: str | None = None) -> jobs.Job | None:
+        """File ▸ Export seamless tile: the tile alone, one file per material map."""
+        maps = project_io.template_maps(self.doc)
+        if maps is None:
+            self._say(
+                "warning", "No seamless tile yet: choose a tile size or draw the tile rectangle."
+            )
+            return None
+        path = path or self.ask_image_path("Export seamless tile", f"{self.doc.name}_tile.png")
+        if not path:
+            return None
+        return self._write_image("export_seamless", _export_seamless, path, maps, self._on_tile)
+
+    def _on_tile(self, path: str, written) -> None:
+        h, w = next(iter(project_io.template_maps(self.doc).values())).shape[:2]
+        names = ", ".join(p.name for p in written)
+        self._say("info", f"Exported the {w}×{h} seamless tile: {names}.")
+
+    def _write_image(self, key: str, writer, path: str, image, on_done) -> jobs.Job:
+        """``writer(path, image, bit_depth=)`` in the background; errors become messages."""
+        depth = self.doc.source.bit_depth if Path(path).suffix.lower() in HIGH_DEPTH else 8
+        source_depth = self.doc.source.bit_depth
+
+        def done(result) -> None:
+            settings.set("last_export_dir", str(Path(path).parent))
+            on_done(path, result)
+
+        return self.jobs.start(
+            key,
+            writer,
+            path,
+            image,
+            bit_depth=depth,
+            source_bit_depth=source_depth,
+            label=f"Writing {Path(path).name}",
+            pass_cancel=False,
+            on_done=done,
+            on_error=partial(self._on_write_error, path),
+        )
+
+    def _on_write_error(self, path: str, exc) -> None:
+        self._say("error", f"{Path(path).name} was not written. {error_text(exc)}")
 
     # ------------------------------------------------------------------ autosave, recovery
     def recovery_file(self) -> Path:

@@ -158,6 +158,18 @@ class MainWindow(QMainWindow):
             "Ctrl+E",
             "Write the picked tiles, atlases, manifest, Tiled and Godot files",
         )
+        self.act_export_seamless = A(
+            "Export seamless &tile…",
+            self.files.export_seamless,
+            "Ctrl+Shift+E",
+            "Write the seamless tile alone, one file per material map",
+        )
+        self.act_save_output = A(
+            "Save &output…",
+            self.files.save_output,
+            None,  # Ctrl+Shift+S while the Quilting tab is in front (see _on_tab_changed)
+            "Save the synthesized texture as an image",
+        )
         self.act_quit = A("&Quit", self.close, K.Quit, "Close Quilt Studio")
         self.act_undo = self.doc.undo_group.createUndoAction(self, "&Undo")
         self.act_undo.setShortcut(QKeySequence(K.Undo))
@@ -292,6 +304,7 @@ class MainWindow(QMainWindow):
             3, "A Wang tile set: tiles whose edges vary, any two with matching colours join"
         )
         self.quilt_view = QuiltView(doc, (self.act_quilt, self.act_load_target, self.act_transfer))
+        self.quilt_view.set_output_actions((self.act_save_output, self.act_fit, self.act_100))
         self.tabs.addTab(self.quilt_view, "Quilting")
         central = QWidget()
         lay = QVBoxLayout(central)
@@ -360,7 +373,9 @@ class MainWindow(QMainWindow):
         m.addAction(self.act_open_library)
         m.addAction(self.act_attach)
         m.addSeparator()
-        m.addActions([self.act_save, self.act_save_as, self.act_export])
+        m.addActions([self.act_save, self.act_save_as])
+        m.addSeparator()
+        m.addActions([self.act_export_seamless, self.act_export, self.act_save_output])
         m.addSeparator()
         m.addAction(self.act_quit)
         m = mb.addMenu("&Edit")
@@ -431,6 +446,8 @@ class MainWindow(QMainWindow):
         doc.tileset.candidates_reset.connect(self._update_actions)
         doc.tileset.candidate_inserted.connect(self._update_actions)
         doc.tileset.picks_changed.connect(self._update_actions)
+        for signal in (doc.quilting.reset, doc.quilting.finished, doc.quilting.restored):
+            signal.connect(self._update_actions)
         doc.wang.reset.connect(self._update_actions)
         doc.wang.layout_changed.connect(self._update_actions)
         self.gallery.open_requested.connect(self.open_candidate)
@@ -578,20 +595,25 @@ class MainWindow(QMainWindow):
     # ------------------------------------------------------------------ quilting
     def run_quilt(self, *_args) -> None:
         self.tabs.setCurrentWidget(self.quilt_view)
-        self.pipeline.run_quilt()
+        if not self.doc.quilting.unsaved or self.files.ask_discard_output():
+            self.pipeline.run_quilt()
 
     def _clear_painted(self, *_args) -> None:
         self.source_view.painter.clear_painted()
 
     def run_transfer(self, *_args) -> None:
         self.tabs.setCurrentWidget(self.quilt_view)
-        self.pipeline.run_transfer()
+        if not self.doc.quilting.unsaved or self.files.ask_discard_output():
+            self.pipeline.run_transfer()
 
     @Slot(int)
     def _on_tab_changed(self, _index: int) -> None:
         quilting = self.tabs.currentWidget() is self.quilt_view
         wang = self.tabs.currentWidget() is self.wang_view
         self.doc.set_workflow("quilting" if quilting else "wang" if wang else "tileset")
+        save_as = QKeySequence(QKeySequence.StandardKey.SaveAs)  # on the Quilting tab: Save output
+        self.act_save_as.setShortcut(QKeySequence() if quilting else save_as)
+        self.act_save_output.setShortcut(save_as if quilting else QKeySequence())
         self.params_panel.show_groups(QUILT_GROUPS if quilting else TILESET_GROUPS)
         for key in ("overlaps", "tile", "gallery"):
             self.docks[key].setVisible(not quilting and not wang)
@@ -708,6 +730,8 @@ class MainWindow(QMainWindow):
             a.setEnabled(has)
         self.act_generate.setEnabled(has and self.doc.tileset.seamless is not None)
         self.act_export.setEnabled(bool(self.doc.tileset.candidates) or self.doc.wang.complete)
+        self.act_export_seamless.setEnabled(self.doc.tileset.seamless is not None)
+        self.act_save_output.setEnabled(self.doc.quilting.finished_output is not None)
         self.act_reroll_layout.setEnabled(bool(self.doc.tileset.picks))
         n = len(self.doc.tileset.candidates)
         title = f"Candidates — {len(self.doc.tileset.picks)} of {n} picked" if n else "Candidates"

@@ -1,9 +1,10 @@
 """The document as a project file's :class:`engine.project.Project`, and back.
 
 :func:`to_project` reads every part of the document (the source, the parameters, the tile
-set's template, candidates, picks and layout, the Wang set, the painted exclusion);
-:func:`apply_project`
-replaces the whole document by a project (the undo history starts empty).
+set's template, candidates, picks and layout, the Wang set, the painted exclusion, the
+finished quilting output and the transfer target); :func:`apply_project` replaces the whole
+document by a project (the undo history starts empty). :func:`template_maps` is the seamless
+tile per material map (what File ▸ Export seamless tile writes).
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from engine.project import Project
 from quilt_gui import params
 from quilt_gui.model import WAYPOINT_KEYS, Source
 
-__all__ = ["apply_project", "to_project"]
+__all__ = ["apply_project", "template_maps", "to_project"]
 
 
 def to_project(doc) -> Project:
@@ -56,6 +57,7 @@ def to_project(doc) -> Project:
         waypoints={k: [tuple(p) for p in v] for k, v in ts.waypoints.items()},
         preview=preview,
         extra={"editor": "quilt-studio", **mask_to_json(doc.exclude_painted)},
+        outputs=_outputs(doc.quilting),
         wang=wang,
         wang_tiles=wang_tiles,
     )
@@ -83,12 +85,30 @@ def apply_project(doc, project: Project, path: str | None) -> None:
     if project.preview is not None:
         ts.preview = next(iter(project.preview.values()))
     doc.project_path = path
+    doc.quilting.restore(project.outputs.get(QUILT), project.outputs.get(TARGET))
     doc.apply_painted(mask_from_json(project.extra, source.shape))
     doc.params_changed.emit(frozenset(doc.params))
     ts.emit_all()
     doc.wang.apply_project(project.wang, project.wang_tiles)
     doc.path_changed.emit()
     doc.mark_saved()
+
+
+QUILT, TARGET = "quilt", "transfer_target"  # names in Project.outputs
+
+
+def _outputs(quilting) -> dict:
+    """The finished quilting / transfer output and the transfer target, for the project."""
+    out = {QUILT: quilting.finished_output, TARGET: quilting.target}
+    return {k: np.asarray(v, dtype=np.float32) for k, v in out.items() if v is not None}
+
+
+def template_maps(doc) -> dict[str, np.ndarray] | None:
+    """The seamless tile of every material map (main first), None without one."""
+    seamless = doc.tileset.seamless
+    if seamless is None or doc.source is None:
+        return None
+    return _tile_maps(seamless, list(doc.source.maps))
 
 
 def _tile_maps(seamless, names: list[str]) -> dict[str, np.ndarray] | None:

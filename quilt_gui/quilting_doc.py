@@ -2,7 +2,8 @@
 synthesized, its placed blocks, the finished result and the transfer target.
 
 Everything here streams in from a job (no undo steps); the parameters of a run are the
-document's (:attr:`quilt_gui.document.Document.params`).
+document's (:attr:`quilt_gui.document.Document.params`). A finished output is part of the
+project (saved with it); :attr:`QuiltingDocument.unsaved` says it exists nowhere else yet.
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ class QuiltingDocument(QObject):
     finished = Signal()
     iteration_finished = Signal(int)  # a texture-transfer pass finished (its number)
     target_changed = Signal()
+    restored = Signal()  # an output read from a project (no blocks, no record)
 
     def __init__(self, root, undo_stack) -> None:
         super().__init__(root)
@@ -28,6 +30,8 @@ class QuiltingDocument(QObject):
         self.blocks: list = []  # engine BlockRecord per placed block
         self.result = None  # engine QuiltResult / TransferResult when finished
         self.target: np.ndarray | None = None  # the image a transfer imitates
+        self.kept: np.ndarray | None = None  # a finished output read from a project
+        self.unsaved = False  # a finished output not yet saved (as an image or in a project)
 
     def start(self, shape: tuple[int, int] | None) -> None:
         """Clear the output (None) or start a new one of ``shape`` (H, W)."""
@@ -39,6 +43,8 @@ class QuiltingDocument(QObject):
             self.output = np.zeros((*shape, c), dtype=np.float32)
         self.blocks = []
         self.result = None
+        self.kept = None
+        self.unsaved = False
         self.reset.emit()
 
     def place_block(self, record, pixels: np.ndarray) -> int:
@@ -63,7 +69,22 @@ class QuiltingDocument(QObject):
         self.output = np.asarray(result.image, dtype=np.float32)  # the worker's display
         # copy of this very array is cached (imaging.prepare_display): no copy here
         self.blocks = list(result.blocks)
+        self.unsaved = True
+        self.root.mark_dirty()  # the project keeps it: saving it saves the output
         self.finished.emit()
+
+    @property
+    def finished_output(self) -> np.ndarray | None:
+        """The finished output (made now or read from the project), None while none is."""
+        return self.output if self.result is not None or self.kept is not None else None
+
+    def restore(self, output: np.ndarray | None, target: np.ndarray | None) -> None:
+        """A project's saved output and transfer target (not an undo step)."""
+        self.output, self.blocks, self.result = output, [], None
+        self.kept, self.unsaved = output, False
+        self.target = target
+        self.target_changed.emit()
+        self.restored.emit()
 
     def set_target(self, pixels: np.ndarray | None) -> None:
         self.target = pixels

@@ -26,6 +26,7 @@ from PySide6.QtWidgets import (
 from engine.project import export_project
 from quilt_gui import jobs, project_io, settings
 from quilt_gui.document import Document, safe_name
+from quilt_gui.files import default_folder
 from quilt_gui.jobs import error_text
 
 
@@ -86,6 +87,7 @@ class ExportDialog(QDialog):
             "empty unless Overwrite is on)"
         )
         browse = QPushButton("Browse…")
+        browse.setAutoDefault(False)  # Enter exports, wherever the focus is
         browse.clicked.connect(self._browse)
         row = QHBoxLayout()
         row.setContentsMargins(0, 0, 0, 0)
@@ -156,7 +158,7 @@ class ExportDialog(QDialog):
         self.wang = bool(wang)
         self.setWindowTitle("Export Wang tile set" if self.wang else "Export tile set")
         self.name.setText(doc.name)
-        base = settings.get("last_export_dir") or str(Path.home())
+        base = default_folder(doc, "last_export_dir")
         suffix = "_wang_export" if self.wang else "_export"
         self.folder.setText(str(Path(base) / f"{doc.name}{suffix}"))
         maps = list(doc.source.maps) if doc.source else []

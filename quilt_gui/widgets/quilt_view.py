@@ -150,6 +150,7 @@ class QuiltView(QWidget):
         doc.quilting.reset.connect(self._on_reset)
         doc.quilting.block_placed.connect(self._on_block_placed)
         doc.quilting.finished.connect(self._on_finished)
+        doc.quilting.restored.connect(self._on_restored)
         doc.quilting.iteration_finished.connect(self._on_iteration)
         doc.quilting.target_changed.connect(self._on_target_changed)
         self._on_source_changed()
@@ -181,6 +182,23 @@ class QuiltView(QWidget):
         self.output.set_image(np.zeros(out.shape, np.uint8), fit=fit)
         self.raster.reset(h, w)
         self.counter.setText("quilting…")
+
+    @Slot()
+    def _on_restored(self) -> None:
+        """An output read from a project: shown as it was saved (its blocks are not kept)."""
+        self.select(None)
+        self.raster.reset(0, 0)
+        self.block_rect.hide()
+        out = self.doc.quilting.output
+        self.output.set_image(out, fit=True)
+        if out is not None:
+            h, w = out.shape[:2]
+            self.counter.setText(f"{w}×{h} output kept in the project (its blocks are not)")
+
+    def set_output_actions(self, actions) -> None:
+        """The output's context menu (right-click): Save output… and the like."""
+        self.output.setContextMenuPolicy(Qt.ContextMenuPolicy.ActionsContextMenu)
+        self.output.addActions(list(actions))
 
     @Slot(int)
     def _on_block_placed(self, index: int) -> None:

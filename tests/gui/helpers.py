@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from PySide6.QtCore import QPoint, Qt
+from PySide6.QtCore import QMimeData, QPoint, QPointF, Qt, QUrl
+from PySide6.QtGui import QDropEvent
 
 from quilt_gui.main_window import MainWindow
 
@@ -45,6 +46,20 @@ def click_candidate(qtbot, window: MainWindow, row: int, modifier=Qt.KeyboardMod
     view.scrollTo(ix)
     pos: QPoint = view.visualRect(ix).center()
     qtbot.mouseClick(view.viewport(), Qt.MouseButton.LeftButton, modifier, pos)
+
+
+def drop(w: MainWindow, path) -> None:
+    """Drop the file ``path`` on the window, as from a file manager."""
+    mime = QMimeData()
+    mime.setUrls([QUrl.fromLocalFile(str(path))])
+    ev = QDropEvent(
+        QPointF(50, 50),
+        Qt.DropAction.CopyAction,
+        mime,
+        Qt.MouseButton.NoButton,
+        Qt.KeyboardModifier.NoModifier,
+    )
+    w.dropEvent(ev)
 
 
 def make_window(qtbot) -> MainWindow:

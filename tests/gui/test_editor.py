@@ -5,15 +5,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from PIL import Image
-from PySide6.QtCore import QMimeData, QPoint, QPointF, Qt, QUrl
-from PySide6.QtGui import QDropEvent, QWheelEvent
+from PySide6.QtCore import QPoint, QPointF, Qt
+from PySide6.QtGui import QWheelEvent
 from PySide6.QtWidgets import QPushButton
 
 from quilt_gui import settings
 from quilt_gui.imaging import to_uint8
 from quilt_gui.widgets.canvas import ImageCanvas
 from quilt_gui.widgets.gallery import CandidateModel
-from tests.gui.helpers import make_window, open_sample, template, wait_idle
+from tests.gui.helpers import drop, make_window, open_sample, template, wait_idle
 
 
 @pytest.fixture
@@ -318,19 +318,6 @@ def test_lock_reroll_and_patch_drag(qtbot, win):
 
 
 # ---------------------------------------------------------------------- bad input
-def drop(w, path) -> None:
-    mime = QMimeData()
-    mime.setUrls([QUrl.fromLocalFile(str(path))])
-    ev = QDropEvent(
-        QPointF(50, 50),
-        Qt.DropAction.CopyAction,
-        mime,
-        Qt.MouseButton.NoButton,
-        Qt.KeyboardModifier.NoModifier,
-    )
-    w.dropEvent(ev)
-
-
 def test_corrupt_file_dropped_shows_message_and_keeps_editor_usable(qtbot, win, tmp_path):
     bad = tmp_path / "broken.png"
     bad.write_bytes(b"\x89PNG\r\n\x1a\n" + b"garbage" * 50)
