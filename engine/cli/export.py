@@ -87,13 +87,14 @@ def run(args) -> int:
     from engine.export import bundle_files
     from engine.project import export_project, load_project
 
-    check_folder(  # refuse an output folder before reading the project
-        args.out,
-        owned=bundle_files,
-        inputs=[args.project],
-        overwrite=args.overwrite,
-        action="export to",
-    )
+    if not args.seamless:  # --seamless writes files into --out, never replaces the folder
+        check_folder(  # refuse an output folder before reading the project
+            args.out,
+            owned=bundle_files,
+            inputs=[args.project],
+            overwrite=args.overwrite,
+            action="export to",
+        )
     project = load_project(args.project)
     if args.name is not None:
         project.name = args.name
