@@ -53,6 +53,7 @@ def main(argv=None) -> int:
 
     window = MainWindow()
     window.files.ask_save_changes = lambda: "discard"
+    window.files.ask_discard_output = lambda: True  # a new quilt replaces the last
     window.resize(1400, 900)
     window.show()
     window.files.open_path(str(sample_path(args.sample)), confirm=False, remember=False)

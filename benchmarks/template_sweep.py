@@ -88,6 +88,7 @@ def editor_rows(repeats: int) -> list:
 
     w = MainWindow()
     w.files.ask_save_changes = lambda: "discard"
+    w.files.ask_discard_output = lambda: True  # a new quilt replaces the last
     w.resize(1400, 900)
     w.show()
     w.open_initial(None)

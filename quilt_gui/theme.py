@@ -41,6 +41,15 @@ def dark_palette() -> QPalette:
     return p
 
 
+# Fusion draws a checked tool button (1×1/3×3/5×5, Basic/Advanced) a shade darker than the
+# others: invisible on the dark palette. The highlight colour says which one is on.
+CHECKED_BUTTONS = (
+    "QToolButton:checked { background-color: palette(highlight); "
+    "color: palette(highlighted-text); border: 1px solid palette(highlight); "
+    "border-radius: 3px; padding: 2px 4px; }"
+)
+
+
 def apply_theme(app: QApplication, theme: str) -> None:
     """Fusion style with a dark palette ("dark") or Fusion's own light palette ("light").
 
@@ -49,6 +58,7 @@ def apply_theme(app: QApplication, theme: str) -> None:
     light-grey numbers on a light background.
     """
     app.setStyle("Fusion")
+    app.setStyleSheet(CHECKED_BUTTONS)
     if theme == "light":
         app.setPalette(app.style().standardPalette())
     else:

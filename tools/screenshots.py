@@ -39,6 +39,7 @@ def open_editor():
 
     w = MainWindow()
     w.files.ask_save_changes = lambda: "discard"
+    w.files.ask_discard_output = lambda: True  # a new quilt replaces the last
     w.resize(1600, 1000)
     w.show()
     w.open_initial(None)

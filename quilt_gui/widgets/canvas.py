@@ -174,6 +174,7 @@ class ImageCanvas(QGraphicsView):
         self._press_pos = None
         self._pan_from = None  # (view pos, scroll values) while Space/middle-panning
         self.space_down = False
+        self._scrollbars = True  # shown when the image does not fit (hide_scrollbars: never)
         self._apply_zoom_hints()
 
     # ------------------------------------------------------------------ image
@@ -193,6 +194,7 @@ class ImageCanvas(QGraphicsView):
         if fit or first:
             self._fit_pending = True
             self.fit()
+        self._update_scrollbars()
 
     def image_rect(self) -> QRectF:
         a = self.image_item.array
@@ -220,6 +222,7 @@ class ImageCanvas(QGraphicsView):
         self.horizontalScrollBar().setValue(self.horizontalScrollBar().value() + delta.x())
         self.verticalScrollBar().setValue(self.verticalScrollBar().value() + delta.y())
         self._apply_zoom_hints()
+        self._update_scrollbars()
         self.zoom_changed.emit(zoom)
 
     def _apply_zoom_hints(self) -> None:
@@ -276,6 +279,7 @@ class ImageCanvas(QGraphicsView):
         self.fitted = True
         self._fit_size = self.size()
         self._apply_zoom_hints()
+        self._update_scrollbars()
         self.zoom_changed.emit(self._zoom)
 
     def center_on_pixel(self, row: float, col: float) -> None:
@@ -295,6 +299,8 @@ class ImageCanvas(QGraphicsView):
         # make a fit -> resize -> fit loop
         if self._fit_pending or (self.fitted and self.size() != self._fit_size):
             self.fit()
+        else:
+            self._update_scrollbars()
 
     def showEvent(self, event) -> None:  # noqa: N802 - Qt API
         super().showEvent(event)
@@ -386,8 +392,18 @@ class ImageCanvas(QGraphicsView):
 
     def hide_scrollbars(self) -> None:
         """For small panels: pan by dragging only."""
-        self.setHorizontalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
-        self.setVerticalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+        self._scrollbars = False
+        self._update_scrollbars()
+
+    def _update_scrollbars(self) -> None:
+        """Scroll bars only where the image at this zoom is wider / taller than the view
+        (the scene has a margin to pan into, which alone must not bring scroll bars)."""
+        r, room = self.image_rect(), self.maximumViewportSize()
+        off, needed = Qt.ScrollBarPolicy.ScrollBarAlwaysOff, Qt.ScrollBarPolicy.ScrollBarAsNeeded
+        wide = self._scrollbars and r.width() * self._zoom > room.width()
+        tall = self._scrollbars and r.height() * self._zoom > room.height()
+        self.setHorizontalScrollBarPolicy(needed if wide else off)
+        self.setVerticalScrollBarPolicy(needed if tall else off)
 
     def add_item(self, item: QGraphicsItem) -> QGraphicsItem:
         self.scene().addItem(item)

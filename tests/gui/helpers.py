@@ -66,6 +66,7 @@ def make_window(qtbot) -> MainWindow:
     w = MainWindow()
     qtbot.addWidget(w)
     w.files.ask_save_changes = lambda: "discard"  # never a modal dialog in tests
+    w.files.ask_discard_output = lambda: True  # a new quilt replaces the last
     w.resize(1400, 900)
     w.show()
     qtbot.waitExposed(w)

@@ -1,0 +1,49 @@
+"""Issue 13's polish list, one check each."""
+
+from __future__ import annotations
+
+import numpy as np
+from PySide6.QtGui import QImage, QPalette
+
+from quilt_gui.theme import apply_theme
+from tests.gui.helpers import make_window, open_sample, wait_idle
+
+
+def test_no_scrollbars_when_the_image_fits(qtbot):
+    w = make_window(qtbot)
+    open_sample(qtbot, w)
+    wait_idle(qtbot, w)
+    v = w.source_view
+    v.fit()
+    qtbot.wait(50)
+    h, vbar = v.horizontalScrollBar(), v.verticalScrollBar()
+    assert not h.isVisible() and not vbar.isVisible()  # the margin to pan into brings none
+    v.set_zoom(4.0)  # 512 px at 400 % does not fit: both bars
+    qtbot.waitUntil(lambda: h.isVisible() and vbar.isVisible(), timeout=2000)
+    v.fit()
+    qtbot.waitUntil(lambda: not h.isVisible() and not vbar.isVisible(), timeout=2000)
+
+
+def mean_colour(widget) -> np.ndarray:
+    img = widget.grab().toImage().convertToFormat(QImage.Format.Format_RGB888)
+    w, h = img.width(), img.height()
+    a = np.frombuffer(img.constBits(), np.uint8, img.bytesPerLine() * h)
+    return a.reshape(h, img.bytesPerLine())[:, : w * 3].reshape(h, w, 3).mean(axis=(0, 1))
+
+
+def test_the_active_repeat_button_stands_out_in_the_dark_theme(qtbot, qapp):
+    style, palette = qapp.style().name(), QPalette(qapp.palette())
+    apply_theme(qapp, "dark")
+    try:
+        w = make_window(qtbot)
+        buttons = w.tile_view.repeat_buttons
+        on = buttons.checkedButton()
+        off = next(b for b in buttons.buttons() if b is not on)
+        assert np.abs(mean_colour(on) - mean_colour(off)).max() > 40  # not a shade: a colour
+        basic = w.params_panel.view_buttons.checkedButton()
+        other = next(b for b in w.params_panel.view_buttons.buttons() if b is not basic)
+        assert np.abs(mean_colour(basic) - mean_colour(other)).max() > 40
+    finally:
+        qapp.setStyleSheet("")
+        qapp.setStyle(style)
+        qapp.setPalette(palette)
