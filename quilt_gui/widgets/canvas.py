@@ -216,13 +216,13 @@ class ImageCanvas(QGraphicsView):
         scene_pt = self.mapToScene(anchor.toPoint())
         self._zoom = zoom
         self.setTransform(QTransform.fromScale(zoom, zoom))
+        self._update_scrollbars()  # before the correction: bars coming or going move the view
         # scroll so that scene_pt is again under anchor
         now = self.mapFromScene(scene_pt)
         delta = now - anchor.toPoint()
         self.horizontalScrollBar().setValue(self.horizontalScrollBar().value() + delta.x())
         self.verticalScrollBar().setValue(self.verticalScrollBar().value() + delta.y())
         self._apply_zoom_hints()
-        self._update_scrollbars()
         self.zoom_changed.emit(zoom)
 
     def _apply_zoom_hints(self) -> None:
