@@ -165,7 +165,14 @@ class CandidateDelegate(QStyledItemDelegate):
         self.thumb = thumb
 
     def sizeHint(self, option, index) -> QSize:  # noqa: N802 - Qt API
-        return QSize(self.thumb + 12, self.thumb + 30)
+        """The thumbnail's own shape (a 192×64 strip leaves no square of empty cell), wide
+        enough for the caption."""
+        pm = index.data(Qt.ItemDataRole.DecorationRole)
+        if not isinstance(pm, QPixmap):
+            return QSize(self.thumb + 12, self.thumb + 30)
+        size = pm.deviceIndependentSize()
+        w = max(int(round(size.width())), min(self.thumb, 72))
+        return QSize(w + 12, int(round(size.height())) + 30)
 
     def paint(self, painter: QPainter, option, index) -> None:
         painter.save()

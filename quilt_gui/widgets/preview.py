@@ -101,6 +101,7 @@ class PreviewView(QWidget):
         lay.addLayout(bar)
         lay.addWidget(self.warnings)
         lay.addWidget(self.canvas, 1)
+        lay.addStretch(0)  # holds the bar at the top while the canvas is hidden (no preview)
         self._shape = None
         self._cells = ""
         doc.tileset.preview_changed.connect(self._on_preview_changed)

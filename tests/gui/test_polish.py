@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import numpy as np
+from PySide6.QtCore import Qt
 from PySide6.QtGui import QImage, QPalette
 
 from quilt_gui.theme import apply_theme
-from tests.gui.helpers import make_window, open_sample, wait_idle
+from tests.gui.helpers import generate, make_window, open_sample, wait_idle
 
 
 def test_no_scrollbars_when_the_image_fits(qtbot):
@@ -47,3 +48,26 @@ def test_the_active_repeat_button_stands_out_in_the_dark_theme(qtbot, qapp):
         qapp.setStyleSheet("")
         qapp.setStyle(style)
         qapp.setPalette(palette)
+
+
+def test_the_empty_previews_toolbar_is_at_the_top(qtbot):
+    w = make_window(qtbot)
+    open_sample(qtbot, w)
+    w.tabs.setCurrentWidget(w.preview_view)
+    qtbot.wait(50)
+    p = w.preview_view
+    assert w.doc.tileset.preview is None and not p.canvas.isVisible()
+    assert p.grid_box.geometry().bottom() < 60 < p.height() / 2  # not in the middle of the tab
+
+
+def test_non_square_thumbnails_leave_no_gaps(qtbot):
+    w = make_window(qtbot)
+    open_sample(qtbot, w)
+    generate(qtbot, w, 3, rect=(100, 100, 192, 64))  # a 3:1 strip
+    wait_idle(qtbot, w)
+    view = w.gallery
+    cell = view.visualRect(view.model().index(0, 0))
+    thumb = view.model().index(0, 0).data(Qt.ItemDataRole.DecorationRole)
+    tw, th = thumb.deviceIndependentSize().width(), thumb.deviceIndependentSize().height()
+    assert tw > 2.5 * th
+    assert cell.height() <= th + 40 and cell.width() <= tw + 20  # the strip's shape, no square
