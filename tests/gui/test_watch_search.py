@@ -33,7 +33,7 @@ def test_watch_mode_draws_every_improvement_then_keeps_or_goes_back(qtbot):
     drawn = []
     w.pipeline.seam_updated.connect(lambda u: drawn.append(u))
     watch.timer.setInterval(1)  # the test does not wait for a person's pace
-    per_tick = []  # improvements drawn by each timer tick (the first after a pause is drawn at once)
+    per_tick = []  # drawn by each timer tick (the first after a pause is drawn at once)
 
     def counted_tick():
         before = watch.drawn
