@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 from PySide6.QtCore import Qt
 from PySide6.QtGui import QImage, QPalette
 
+from quilt_gui.files import default_folder
 from quilt_gui.theme import apply_theme
 from tests.gui.helpers import generate, make_window, open_sample, wait_idle
 
@@ -71,3 +74,26 @@ def test_non_square_thumbnails_leave_no_gaps(qtbot):
     tw, th = thumb.deviceIndependentSize().width(), thumb.deviceIndependentSize().height()
     assert tw > 2.5 * th
     assert cell.height() <= th + 40 and cell.width() <= tw + 20  # the strip's shape, no square
+
+
+def test_save_and_export_start_in_the_same_folder_beside_the_source(qtbot, tmp_path, monkeypatch):
+    from PIL import Image
+    from PySide6.QtWidgets import QFileDialog
+
+    folder = tmp_path / "photos"
+    folder.mkdir()
+    src = folder / "bark.png"
+    Image.fromarray((np.random.default_rng(1).random((64, 64, 3)) * 255).astype(np.uint8)).save(src)
+    w = make_window(qtbot)
+    with qtbot.waitSignal(w.doc.source_changed, timeout=5000):
+        w.files.open_path(str(src), confirm=False)
+    starts = []
+    monkeypatch.setattr(
+        QFileDialog,
+        "getSaveFileName",
+        lambda parent, cap, start, *a: starts.append(start) or ("", ""),
+    )
+    w.files.ask_image_path("Save output", "bark_quilted.png")
+    w.files.ask_save_path()
+    assert [str(Path(s).parent) for s in starts] == [str(folder)] * 2
+    assert default_folder(w.doc, "last_export_dir") == str(folder)  # the export dialog's rule
