@@ -35,7 +35,7 @@ from __future__ import annotations
 import math
 import numbers
 import warnings
-from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -44,6 +44,7 @@ from numba import njit
 from engine._validate import as_image, choice, non_negative_number, positive_int
 from engine.cancel import AnyCancel, Cancelled, CancelToken, check, is_cancelled
 from engine.candidate import CandidateTile
+from engine.completions import Completions
 from engine.errormap import colour_channels
 from engine.events import Item, Progress, drain, frozen_array
 from engine.exclusion import valid_anchors
@@ -661,12 +662,15 @@ def _iter_candidates(setup: _Setup, n: int, base: int, workers: int, cancel):
         stop = CancelToken()
         token = AnyCancel(cancel, stop)
         pool = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="candidates")
+        completions = Completions()  # a Ctrl+C while waiting never wedges a worker
         try:
-            pending = {
-                pool.submit(setup.make, k, seeds[k], origins[k], step, token): k for k in range(n)
-            }
+            pending = {}
+            for k in range(n):
+                fut = pool.submit(setup.make, k, seeds[k], origins[k], step, token)
+                pending[fut] = k
+                completions.watch(fut)
             while pending:
-                finished, _ = wait(pending, return_when=FIRST_COMPLETED)
+                finished = completions.wait(pending)
                 for fut in sorted(finished, key=pending.get):
                     k = pending.pop(fut)
                     if fut.cancelled():

@@ -36,12 +36,13 @@ copies of the source (16-bit values stay exact).
 from __future__ import annotations
 
 import warnings
-from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
+from concurrent.futures import Future, ThreadPoolExecutor
 
 import numpy as np
 
 from engine._validate import choice, positive_int
 from engine.cancel import AnyCancel, Cancelled, CancelToken, is_cancelled
+from engine.completions import Completions
 from engine.events import Progress, drain
 from engine.tiles.candidates import base_seed
 from engine.tiles.wang_setup import WangSetup
@@ -215,15 +216,17 @@ def _iter_wang_set(setup: WangSetup, samples, indices, avoid, base, workers, can
         ThreadPoolExecutor(max_workers=workers, thread_name_prefix="wang") if workers > 1 else None
     )
 
+    completions = Completions()  # a Ctrl+C while waiting never wedges a worker
+
     def submit(fn, *args) -> Future:
         if pool is not None:
-            return pool.submit(fn, *args)
+            return completions.watch(pool.submit(fn, *args))
         f: Future = Future()
         try:
             f.set_result(fn(*args))
         except BaseException as exc:  # noqa: BLE001 - handed to the consumer like a pool's
             f.set_exception(exc)
-        return f
+        return completions.watch(f)
 
     def stage_a(k):
         sig, _ = _signature(setup.K, k)
@@ -255,8 +258,8 @@ def _iter_wang_set(setup: WangSetup, samples, indices, avoid, base, workers, can
             if is_cancelled(cancel):
                 break
             fut = firsts[k]
-            while not fut.done():  # hand out finished tiles while tile k's frame is made
-                done, _ = wait([fut, *finishing], return_when=FIRST_COMPLETED)
+            while not completions.is_done(fut):  # hand out finished tiles while k's frame is made
+                done = completions.wait([fut, *finishing])
                 yield from _collect(done, finishing, made, n)
             try:
                 fr, framed, errs = fut.result()
@@ -270,10 +273,10 @@ def _iter_wang_set(setup: WangSetup, samples, indices, avoid, base, workers, can
                 origin, band_error, _ = setup.patch_anchor(errs, samples, placed, rng)
                 placed.append(origin)
             finishing[submit(stage_c, k, fr, framed, origin, band_error)] = k
-            done = [f for f in finishing if f.done()]
+            done = [f for f in finishing if completions.is_done(f)]
             yield from _collect(done, finishing, made, n)
         while finishing and not is_cancelled(cancel):
-            done, _ = wait(list(finishing), return_when=FIRST_COMPLETED)
+            done = completions.wait(finishing)
             yield from _collect(done, finishing, made, n)
     finally:
         stop.cancel()
