@@ -29,6 +29,7 @@ COLUMNS = (
     ("lattice", "Lattice dB", "{:+.1f}"),
     ("duplicates", "Duplicates", "{:d}"),
     ("template_share", "Template share", "{:.0%}"),
+    ("spread", "Detail spread", "{:.1f}"),
     ("seconds", "Time s", "{:.1f}"),
 )
 

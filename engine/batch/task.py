@@ -143,6 +143,7 @@ def fill_folder(
     """Write ``photo``'s tile set, project, thumbnail and manifest into the empty ``folder``
     (read from ``data`` if given, else from ``photo.path``), the set made on ``threads``
     threads (the bytes do not depend on them). Raises on any failure."""
+    from engine.batch.quality import detail_spread, spread_warning
     from engine.io import load_image
 
     t0 = time.perf_counter()
@@ -163,6 +164,8 @@ def fill_folder(
     mpath = folder / MANIFEST
     manifest = json.loads(mpath.read_text(encoding="utf-8"))
     metrics, figure_warnings = _figures(folder, manifest, source)
+    metrics["spread"] = detail_spread(source)
+    figure_warnings = [*spread_warning(metrics["spread"]), *figure_warnings]
     warnings = list(
         dict.fromkeys([*manifest.get("warnings", []), *engine_warnings, *figure_warnings])
     )

@@ -225,3 +225,29 @@ def test_a_photo_changed_since_replaces_its_old_folder(tmp_path):
     run_photo(new, SMALL, lib)
     assert remove_superseded(lib, photos) == [old["brick.png"]]
     assert sorted(photo_folders(lib)) == sorted([new.key, old["gravel.png"]])
+
+
+def test_a_non_stationary_photo_is_done_and_flagged(tmp_path):
+    import numpy as np
+    from PIL import Image
+
+    from engine.batch.quality import SPREAD_LIMIT, detail_spread
+    from engine.io import load_image
+    from resources import SAMPLE_NAMES, sample_path
+
+    for name in SAMPLE_NAMES:  # stationary textures stay under the limit
+        assert detail_spread(load_image(sample_path(name)).pixels) < SPREAD_LIMIT / 2
+    (p,) = write_photos(tmp_path / "in", names=("gravel",))
+    a = np.asarray(Image.open(p).convert("RGB")).copy()
+    a[:, a.shape[1] // 2 :] = np.linspace(90, 110, a.shape[1] - a.shape[1] // 2)[None, :, None]
+    Image.fromarray(a).save(p)  # half gravel, half a smooth wall
+    (ph,) = find_photos([str(p)])[0]
+    record = run_photo(ph, SMALL, tmp_path / "lib")
+    assert record.status == "done", record.error  # the set is made, the photo flagged
+    assert record.metrics["spread"] > SPREAD_LIMIT
+    assert any("not stationary" in w for w in record.warnings)
+    (e,) = read_library(tmp_path / "lib")
+    assert e.text("spread") == f"{record.metrics['spread']:.1f}"
+    write_index(tmp_path / "lib")
+    html = (tmp_path / "lib" / "index.html").read_text()
+    assert "Detail spread" in html and "not stationary" in html
