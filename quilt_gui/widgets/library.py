@@ -36,6 +36,7 @@ from PySide6.QtWidgets import (
 
 from engine.batch.index import INDEX_HTML
 from engine.batch.library import COLUMNS, Entry, read_library
+from engine.batch.quality import past_limit
 from quilt_gui import jobs
 
 SORT_ROLE = Qt.ItemDataRole.UserRole + 1
@@ -111,8 +112,8 @@ class LibraryModel(QAbstractTableModel):
         if role == Qt.ItemDataRole.ForegroundRole:
             if e.failed:
                 return QBrush(FAIL_COLOR)
-            if key == "notes" and e.warnings:
-                return QBrush(WARN_COLOR)
+            if (key == "notes" and e.warnings) or past_limit(key, e.values.get(key)):
+                return QBrush(WARN_COLOR)  # as the contact sheet marks the figures past limit
         if role == Qt.ItemDataRole.FontRole and e.key in self.opened:
             f = QFont()
             f.setItalic(True)

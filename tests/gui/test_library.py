@@ -46,6 +46,13 @@ def test_library_lists_every_photo_failed_first_with_the_index_columns(qtbot, li
     assert "truncated or corrupt" in notes
     assert table.model().index(1, 0).data(Qt.ItemDataRole.DecorationRole) is not None  # thumb
     assert "3 photos, 1 failed" in view.summary.text()
+    from engine.batch.quality import past_limit
+
+    fg = Qt.ItemDataRole.ForegroundRole
+    for r, e in enumerate(read_library(library)[1:], start=1):  # figures past limit marked
+        for c, (key, _) in enumerate(HEADERS[2:], start=2):
+            marked = table.model().index(r, c).data(fg) is not None
+            assert marked == past_limit(key, e.values.get(key)), (e.name, key)
 
 
 def test_double_click_opens_the_project_and_next_the_following(qtbot, library):
