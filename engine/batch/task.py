@@ -165,9 +165,15 @@ def fill_folder(
     manifest = json.loads(mpath.read_text(encoding="utf-8"))
     metrics, figure_warnings = _figures(folder, manifest, source)
     metrics["spread"] = detail_spread(source)
-    figure_warnings = [*spread_warning(metrics["spread"]), *figure_warnings]
-    warnings = list(
-        dict.fromkeys([*manifest.get("warnings", []), *engine_warnings, *figure_warnings])
+    warnings = list(  # the photo itself first: a non-stationary one explains the rest
+        dict.fromkeys(
+            [
+                *spread_warning(metrics["spread"]),
+                *manifest.get("warnings", []),
+                *engine_warnings,
+                *figure_warnings,
+            ]
+        )
     )
     _thumbnail(folder / manifest["preview"]["file"], folder / THUMBNAIL, settings.thumbnail)
     record = PhotoRecord(
