@@ -11,11 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from engine.metrics import QUALITY_LIMITS
-
-#: a photo whose detail varies more than this between its regions is not stationary
-#: (:func:`detail_spread`; bundled samples and the public evaluation set: 1.1-2.3 for the
-#: textures, 3.2 for the unevenly lit retina, 5-24 for the cell, the moon, the page, the text)
-SPREAD_LIMIT = 4.0
+from engine.tiles.stationarity import DETAIL_LIMIT
 
 #: figure -> (limit, "max" or "min"): issue 10's interior limits and issue 3's wrap and detail
 #: targets; the contact sheet marks the figures past them
@@ -23,7 +19,7 @@ LIMITS = {
     **{k: (v, "max") for k, v in QUALITY_LIMITS.items()},
     "wrap": (1.15, "max"),
     "detail": (0.95, "min"),
-    "spread": (SPREAD_LIMIT, "max"),
+    "spread": (DETAIL_LIMIT, "max"),
 }
 
 #: the figures an index row shows (``manifest["quality"]`` has a few more)
@@ -64,32 +60,14 @@ def wang_figures(source, tiles, *, band: int, margin: int, layout) -> dict:
     return _rounded(out)
 
 
-def detail_spread(source, *, cells: int = 4) -> float:
-    """How unevenly the detail is spread over a photo: the largest over the smallest standard
-    deviation of the luminance in a ``cells`` x ``cells`` grid. A stationary texture keeps it
-    near 1-2; a photo whose content changes across it (one object, text on a page, a region
-    of another material) goes far higher, and a tile set can then only repeat one region's
-    look. A lighting gradient alone barely changes it (the ring-tone figure and ``--flatten``
-    deal with those)."""
-    from engine.metrics import luminance
+def detail_spread(source) -> float:
+    """The source's detail spread as the template search judges it
+    (:func:`engine.tiles.stationarity.check_stationarity`: the busiest blocks' high-frequency
+    energy over the calmest ones'; past :data:`DETAIL_LIMIT` the search warns that the
+    photo is not the same texture everywhere). Capped at 1e6 (a blank region gives infinity)."""
+    from engine.tiles.stationarity import check_stationarity
 
-    y = luminance(source)
-    rows = np.array_split(np.arange(y.shape[0]), cells)
-    cols = np.array_split(np.arange(y.shape[1]), cells)
-    sd = np.array([y[r[0] : r[-1] + 1, c[0] : c[-1] + 1].std() for r in rows for c in cols])
-    floor = 1e-3  # a flat cell (a scan's border, a blank area) counts as barely textured
-    return round(float(np.maximum(sd, floor).max() / np.maximum(sd, floor).min()), 4)
-
-
-def spread_warning(spread: float) -> list[str]:
-    """The warning a non-stationary photo gets (none below :data:`SPREAD_LIMIT`)."""
-    if spread <= SPREAD_LIMIT:
-        return []
-    return [
-        f"the photo is not stationary: its detail varies {spread:.1f}x between regions "
-        f"(> {SPREAD_LIMIT:g}): the tiles repeat one region's look; crop the photo to a "
-        "uniform region of the texture"
-    ]
+    return round(min(check_stationarity(source).detail, 1e6), 4)
 
 
 def _rounded(d: dict) -> dict:

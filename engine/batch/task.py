@@ -143,7 +143,7 @@ def fill_folder(
     """Write ``photo``'s tile set, project, thumbnail and manifest into the empty ``folder``
     (read from ``data`` if given, else from ``photo.path``), the set made on ``threads``
     threads (the bytes do not depend on them). Raises on any failure."""
-    from engine.batch.quality import detail_spread, spread_warning
+    from engine.batch.quality import detail_spread
     from engine.io import load_image
 
     t0 = time.perf_counter()
@@ -164,16 +164,9 @@ def fill_folder(
     mpath = folder / MANIFEST
     manifest = json.loads(mpath.read_text(encoding="utf-8"))
     metrics, figure_warnings = _figures(folder, manifest, source)
-    metrics["spread"] = detail_spread(source)
-    warnings = list(  # the photo itself first: a non-stationary one explains the rest
-        dict.fromkeys(
-            [
-                *spread_warning(metrics["spread"]),
-                *manifest.get("warnings", []),
-                *engine_warnings,
-                *figure_warnings,
-            ]
-        )
+    metrics["spread"] = detail_spread(source)  # its warning is the template search's own
+    warnings = list(
+        dict.fromkeys([*manifest.get("warnings", []), *engine_warnings, *figure_warnings])
     )
     _thumbnail(folder / manifest["preview"]["file"], folder / THUMBNAIL, settings.thumbnail)
     record = PhotoRecord(

@@ -231,12 +231,13 @@ def test_a_non_stationary_photo_is_done_and_flagged(tmp_path):
     import numpy as np
     from PIL import Image
 
-    from engine.batch.quality import SPREAD_LIMIT, detail_spread
+    from engine.batch.quality import detail_spread
     from engine.io import load_image
+    from engine.tiles.stationarity import DETAIL_LIMIT
     from resources import SAMPLE_NAMES, sample_path
 
     for name in SAMPLE_NAMES:  # stationary textures stay under the limit
-        assert detail_spread(load_image(sample_path(name)).pixels) < SPREAD_LIMIT / 2
+        assert detail_spread(load_image(sample_path(name)).pixels) < DETAIL_LIMIT
     (p,) = write_photos(tmp_path / "in", names=("gravel",))
     a = np.asarray(Image.open(p).convert("RGB")).copy()
     a[:, a.shape[1] // 2 :] = np.linspace(90, 110, a.shape[1] - a.shape[1] // 2)[None, :, None]
@@ -244,10 +245,10 @@ def test_a_non_stationary_photo_is_done_and_flagged(tmp_path):
     (ph,) = find_photos([str(p)])[0]
     record = run_photo(ph, SMALL, tmp_path / "lib")
     assert record.status == "done", record.error  # the set is made, the photo flagged
-    assert record.metrics["spread"] > SPREAD_LIMIT
-    assert "not stationary" in record.warnings[0]
+    assert record.metrics["spread"] > DETAIL_LIMIT
+    assert any("sharpness varies" in w for w in record.warnings)  # the search's warning
     (e,) = read_library(tmp_path / "lib")
     assert e.text("spread") == f"{record.metrics['spread']:.1f}"
     write_index(tmp_path / "lib")
     html = (tmp_path / "lib" / "index.html").read_text()
-    assert "Detail spread" in html and "not stationary" in html
+    assert "Detail spread" in html and "sharpness varies" in html
