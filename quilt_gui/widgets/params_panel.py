@@ -38,7 +38,6 @@ from quilt_gui.param_table import ADVANCED, BASIC
 #: Integer parameters edited with a slider (the rest use spin boxes).
 SLIDERS = frozenset(
     {
-        "overlap",
         "o_max",
         "max_run",
         "width",

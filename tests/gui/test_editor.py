@@ -482,7 +482,7 @@ def test_autosave_and_recovery_after_a_crash(qtbot, win):
 def test_light_theme_on_request(qtbot, win):
     from PySide6.QtWidgets import QApplication
 
-    label = win.params_panel.widgets["overlap"]._label  # a style-sheeted superqt label
+    label = win.params_panel.widgets["rho"]._label  # a style-sheeted superqt label
 
     def text_lightness() -> int:
         return label.palette().color(label.foregroundRole()).lightness()

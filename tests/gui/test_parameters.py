@@ -90,6 +90,7 @@ def test_reset_to_defaults_and_sizes_that_follow_the_image(qtbot, tmp_path):
     with qtbot.waitSignal(w.doc.source_changed, timeout=5000):
         w.files.open_path(str(small), confirm=False)
     assert w.doc.params["tile_size"] == "auto" and w.doc.params["overlap"] == 0
+    assert w.params_panel.widgets["overlap"].text() == "auto"  # not a bare "0"
     assert "Tile size, Seam search width: too large for this image" in w.last_message()
     w.act_find.trigger()
     wait_idle(qtbot, w)
