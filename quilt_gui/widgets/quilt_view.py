@@ -294,12 +294,7 @@ class QuiltView(QWidget):
         self.block_rect.set_rect(c, r, w, h)
         self.block_rect.show()
         t, left, b, rt = rec.arms
-        if len(rec.path):
-            seam = f"seam criterion {rec.criterion:.3f}, peak {rec.peak:.3f}"
-        elif any(rec.arms):
-            seam = "straight overlap (no cut)"
-        else:
-            seam = "no overlap (first block)"
+        seam = seam_text(rec)
         match = (
             ""
             if np.isnan(rec.match_error)
@@ -309,7 +304,7 @@ class QuiltView(QWidget):
             f"Block #{rec.index + 1} at row {r}, col {c} ({w}×{h}) from sample ({x}, {y}) · "
             f"overlaps top {t}, left {left}{', bottom ' + str(b) if b else ''}"
             f"{', right ' + str(rt) if rt else ''} · {seam}{match} · chosen among "
-            f"{rec.candidates} windows"
+            f"{rec.candidates} window{'s' if rec.candidates != 1 else ''}"
         )
         self.selection_changed.emit()
 
@@ -319,3 +314,15 @@ class QuiltView(QWidget):
         return (
             None if i is None or i >= len(self.doc.quilting.blocks) else self.doc.quilting.blocks[i]
         )
+
+
+def seam_text(rec) -> str:
+    """How block ``rec`` met its neighbours, for the inspector's caption."""
+    if len(rec.path):
+        return f"seam criterion {rec.criterion:.3f}, peak {rec.peak:.3f}"
+    if not any(rec.arms):
+        return "no overlap (first block)"
+    if rec.error is not None and rec.keep_old is not None and not np.any(rec.error):
+        # the engine searches no cut where old and new agree exactly (a continued copy)
+        return "no cut needed: the sample continues its neighbours exactly (overlap error 0)"
+    return "straight overlap (no cut)"

@@ -161,3 +161,23 @@ def test_quilting_job_carries_the_engine_estimate_for_the_status_bar(qtbot):
     assert job.estimate.startswith("estimate: ") and "search" in job.estimate
     assert "about" in job.estimate and "peak memory" in job.estimate
     wait_idle(qtbot, w)
+
+
+def test_the_inspector_says_why_a_block_has_no_cut():
+    """A block that continues its neighbours' sample exactly gets no cut from the engine: the
+    caption says so instead of calling it a straight overlap."""
+    from types import SimpleNamespace
+
+    from quilt_gui.widgets.quilt_view import seam_text
+
+    zero, some = np.zeros((4, 4), np.float32), np.ones((4, 4), np.float32)
+    keep = np.zeros((4, 4), bool)
+    block = SimpleNamespace(path=(), arms=(2, 2, 0, 0), error=zero, keep_old=keep)
+    assert seam_text(block).startswith("no cut needed")
+    assert seam_text(SimpleNamespace(**{**vars(block), "error": some})) == (
+        "straight overlap (no cut)"
+    )
+    first = SimpleNamespace(path=(), arms=(0, 0, 0, 0), error=None, keep_old=None)
+    assert seam_text(first) == "no overlap (first block)"
+    cut = SimpleNamespace(**{**vars(block), "path": [(0, 1)], "criterion": 1.5, "peak": 0.25})
+    assert seam_text(cut) == "seam criterion 1.500, peak 0.250"
