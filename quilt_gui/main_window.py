@@ -537,6 +537,8 @@ class MainWindow(QMainWindow):
         dock = self.docks["library"]
         dock.show()
         dock.raise_()
+        # a list to browse: the lower half of the centre, not the gallery's strip of thumbnails
+        self.resizeDocks([dock], [self.height() // 2], Qt.Orientation.Vertical)
         return self.library_view.load(path)
 
     def export_dialog(self, *_args, wang: bool | None = None) -> None:
