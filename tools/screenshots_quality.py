@@ -2,7 +2,8 @@
 
     xvfb-run -s "-screen 0 1600x1000x24" python tools/screenshots_quality.py
 
-Writes docs/preview_quality.png (cobblestones, the defaults: no warning) and
+Writes docs/preview_quality.png (cobblestones, the editor's defaults, all candidates picked:
+the figures in one line; it still shows one warning, lattice +1.9 dB above its floor) and
 docs/preview_warned.png (the evaluation set's procedural bricks under a lighting gradient:
 the frame, ring tone and lattice warnings in words).
 """
