@@ -148,7 +148,7 @@ def run_wang(args, settings, rect=None) -> int:
     s = resolve_wang(settings, S.shape[:2])
     count = s.wang_variants * s.wang**4
     settings = check_sizes(args, settings, S, s.tile_min, maps, tiles=count)
-    s = resolve_wang(settings, S.shape[:2])
+    s = s.replace(preview=settings.preview)  # a default preview may have shrunk to fit
     say(f"Wang set: {s.wang} colours per edge direction, {count} tiles of {s.tile_min[0]} px")
     result = drain(
         iter_wang_tileset(

@@ -322,7 +322,7 @@ def seam_text(rec) -> str:
         return f"seam criterion {rec.criterion:.3f}, peak {rec.peak:.3f}"
     if not any(rec.arms):
         return "no overlap (first block)"
-    if rec.error is not None and rec.keep_old is not None and not np.any(rec.error):
+    if rec.error is not None and not np.any(rec.error):
         # the engine searches no cut where old and new agree exactly (a continued copy)
         return "no cut needed: the sample continues its neighbours exactly (overlap error 0)"
     return "straight overlap (no cut)"

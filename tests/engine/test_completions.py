@@ -36,7 +36,7 @@ def test_an_interrupt_while_waiting_leaves_the_workers_free():
     old = signal.signal(signal.SIGALRM, interrupt)
     try:
         with ThreadPoolExecutor(2) as pool:
-            futs = [c.watch(pool.submit(release.wait, 5)) for _ in range(4)]
+            futs = [c.watch(pool.submit(release.wait, 60)) for _ in range(4)]  # released below
             signal.setitimer(signal.ITIMER_REAL, 0.05)
             with pytest.raises(KeyboardInterrupt):
                 c.wait(futs)
