@@ -14,20 +14,21 @@ from engine.batch.library import COLUMNS
 from engine.batch.quality import past_limit
 
 _CSS = """
-body{font:14px/1.35 system-ui,sans-serif;margin:16px;background:#fafafa;color:#222}
+body{font:13px/1.35 system-ui,sans-serif;margin:12px;background:#fafafa;color:#222}
 h1{font-size:20px;margin:0 0 4px}
 p.sum{margin:0 0 12px;color:#555}
 table{border-collapse:collapse;background:#fff}
 th,td{border:1px solid #ddd;padding:4px 6px;vertical-align:top}
-th{background:#eee;cursor:pointer;position:sticky;top:0;white-space:nowrap}
+th{background:#eee;cursor:pointer;position:sticky;top:0}
+th.num{max-width:80px}
 td.num{text-align:right;font-variant-numeric:tabular-nums;white-space:nowrap}
 td.bad{background:#fde2d6;color:#8a2500;font-weight:600}
 tr.failed td{background:#fbeaea}
-td.img img{display:block;max-width:160px;max-height:160px}
+td.img img{display:block;max-width:128px;max-height:128px}
 td.tile img{max-width:96px;max-height:96px;image-rendering:auto}
 .name{font-weight:600}
-td.photo{min-width:150px;max-width:220px}
-td.notes{min-width:240px;max-width:340px}
+td.photo{min-width:130px;max-width:180px}
+td.notes{min-width:220px;max-width:300px}
 .src{color:#777;font-size:12px;word-break:break-all}
 ul.warn{margin:0;padding-left:16px;color:#8a4b00}
 .err{color:#a00;font-weight:600}
@@ -52,6 +53,14 @@ document.querySelectorAll('th[data-k]').forEach(function(th, i){
   });
 });
 """
+
+
+SHEET_COLUMNS = tuple(c for c in COLUMNS if c[0] != "warning_count")
+"""The library's columns on the sheet: the warning count is left out (the warnings column
+lists them and sorts by their number), so a row fits a 1400 px wide window."""
+
+
+_NUM = ' class="num"'
 
 
 def _href(key: str, name: str) -> str:
@@ -84,7 +93,7 @@ def _row(e) -> str:
         items = "".join(f"<li>{escape(w)}</li>" for w in e.warnings)
         notes.append(f'<ul class="warn">{items}</ul>')
     cells.append(f'<td class="notes" data-v="{len(e.warnings)}">{"".join(notes)}</td>')
-    for key, _, fmt in COLUMNS:
+    for key, _, fmt in SHEET_COLUMNS:
         v = e.values.get(key)
         text = escape(e.text(key))
         sort_v = escape(str(v)) if v is not None else ""
@@ -102,10 +111,13 @@ def contact_sheet(entries, *, title: str = "library") -> str:
     entries = list(entries)
     failed = sum(e.failed for e in entries)
     warned = sum(bool(e.warnings) and not e.failed for e in entries)
-    heads = ["8x8 preview", "Tile", "Photo", "Warnings / error", *(h for _, h, _ in COLUMNS)]
-    keys = ["", "", "photo", "notes", *(k for k, _, _ in COLUMNS)]
+    heads = ["8x8 preview", "Tile", "Photo", "Warnings / error", *(h for _, h, _ in SHEET_COLUMNS)]
+    keys = ["", "", "photo", "notes", *(k for k, _, _ in SHEET_COLUMNS)]
+    numeric = {k for k, _, fmt in SHEET_COLUMNS if fmt}
     th = "".join(
-        f'<th data-k="{k}" title="click to sort">{escape(h)}</th>' if k else f"<th>{h}</th>"
+        f'<th data-k="{k}"{_NUM if k in numeric else ""} title="click to sort">{escape(h)}</th>'
+        if k
+        else f"<th>{h}</th>"
         for k, h in zip(keys, heads, strict=True)
     )
     rows = "\n".join(_row(e) for e in entries)

@@ -252,3 +252,4 @@ def test_a_non_stationary_photo_is_done_and_flagged(tmp_path):
     write_index(tmp_path / "lib")
     html = (tmp_path / "lib" / "index.html").read_text()
     assert "Detail spread" in html and "sharpness varies" in html
+    assert 'data-k="warning_count"' not in html  # listed in the warnings column: fits 1400 px
