@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import functools
 import numbers
 from dataclasses import dataclass
 
@@ -216,6 +217,13 @@ def _iter_anytime(e, pins, cyclic, opts, cancel):
     return best
 
 
+@functools.cache
+def _default_spec(method: str) -> SeamSpec:
+    """``SeamSpec(method)``, built once per method: a spec is immutable, and validating it
+    again on every call cost about 20 µs of a 70 µs cut on a 32×6 overlap."""
+    return SeamSpec(method)
+
+
 # ----------------------------------------------------------------------------- public API
 def iter_find_seam(
     error,
@@ -272,7 +280,7 @@ def iter_find_seam(
             raise ValueError(
                 f"method must be one of {', '.join(map(repr, METHODS))}, got {method!r}"
             )
-        seam = SeamSpec(method, options)
+        seam = SeamSpec(method, options) if options else _default_spec(method)
     method = seam.method
     e = np.ascontiguousarray(as_error_map(error))
     if not e.flags.writeable:  # numba compiles read-only arrays separately: avoid a recompile
