@@ -31,7 +31,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy import ndimage
 from skimage.util import img_as_float32
 
 from engine._validate import as_error_map, choice, positive_int
@@ -74,6 +73,8 @@ def ramp_from_mask(mask, half_width, *, wrap_rows: bool = False) -> np.ndarray:
     (then b is read at the nearest pixel across the boundary); b = 0 gives the hard mask.
     ``wrap_rows``: rows 0 and h - 1 are neighbours (a cyclic seam), the ramp is periodic.
     """
+    from scipy import ndimage
+
     m = np.asarray(mask, dtype=bool)
     if m.ndim != 2:
         raise ValueError(f"mask must be 2-D, got shape {m.shape}")
@@ -214,6 +215,8 @@ def _row_ramp(cols: np.ndarray, b_rows: np.ndarray, width: int) -> np.ndarray:
 
 
 def _winding_ramp(mask: np.ndarray, path: np.ndarray, b_rows: np.ndarray, cyclic: bool):
+    from scipy import ndimage
+
     on_path = np.zeros(mask.shape, dtype=bool)
     on_path[path[:, 0], path[:, 1]] = True
     _, idx = ndimage.distance_transform_edt(~on_path, return_indices=True)

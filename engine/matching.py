@@ -24,8 +24,8 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.fft as sfft
-from numba import njit
 
+from engine._jit import njit
 from engine._validate import as_image, as_rng, positive_int
 
 __all__ = [

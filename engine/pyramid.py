@@ -37,8 +37,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
+from engine._jit import njit
 from engine.matching import SampleSpectrum, smallest_indices
 
 __all__ = [

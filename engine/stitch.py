@@ -22,9 +22,8 @@ from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
-from scipy import ndimage
 
+from engine._jit import njit
 from engine._validate import as_error_map, as_image, choice, positive_int
 from engine.blend import (
     adaptive_half_widths,
@@ -633,6 +632,8 @@ def patch_cut(
         pieces[name] = np.column_stack([rows, cols]).astype(np.intp)
         b_rows = _side_half_widths(side, ce, spec)
         np.maximum.at(b_at, (rows, cols), b_rows[p[:, 0]])
+    from scipy import ndimage
+
     loop = _ordered_loop(pieces)
     barrier = np.zeros((ph, pw), dtype=bool)
     barrier[loop[:, 0], loop[:, 1]] = True
@@ -655,6 +656,8 @@ def patch_cut(
 
 def _loop_ramp(mask: np.ndarray, barrier: np.ndarray, b_at: np.ndarray) -> np.ndarray:
     """EDT ramp of ``mask`` whose half-width is read at the loop pixel nearest to each pixel."""
+    from scipy import ndimage
+
     _, idx = ndimage.distance_transform_edt(~barrier, return_indices=True)
     return ramp_from_mask(mask, b_at[idx[0], idx[1]])
 

@@ -44,11 +44,11 @@ from engine.pyramid import PyramidSearch
 from engine.quilting.core import BlockWork, Quilter
 from engine.quilting.estimate import Estimated, check_plan, plan
 from engine.quilting.layout import grid_rects
+from engine.quilting.names import CORRESPONDENCES
 from engine.quilting.options import check_options, resolve_threads, sample_array
 from engine.quilting.records import BlockRecord
 from engine.quilting.scheduler import run_levels
 
-CORRESPONDENCES = ("luminance", "blurred")
 PYRAMID_KEEP = 12
 """Candidates the coarse-to-fine search carries per level in transfer (quilting: 24). Every
 pixel of a transfer block weighs in its exact re-ranking, so each candidate costs the whole

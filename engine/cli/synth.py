@@ -15,8 +15,6 @@ import sys
 import time
 from pathlib import Path
 
-import numpy as np
-
 from engine.cli import SUBCOMMANDS
 from engine.cli._args import (
     add_bit_depth,
@@ -52,9 +50,8 @@ def parse_wxh(text: str) -> tuple[int, int]:
 
 def add_cut_arguments(p: argparse.ArgumentParser) -> None:
     """Options shared by ``synth`` and ``transfer``: the cut, blending, search, seed, threads."""
-    from engine.blend import BLEND_MODES
-    from engine.errormap import METRICS
-    from engine.quilting import MODES, SEAMS
+    from engine.quilting.names import MODES, SEAMS
+    from engine.seams.spec import BLEND_MODES, METRICS
 
     p.add_argument(
         "--seam",
@@ -105,7 +102,7 @@ def add_cut_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
-    from engine.quilting import SELECTIONS
+    from engine.quilting.names import SELECTIONS
 
     p = subparsers.add_parser(
         "synth",
@@ -280,7 +277,7 @@ def cut_options(args) -> dict:
 
 def run(args) -> int:
     from engine.metrics import block_grid_border_ratio
-    from engine.quilting import iter_quilt
+    from engine.quilting.synthesis import iter_quilt
 
     sample, depth, excluded = load_sample_and_exclusion(args)
     gen = start(
@@ -313,6 +310,8 @@ def run(args) -> int:
 
 def save_seams(path: str, res) -> None:
     """Every block's cut: JSON records, or the output with the cut pixels in red."""
+    import numpy as np
+
     from engine.io import save_image, to_rgb
 
     p = Path(path)

@@ -35,7 +35,7 @@ def alpha_arg(text: str):
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
-    from engine.transfer import CORRESPONDENCES
+    from engine.quilting.names import CORRESPONDENCES
 
     p = subparsers.add_parser(
         "transfer",

@@ -45,20 +45,33 @@ Determinism and threads
     of threads (:mod:`~engine.quilting.scheduler`).
 """
 
-from engine.quilting.estimate import Estimated, Plan
-from engine.quilting.options import MODES, SEAMS, SELECTIONS
-from engine.quilting.records import BlockPlaced, BlockRecord, QuiltResult
-from engine.quilting.synthesis import iter_quilt, quilt
+import importlib
 
-__all__ = [
-    "MODES",
-    "SEAMS",
-    "SELECTIONS",
-    "BlockPlaced",
-    "BlockRecord",
-    "Estimated",
-    "Plan",
-    "QuiltResult",
-    "iter_quilt",
-    "quilt",
-]
+# Names are loaded on first use (PEP 562): the command line's parsers read the tables of
+# engine.quilting.names without loading numpy, and a module imports what it uses once.
+_EXPORTS = {
+    "MODES": "engine.quilting.names",
+    "SEAMS": "engine.quilting.names",
+    "SELECTIONS": "engine.quilting.names",
+    "BlockPlaced": "engine.quilting.records",
+    "BlockRecord": "engine.quilting.records",
+    "Estimated": "engine.quilting.estimate",
+    "Plan": "engine.quilting.estimate",
+    "QuiltResult": "engine.quilting.records",
+    "iter_quilt": "engine.quilting.synthesis",
+    "quilt": "engine.quilting.synthesis",
+}
+
+__all__ = sorted(_EXPORTS)
+
+
+def __getattr__(name: str):
+    if name not in _EXPORTS:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(_EXPORTS[name]), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *_EXPORTS})

@@ -13,7 +13,6 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import replace
 
 import numpy as np
-from scipy import ndimage
 
 from engine.cancel import check
 from engine.errormap import error_map
@@ -179,6 +178,8 @@ def _bhatia_seam(q: Quilter, e: np.ndarray, own_band: np.ndarray):
 
 def _territory_composite(terr, srcs, blend: str, width: float) -> np.ndarray:
     """Composite the territories' sources: hard, or blurred one-hot weights renormalised."""
+    from scipy import ndimage
+
     h, w = terr.shape
     if blend == "none":
         out = srcs[0].copy()

@@ -11,7 +11,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import ndimage
 
 from engine.blend import ramp_from_mask
 from engine.seams import SeamSpec, find_seam
@@ -96,6 +95,8 @@ def _adaptive_half_width_map(keep, path, err, overlap, rho: int) -> np.ndarray:
     """ρ-adaptive half-widths (§1.3) for any path: b = min(⌊ρ ẽ / Ē⌋, 2ρ) with ẽ the path error
     smoothed over ±ρ path pixels and Ē the mean error of the overlap; read at the nearest path
     pixel."""
+    from scipy import ndimage
+
     e = err[path[:, 0], path[:, 1]].astype(np.float64)
     k = np.ones(2 * rho + 1)
     sm = np.convolve(e, k, mode="same") / np.convolve(np.ones(e.size), k, mode="same")

@@ -13,13 +13,10 @@ from engine.exclusion import valid_anchors
 from engine.matching import check_block
 from engine.quilting.bhatia import bhatia_anchors
 from engine.quilting.layout import check_torus_axis, torus_overlap
+from engine.quilting.names import MODES, SEAMS, SELECTIONS
 from engine.seams import SeamSpec
-from engine.seams.spec import METHODS as SEAM_METHODS
-from engine.seams.spec import STRAIGHT, check_blend
+from engine.seams.spec import check_blend
 
-SELECTIONS = ("best", "random", "sampled", "bhatia")
-MODES = ("auto", "exact", "fast")
-SEAMS = (STRAIGHT, *SEAM_METHODS)
 QUILT_SEAM = SeamSpec("dp", metric="ssd")
 """Quilting's default cut: Efros & Freeman's minimum error boundary cut on the squared error,
 no blending."""

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import numpy as np
-from scipy import ndimage
 
 
 class Seam:
@@ -130,6 +129,8 @@ def mask_from_path(path: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
     The path is a barrier; the region 4-connected to the right edge (R2 side)
     outside the barrier is R2, everything else (left region and path) is R1.
     """
+    from scipy import ndimage
+
     h, w = shape
     barrier = np.zeros(shape, dtype=bool)
     barrier[path[:, 0], path[:, 1]] = True

@@ -11,8 +11,8 @@ closed cost: O(3 w h) per start tried, O(3 w² h) at worst, a few starts on real
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from engine._jit import njit
 from engine.seams._result import Seam, make_seam, mask_from_columns
 
 

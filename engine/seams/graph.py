@@ -19,8 +19,8 @@ inline in a lazy-deletion heap, the sorted label in an indexed heap with decreas
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from engine._jit import njit
 from engine._validate import as_error_map, choice, positive_int
 from engine.cancel import check
 from engine.seams.spec import check_connectivity

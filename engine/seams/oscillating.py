@@ -44,9 +44,8 @@ with ``cyclic`` rows 0 and h-1 are neighbours). Criterion
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
-from scipy import ndimage
 
+from engine._jit import njit
 from engine.cancel import check, is_cancelled
 from engine.seams._result import Seam
 from engine.seams.dp import dp_columns
@@ -376,6 +375,8 @@ def initial_controls(
     ``cyclic`` (O(3wh); :func:`iter_oscillating` streams the closed cyclic cut next when that is
     better); per-row argmin when the pins admit no such path.
     """
+    from scipy import ndimage
+
     if init not in INITS:
         raise ValueError(f"init must be one of {', '.join(map(repr, INITS))}, got {init!r}")
     if init == "dp":

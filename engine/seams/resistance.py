@@ -74,7 +74,8 @@ A straight run is at most ``max_run`` consecutive pixels in one row or one colum
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from engine._jit import njit
 
 # walk: down, down-left, down-right, left, right
 _DR = np.array([1, 1, 1, 0, 0], dtype=np.int64)

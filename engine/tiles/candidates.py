@@ -39,8 +39,8 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 
+from engine._jit import njit
 from engine._validate import as_image, choice, non_negative_number, positive_int
 from engine.cancel import AnyCancel, Cancelled, CancelToken, check, is_cancelled
 from engine.candidate import CandidateTile

@@ -47,17 +47,21 @@ def test_help_loads_no_numerical_library_and_no_subcommand():
     assert heavy == [] and cli == []
 
 
-@pytest.mark.parametrize("name", ["seam", "tileset", "export"])
+@pytest.mark.parametrize("name", ["seam", "tileset", "export", "synth", "transfer"])
 def test_a_subcommands_help_loads_only_its_own_command(name):
     heavy, cli = _loaded([name, "--help"])
     assert heavy == []  # their parsers read the engine's light tables
     own = {f"engine.cli.{name}", "engine.cli._args", "engine.cli.outcome"}  # outcome: exit codes
     if name == "tileset":
         own |= {"engine.cli.export", "engine.cli.tileset_output", "engine.cli.tileset_wang"}
+    if name == "transfer":
+        own.add("engine.cli.synth")  # the cut options it shares
     assert set(cli) <= own, cli
 
 
-@pytest.mark.parametrize("module", ["engine.seams.spec", "engine.settings", "engine.cli"])
+@pytest.mark.parametrize(
+    "module", ["engine.seams.spec", "engine.settings", "engine.cli", "engine.quilting.names"]
+)
 def test_the_tables_the_parsers_read_load_without_numpy(module):
     code = f"import sys, json, {module}; print(json.dumps(sorted(sys.modules)))"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
