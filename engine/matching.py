@@ -25,6 +25,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.fft as sfft
 
+from engine import _jit as jit
 from engine._jit import njit
 from engine._validate import as_image, as_rng, positive_int
 
@@ -376,15 +377,29 @@ def select_within_tolerance(errors: np.ndarray, *, tolerance: float, zero_level:
     whose error is 0. Returns ``(flat index, e_min, number of qualifying entries)``.
     """
     flat = errors.ravel()
-    i_min = int(_argmin(flat))
+    small = not jit.loaded()  # the same result without starting numba (a small job)
+    i_min = _argmin_numpy(flat) if small else int(_argmin(flat))
     e_min = float(flat[i_min])
     if not np.isfinite(e_min):
         raise ValueError("no valid candidate position (every position is excluded)")
     limit = flat.dtype.type((1.0 + tolerance) * max(e_min, zero_level))  # compared in e's dtype
-    n = int(_count_at_most(flat, limit))
+    if small:
+        at_most = np.flatnonzero(flat <= limit)
+        n = at_most.size
+    else:
+        n = int(_count_at_most(flat, limit))
     if n == 0:  # float round-off
         return i_min, e_min, 1
-    return int(_kth_at_most(flat, limit, rng.integers(n))), e_min, n
+    k = rng.integers(n)
+    return int(at_most[k] if small else _kth_at_most(flat, limit, k)), e_min, n
+
+
+def _argmin_numpy(flat: np.ndarray) -> int:
+    """:func:`_argmin`'s answer: the first of equal minima, NaN skipped unless it comes first."""
+    i = int(np.argmin(flat))
+    if np.isnan(flat[i]) and not np.isnan(flat[0]):
+        i = int(np.argmin(np.where(np.isnan(flat), np.inf, flat)))
+    return i
 
 
 @njit(cache=True, nogil=True)

@@ -23,6 +23,8 @@ from typing import NamedTuple
 
 import numpy as np
 
+from engine import _jit as jit
+from engine import stitch_numpy
 from engine._jit import njit
 from engine._validate import as_error_map, as_image, choice, positive_int
 from engine.blend import (
@@ -335,6 +337,8 @@ def _old_side(path: np.ndarray, shape, seed_left: bool, seed_top: bool) -> np.nd
     without crossing it; pockets of the new side enclosed by it become old (holes filled)."""
     barrier = np.zeros(shape, dtype=bool)
     barrier[path[:, 0], path[:, 1]] = True
+    if _numpy_cut(barrier):
+        return stitch_numpy.old_side_of_barrier(barrier, seed_left, seed_top)
     return _old_side_of_barrier(barrier, seed_left, seed_top)
 
 
@@ -381,13 +385,20 @@ def _dp_l_cut(e, ovl, ovt):  # pragma: no cover - compiled
     return path[:n].copy(), _old_side_of_barrier(barrier, True, True), qr, qc
 
 
+def _numpy_cut(e: np.ndarray) -> bool:
+    """Whether to cut ``e`` with :mod:`engine.stitch_numpy` (same results): a small block while
+    numba is not loaded (a small job then never starts it)."""
+    return e.size <= stitch_numpy.SMALL_CUT_PIXELS and not jit.loaded()
+
+
 def _strip_path(strip: np.ndarray, spec: SeamSpec, start, cancel) -> np.ndarray:
     """Top-to-bottom path through a vertical strip with ``spec`` (dp inline for speed)."""
     strip = np.ascontiguousarray(strip)
     if spec.method == "dp":
-        cost, step = _dp_to_bottom(strip)
+        small = _numpy_cut(strip)
+        cost, step = (stitch_numpy.dp_to_bottom if small else _dp_to_bottom)(strip)
         c0 = int(np.argmin(cost[0])) if start is None else start
-        cols = _trace_down(step, 0, c0)
+        cols = (stitch_numpy.trace_down if small else _trace_down)(step, 0, c0)
         return np.column_stack([np.arange(strip.shape[0]), cols])
     return np.asarray(find_seam(strip, seam=spec, start=start, cancel=cancel).path)
 
@@ -451,7 +462,7 @@ def l_cut(
     elif method in GRAPH_METHODS:
         path = _graph_l_path(e, ovl, ovt, spec, cancel)
     elif method == "dp":
-        path, mask, qr, qc = _dp_l_cut(e, ovl, ovt)
+        path, mask, qr, qc = (stitch_numpy.dp_l_cut if _numpy_cut(e) else _dp_l_cut)(e, ovl, ovt)
         meeting = (int(qr), int(qc))
     else:
         qr, qc, _, _ = _dp_meeting(e, ovl, ovt)

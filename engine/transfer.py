@@ -48,6 +48,7 @@ from engine.quilting.names import CORRESPONDENCES
 from engine.quilting.options import check_options, resolve_threads, sample_array
 from engine.quilting.records import BlockRecord
 from engine.quilting.scheduler import run_levels
+from engine.stitch_numpy import use_numba_for
 
 PYRAMID_KEEP = 12
 """Candidates the coarse-to-fine search carries per level in transfer (quilting: 24). Every
@@ -363,6 +364,7 @@ def iter_transfer(
         peak_bytes=max(p.peak_bytes for p in passes),
     )
     check_plan(total, f"texture transfer ({n_iter} passes)")
+    use_numba_for(total.blocks)
     gen = as_rng(rng)
     seed = int(gen.integers(2**63))
     return _iter_transfer(

@@ -13,6 +13,7 @@ from engine.quilting.layout import grid_rects
 from engine.quilting.options import check_options, resolve_threads
 from engine.quilting.records import QuiltResult
 from engine.quilting.scheduler import run_levels
+from engine.stitch_numpy import use_numba_for
 
 __all__ = ["iter_quilt", "quilt", "quilt_unstreamed", "warmup"]
 
@@ -128,6 +129,7 @@ def _build_quilter(sample, out_shape, *, rng, cancel, threads, **options):
     threads = resolve_threads(threads)
     p = plan(opts, threads)
     check_plan(p, "quilting")
+    use_numba_for(p.blocks)
     seed = int(as_rng(rng).integers(2**63))
     return Quilter(seed=seed, cancel=cancel, threads=threads, plan=p, **opts)
 
@@ -183,7 +185,10 @@ def warmup() -> None:
     GIL for a noticeable time)."""
     import numpy as np
 
+    from engine import _jit
     from engine.pyramid import PyramidSearch
+
+    _jit.load()  # else these tiny runs would take the small jobs' numpy paths
 
     s = np.random.default_rng(0).random((72, 72, 3), dtype=np.float32)
     for mode in ("exact", "fast"):
