@@ -601,13 +601,13 @@ def save_layout(f: dict, path: Path, seed: int = 0) -> None:
     ).save(path)
 
 
-def evaluation(which: str, seed: int, layouts: Path | None) -> str:
+def evaluation(which: str, seed: int, layouts: Path | None, **changes) -> str:
     from benchmarks import evalset
 
     rows = []
     for name in evalset.texture_names(which):
         S = load_image_array(evalset.load(name))
-        f = evaluate_texture(S, seed)
+        f = evaluate_texture(S, seed, **changes)
         if layouts is not None:
             save_layout(f, layouts / f"{name}.jpg", seed)
         miss = failures(f)
@@ -617,6 +617,7 @@ def evaluation(which: str, seed: int, layouts: Path | None) -> str:
                 name,
                 f"{S.shape[1]}x{S.shape[0]}",
                 f"{w}x{h}",
+                scale_text(f["result"].scale),
                 f"{f['n']}",
                 f"{f['frame']:.2f} ({f['frame_low']:.2f})",
                 f"{f['tone']:.2f}",
@@ -635,6 +636,7 @@ def evaluation(which: str, seed: int, layouts: Path | None) -> str:
             "texture",
             "source",
             "tile",
+            "scale h x w",
             "cands",
             "frame (low)",
             "ring tone",
@@ -649,6 +651,14 @@ def evaluation(which: str, seed: int, layouts: Path | None) -> str:
         ],
         rows,
     )
+
+
+def scale_text(scale) -> str:
+    """A structure scale as 'h x w' with P marking a period (an autocorrelation peak)."""
+    if scale is None:
+        return "-"
+    mark = ["P" if p else "" for p in scale.periodic]
+    return f"{scale.height:.0f}{mark[0]} x {scale.width:.0f}{mark[1]}"
 
 
 def load_image_array(a: np.ndarray) -> np.ndarray:
@@ -711,6 +721,12 @@ def main(argv=None) -> int:
         metavar="DIR",
         help="with --evalset: write every texture's 8x8 layout there (JPEG, 100 %%)",
     )
+    ap.add_argument(
+        "--cut-structures",
+        action="store_true",
+        help="with --evalset: the template search without the structure-scale preference "
+        "(whole_structures=False), to measure what it changes",
+    )
     args = ap.parse_args(argv)
     unknown = set(args.patch_rings or ()) - set(RINGS)
     if unknown:
@@ -755,8 +771,10 @@ def main(argv=None) -> int:
             flush=True,
         )
     if args.evalset:
-        print(f"\n## Evaluation set: {args.evalset} (tileset defaults, 30 candidates)\n")
-        print(evaluation(args.evalset, args.seed, args.layouts), flush=True)
+        changes = {"whole_structures": False} if args.cut_structures else {}
+        what = ", whole_structures=False" if args.cut_structures else ""
+        print(f"\n## Evaluation set: {args.evalset} (tileset defaults{what}, 30 candidates)\n")
+        print(evaluation(args.evalset, args.seed, args.layouts, **changes), flush=True)
     return 0
 
 

@@ -122,7 +122,9 @@ class TilesetSettings:
     ``tile_min`` when only that is given),
     ``overlap`` w_T (None: about a tenth of the tile), ``joint_weight`` λ of the natural wrap
     joint, ``detail_weight`` κ of the detail term (:mod:`engine.tiles.detail`: keeps the tile
-    out of flat or blurred regions). Cuts: ``seam`` (method, options, metric, blending of the
+    out of flat or blurred regions), ``whole_structures`` (search only tiles that hold three of
+    the texture's structures per side where the range allows, warn when it cannot:
+    :mod:`engine.tiles.scale`). Cuts: ``seam`` (method, options, metric, blending of the
     patches) and ``template_blend`` (the template's blending; None: the same as ``seam.blend``).
     Candidates: ``candidates`` N, ``seed``, ``patch_size`` (None: the tile), ``patch_overlap``
     w_P (None: :func:`engine.tiles.default_patch_overlap`), ``margin`` (None: 1, at most
@@ -147,6 +149,7 @@ class TilesetSettings:
     overlap: int | None = setting(None, optional(at_least(2)))
     joint_weight: float = setting(0.5, number)
     detail_weight: float = setting(1.0, number)
+    whole_structures: bool = setting(True, boolean)
     seam: SeamSpec = setting(DEFAULT_SEAM, seam_spec)
     template_blend: str | None = setting("none", optional(blend_mode))
     candidates: int = setting(30, at_least(1))

@@ -161,6 +161,7 @@ class Pipeline(QObject):
             overlap=s.overlap or doc.tileset.overlap(),
             joint_weight=s.joint_weight,
             detail_weight=s.detail_weight,
+            whole_structures=s.whole_structures,
             sweep=self.sweep_samples,
             on_event=self._on_template_event,
             on_done=self._on_template_done,

@@ -203,6 +203,15 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "away from the template's position (default: a quarter tile, less on small sources)",
     )
     p.add_argument(
+        "--cut-structures",
+        dest="whole_structures",
+        action="store_false",
+        default=None,
+        help="search the whole tile range as given; by default the template search measures "
+        "the texture's structure scale (autocorrelation) and prefers tiles that hold three "
+        "structures per side, and warns when the range cannot",
+    )
+    p.add_argument(
         "--flatten",
         action="store_true",
         default=None,
@@ -282,6 +291,7 @@ _FIELDS = {
     "overlap": "overlap",
     "joint_weight": "joint_weight",
     "detail_weight": "detail_weight",
+    "whole_structures": "whole_structures",
     "candidates": "candidates",
     "seed": "seed",
     "patch_size": "patch_size",
@@ -439,11 +449,20 @@ def _run(args, settings: TilesetSettings, rect) -> int:
         f"seamless tile {result.rect[2]}x{result.rect[3]} (overlap {result.overlap}): seam "
         f"criterion h {st.criterion['horizontal']:.2f} v {st.criterion['vertical']:.2f}"
     )
+    if result.scale is not None:
+        sc = result.scale
+        kind = ["period" if p else "size" for p in sc.periodic]
+        say(
+            f"structure scale: {sc.height:.0f} px tall ({kind[0]}), {sc.width:.0f} px wide "
+            f"({kind[1]}); tile {result.rect[2]}x{result.rect[3]} holds "
+            f"{result.rect[3] / max(sc.height, 1):.1f} x {result.rect[2] / max(sc.width, 1):.1f}"
+        )
     quality = _quality_summary(S, result, say)
 
     def write(tmp: Path) -> dict:
         manifest = write_files(tmp, result, depth)
         manifest["quality"] = quality
+        manifest["scale"] = None if result.scale is None else result.scale.to_dict()
         manifest["warnings"] = manifest["warnings"] + quality["warnings"]
         manifest.update(
             settings=settings.to_dict(),

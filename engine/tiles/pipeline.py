@@ -23,6 +23,7 @@ from engine.tiles.candidates import (
     iter_candidates,
 )
 from engine.tiles.layout import assemble_maps, random_layout
+from engine.tiles.scale import Scale
 from engine.tiles.seamless import MAIN, SeamlessTile, iter_make_seamless
 from engine.tiles.template import default_overlap, iter_find_template, template_cost
 
@@ -45,7 +46,9 @@ class TilesetResult:
     (:func:`resolve`); ``rect``/``overlap``/``cost`` the template rectangle
     (x, y, w, h), w_T and its search criterion; ``picks`` the candidate indices the preview
     uses, ``layout`` its index matrix over ``picks`` (``cells``: the same over candidate
-    indices) and ``preview`` the assembled image per map (``"main"``: the source's).
+    indices) and ``preview`` the assembled image per map (``"main"``: the source's);
+    ``scale`` the texture's structure scale the template search measured (None: a fixed
+    ``rect`` or ``whole_structures`` off).
     """
 
     settings: TilesetSettings
@@ -58,6 +61,7 @@ class TilesetResult:
     layout: np.ndarray
     preview: dict[str, np.ndarray]
     warnings: tuple[str, ...] = field(default=())
+    scale: Scale | None = None
 
     @property
     def cells(self) -> np.ndarray:
@@ -146,6 +150,7 @@ def working_source(source, settings: TilesetSettings):
 def _iter_tileset(source, s, rect, maps, weights, excluded, picks, workers, cancel):
     H, W = np.shape(source)[:2]
     notes: list[str] = []
+    scale = None
     source = working_source(source, s)
     if rect is not None:
         overlap = s.overlap or default_overlap((rect[3], rect[2]))
@@ -167,9 +172,10 @@ def _iter_tileset(source, s, rect, maps, weights, excluded, picks, workers, canc
             excluded=excluded,
             joint_weight=s.joint_weight,
             detail_weight=s.detail_weight,
+            whole_structures=s.whole_structures,
             cancel=cancel,
         )
-        rect, overlap, cost = found.rect, found.overlap, found.cost
+        rect, overlap, cost, scale = found.rect, found.overlap, found.cost, found.scale
         notes += list(found.warnings)
     resolved = resolve(s, (H, W), overlap=overlap)
     seamless = yield from iter_make_seamless(
@@ -234,6 +240,7 @@ def _iter_tileset(source, s, rect, maps, weights, excluded, picks, workers, canc
         layout=ids,
         preview=preview,
         warnings=tuple(notes),
+        scale=scale,
     )
 
 

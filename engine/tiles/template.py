@@ -25,6 +25,7 @@ samples by ``benchmarks/tileset.py --joint-weights``; 0 gives the paper's criter
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import numbers
 import time
@@ -40,6 +41,7 @@ from engine.cancel import Cancelled, is_cancelled
 from engine.errormap import colour_channels
 from engine.events import Item, Progress, Snapshot, drain, frozen_array
 from engine.tiles.detail import DETAIL_WEIGHT, DetailTerm, check_detail_weight
+from engine.tiles.scale import Scale, structure_scale, whole_structure_range
 from engine.tiles.stationarity import check_stationarity
 from engine.tiles.template_scan import (
     Scan,
@@ -125,6 +127,9 @@ class Template:
         NaN when the search ran without the detail term).
     detail_weight : float
         κ used by the search (0: no detail term).
+    scale : Scale or None
+        The texture's structure scale (:mod:`engine.tiles.scale`) the search measured (None:
+        not measured, ``whole_structures=False``).
     """
 
     rect: tuple[int, int, int, int]
@@ -138,6 +143,7 @@ class Template:
     joint_weight: float = 0.0
     detail: float = math.nan
     detail_weight: float = 0.0
+    scale: Scale | None = None
 
     @property
     def footprint(self) -> tuple[int, int, int, int]:
@@ -323,6 +329,7 @@ def iter_find_template(
     joint_weight: float = JOINT_WEIGHT,
     detail_weight: float = DETAIL_WEIGHT,
     sweep: int = 0,
+    whole_structures: bool = True,
     cancel=None,
 ):
     """Search the tile rectangle; returns a generator of events whose value is a Template.
@@ -360,6 +367,11 @@ def iter_find_template(
         every :data:`SWEEP_INTERVAL` seconds (no display redraws faster, and the sampling costs
         the search little); at the end of each phase one more with the phase's own best. For
         drawing the search (the editor draws them faintly); how many arrive depends on timing.
+    whole_structures : bool
+        Measure the texture's structure scale (:func:`engine.tiles.scale.structure_scale`) and
+        search only tiles that hold :data:`~engine.tiles.scale.STRUCTURES_PER_TILE` structures
+        per side where the range allows (its smallest tile raised per axis), warning in words
+        when the largest tile cannot (issue 10, item 6). False: the range as given.
     cancel : CancelToken or None
         Once a first rectangle exists the search returns the best so far; before that it
         raises :class:`engine.cancel.Cancelled`.
@@ -385,6 +397,17 @@ def iter_find_template(
     flat = flat_warning(S)
     if flat:
         notes.append(flat)
+    scale = None
+    if whole_structures and not flat:
+        scale = structure_scale(S)
+        whole, hi, too_small = whole_structure_range(scale, lo, hi)
+        notes += too_small
+        if valid is None:
+            lo = whole
+        elif whole != lo:  # with an exclusion, only when such a tile still fits outside it
+            run_w = _feasible_run0(valid, whole[0] + overlap)
+            if run_w.max(initial=0) >= whole[1] + overlap:
+                lo, run0 = whole, run_w
     for n in notes:
         warnings.warn(n, stacklevel=2)
     if coarse is not None:
@@ -406,6 +429,7 @@ def iter_find_template(
         lam,
         sweep,
         kappa,
+        scale,
     )
 
 
@@ -452,6 +476,7 @@ def _iter_find_template(
     lam=JOINT_WEIGHT,
     sweep=0,
     kappa=DETAIL_WEIGHT,
+    scale=None,
 ):
     H, W = S.shape[:2]
     term = DetailTerm.of(S, kappa)
@@ -528,7 +553,7 @@ def _iter_find_template(
             "no tile rectangle fits the source outside the excluded region for this tile range"
         )
     yield Progress(prog["total"], prog["total"], "template: done")
-    return best
+    return best if scale is None else dataclasses.replace(best, scale=scale)
 
 
 def _phases(
