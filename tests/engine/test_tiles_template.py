@@ -309,7 +309,8 @@ def test_default_overlap_is_a_tenth_of_the_tile():
     assert default_overlap(40, 400) == 20  # 22 would not fit twice in the smallest tile
     assert find_template(periodic(shape=(120, 130)), tile_min=8, tile_max=88).overlap == 4
     with warnings.catch_warnings():
-        warnings.simplefilter("error")
+        warnings.simplefilter("error")  # (that tiles of 20..30 hold under three periods: said)
+        warnings.filterwarnings("ignore", message="the texture repeats about every")
         t = find_template(periodic(), tile_min=20, tile_max=30)
     assert t.overlap == 2 or t.overlap == default_overlap(20, 30)
 

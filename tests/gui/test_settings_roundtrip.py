@@ -50,6 +50,7 @@ FLAGS = {
     "--patch-search": "local",  # the editor has no control for these three yet: they are
     "--min-distance": "7",  # kept with the project and used as they are
     "--flatten": None,
+    "--cut-structures": None,
 }
 
 
@@ -202,6 +203,7 @@ EVERY_FIELD = TilesetSettings(
     overlap=12,
     joint_weight=1.5,
     detail_weight=0.5,
+    whole_structures=False,
     seam=SeamSpec("oscillating", {"o_max": 5}, metric="lab", blend="feather", width=6, rho=5),
     template_blend="adaptive",
     candidates=4,
