@@ -23,11 +23,11 @@ best few estimates are re-ranked by the exact SSD (:func:`ssd_at`).
 from __future__ import annotations
 
 import numpy as np
-import scipy.fft as sfft
 
 from engine import _jit as jit
 from engine._jit import njit
 from engine._validate import as_image, as_rng, positive_int
+from engine.fft import next_fast_len, transforms
 
 __all__ = [
     "ZERO_ERROR_FRACTION",
@@ -66,17 +66,20 @@ class SampleSpectrum:
         channel.
     workers : int
         ``workers=`` passed to :mod:`scipy.fft`.
+    backend : {"scipy", "numpy"}
+        Where the transforms come from (:mod:`engine.fft`): numpy's spare a small run the
+        import of scipy.fft; they round differently in the last bits.
     """
 
-    def __init__(self, sample: np.ndarray, *, groups=None, workers: int = 1):
-        self._setup(sample, groups, workers)
+    def __init__(self, sample: np.ndarray, *, groups=None, workers: int = 1, backend="scipy"):
+        self._setup(sample, groups, workers, backend)
         chans = np.moveaxis(self.sample, 2, 0)
         sq = np.stack([np.sum(chans[list(g)] ** 2, axis=0) for g in self.groups])
         self._fs = self._forward(chans)
         self._fsq = self._forward(sq)
         self._wcache: dict = {}
 
-    def _setup(self, sample, groups, workers) -> None:
+    def _setup(self, sample, groups, workers, backend) -> None:
         s = np.ascontiguousarray(np.asarray(sample, dtype=np.float32))
         if s.ndim != 3:
             raise ValueError(f"sample must be (H, W, C), got shape {s.shape}")
@@ -91,7 +94,9 @@ class SampleSpectrum:
         for gi, g in enumerate(self.groups):
             self.group_of[list(g)] = gi
         self.workers = int(workers)
-        self.padded = (sfft.next_fast_len(h, real=True), sfft.next_fast_len(w, real=True))
+        self.backend = backend
+        self.fft = transforms(backend)
+        self.padded = (next_fast_len(h), next_fast_len(w))
 
     @property
     def nbytes(self) -> int:
@@ -102,16 +107,16 @@ class SampleSpectrum:
         """2-D real FFT of kernels (..., kh, kw) zero-padded to ``padded``; pruned row pass."""
         hp, wp = self.padded
         wk = self.workers if workers is None else workers
-        r = sfft.rfft(k, n=wp, axis=-1, workers=wk)
-        return sfft.fft(r, n=hp, axis=-2, workers=wk)
+        r = self.fft.rfft(k, n=wp, axis=-1, workers=wk)
+        return self.fft.fft(r, n=hp, axis=-2, workers=wk)
 
     def _inverse(
         self, x: np.ndarray, rows: int, cols: int, workers: int | None = None
     ) -> np.ndarray:
         hp, wp = self.padded
         wk = self.workers if workers is None else workers
-        y = sfft.ifft(x, axis=-2, workers=wk)[..., :rows, :]
-        return sfft.irfft(y, n=wp, axis=-1, workers=wk)[..., :cols]
+        y = self.fft.ifft(x, axis=-2, workers=wk)[..., :rows, :]
+        return self.fft.irfft(y, n=wp, axis=-1, workers=wk)[..., :cols]
 
     def correlate(self, kernels: np.ndarray) -> np.ndarray:
         """``Σ_c corr(S_c, K_c)`` at every valid position for a batch of kernels (n, C, kh, kw)."""
@@ -203,7 +208,7 @@ class TiledSpectrum(SampleSpectrum):
     """
 
     def __init__(self, sample: np.ndarray, *, groups=None, workers: int = 1, tile: int = 1024):
-        self._setup(sample, groups, workers)
+        self._setup(sample, groups, workers, "scipy")
         self.tile = positive_int(tile, "tile")
 
     @property

@@ -119,7 +119,7 @@ class Quilter:
         stack, groups = self.search_sample()
         if self.plan.search == "tiled fft":
             return TiledSpectrum(stack, groups=groups, workers=self.threads, tile=TILE)
-        return SampleSpectrum(stack, groups=groups, workers=self.threads)
+        return SampleSpectrum(stack, groups=groups, workers=self.threads, backend=self.plan.fft)
 
     def make_pyramid(self) -> PyramidSearch:
         stack, groups = self.search_sample()

@@ -22,16 +22,17 @@ import time
 from dataclasses import dataclass, replace
 
 import numpy as np
-import scipy.fft as sfft
 
 from engine.budget import check_memory, format_bytes
 from engine.events import Item
+from engine.fft import next_fast_len
 from engine.matching import WEIGHT_CACHE_BYTES
 from engine.pyramid import CHILDREN, SEED_NEIGHBOURS, pyramid_levels
 from engine.quilting.layout import grid_rects
 
 __all__ = [
     "AUTO_EXACT_SECONDS",
+    "NUMPY_FFT_WORK",
     "SEARCH_BUDGET",
     "Estimated",
     "Plan",
@@ -68,6 +69,10 @@ SEAM_COST = {"dijkstra": 8.0, "minimax": 12.0, "oscillating": 3.0, "oscillating-
 BASE_BYTES = 2 * 2**20
 #: speed-up of the block pool on 2 threads (GIL-bound glue between the FFTs and kernels)
 THREAD_GAIN = 1.6
+NUMPY_FFT_WORK = 2000 * 128 * 128
+"""Blocks x padded sample pixels up to which an exact dp quilting search that needs nothing
+else of scipy takes numpy's transforms (:mod:`engine.fft`): their extra time (~0.1 ms a block
+of a 128² sample) stays under the ~0.25 s the import of scipy.fft costs a whole process."""
 
 
 @dataclass(frozen=True)
@@ -89,6 +94,8 @@ class Plan:
         Estimated wall time on this machine now.
     peak_bytes : int
         Estimated peak of the memory the run allocates (the caller's sample not counted).
+    fft : {"scipy", "numpy"}
+        Where an exact search's transforms come from (:data:`NUMPY_FFT_WORK`).
     """
 
     mode: str
@@ -97,6 +104,7 @@ class Plan:
     blocks: int
     seconds: float
     peak_bytes: int
+    fft: str = "scipy"
 
     def describe(self) -> str:
         """One line for a status bar or a terminal."""
@@ -152,6 +160,8 @@ def machine_factor() -> float:
     now = time.monotonic()
     if _factor_cache and now - _factor_cache[0][0] < 30:
         return _factor_cache[0][1]
+    import scipy.fft as sfft
+
     a = np.random.default_rng(0).random((4, 256, 256), dtype=np.float32)
     times = []
     for _ in range(5):
@@ -164,7 +174,7 @@ def machine_factor() -> float:
 
 
 def _fft_shape(h: int, w: int) -> tuple[int, int]:
-    return sfft.next_fast_len(h, real=True), sfft.next_fast_len(w, real=True)
+    return next_fast_len(h), next_fast_len(w)
 
 
 def _fft_query_seconds(shape, channels: int) -> float:
@@ -283,4 +293,15 @@ def plan(
             as_exact.seconds <= AUTO_EXACT_SECONDS or as_exact.seconds <= as_fast.seconds
         )
         chosen = as_exact if cheap else as_fast
+    hp, wp = _fft_shape(H, W)
+    if (
+        chosen.search == "fft"
+        and terms == "overlap"
+        and seam.method in ("dp", "straight")
+        and seam.blend == "none"
+        and n_blocks * hp * wp <= NUMPY_FFT_WORK
+    ):
+        # a small run that needs nothing else of scipy: shown at the development machine's
+        # speed (timing the reference transform would cost it more than it tells)
+        return replace(chosen, fft="numpy")
     return replace(chosen, seconds=chosen.seconds * machine_factor())
