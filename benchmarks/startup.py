@@ -10,6 +10,11 @@ time (the targets) and CPU time (user + system of all threads, steadier under lo
   overlap 6, best match, dp) — target <= 1.2 s, from process start to the file written;
 * the editor, from process start until its window is shown (offscreen), no target.
 
+The processes run as on a user's machine: Python caches the bytecode of what it imports (the
+warm-up run writes it), even where the calling shell sets ``PYTHONDONTWRITEBYTECODE`` (the
+agents' shells here do: every process would then compile the engine's sources again, ~0.07 s
+of job A); ``--no-bytecode`` measures that way instead.
+
 The table is printed and saved to ``benchmarks/results/startup.txt``.
 """
 
@@ -57,7 +62,7 @@ def _run(cmd: list[str], env: dict) -> tuple[float, float]:
     return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
 
 
-def measure(repeats: int) -> dict[str, tuple[float, float]]:
+def measure(repeats: int, bytecode: bool = True) -> dict[str, tuple[float, float]]:
     """Median whole-process (wall, CPU) seconds of each command (runs interleaved)."""
     from benchmarks.quilting import load_sample
     from engine.io import save_image
@@ -66,6 +71,10 @@ def measure(repeats: int) -> dict[str, tuple[float, float]]:
     crop = tmp / "crop128.png"
     save_image(crop, load_sample("cobblestones", 128))
     env = {**os.environ, "QT_QPA_PLATFORM": "offscreen", "XDG_CONFIG_HOME": str(tmp / "cfg")}
+    if bytecode:
+        env.pop("PYTHONDONTWRITEBYTECODE", None)
+    else:
+        env["PYTHONDONTWRITEBYTECODE"] = "1"
     exe = [sys.executable, "-m", "quilt_gui"]
     synth = [*exe, "synth", str(crop), "--size", "512x512", "--block", "32", "--overlap", "6"]
     synth += ["--select", "best", "--seam", "dp", "--seed", "1", "-o", str(tmp / "out.png")]
@@ -90,11 +99,19 @@ def measure(repeats: int) -> dict[str, tuple[float, float]]:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=7, help="processes per command (median)")
+    ap.add_argument(
+        "--no-bytecode",
+        dest="bytecode",
+        action="store_false",
+        help="every process compiles the sources it imports (PYTHONDONTWRITEBYTECODE=1)",
+    )
     args = ap.parse_args(argv)
     sys.path.insert(0, str(ROOT))
     from benchmarks._util import format_table, provenance
 
-    med = measure(args.repeats)
+    first = provenance()
+    med = measure(args.repeats, args.bytecode)
+    load = ", ".join(f"{v:.1f}" for v in os.getloadavg())
     ref, ref_cpu = med['python -c "import numpy"']
     rows = [
         [name, f"{t:.3f}", f"{t / ref:.2f}x", f"{cpu:.3f}", f"{cpu / ref_cpu:.2f}x"]
@@ -111,9 +128,11 @@ def main(argv=None) -> int:
     ok_synth = med["quilt-studio synth (job A)"][0] <= SYNTH_S
     text = "\n".join(
         [
-            provenance(),
-            f"python -m benchmarks.startup --repeats {args.repeats} (whole processes, medians, "
-            "interleaved)",
+            first + f" (at the end: {load})",
+            f"python -m benchmarks.startup --repeats {args.repeats}"
+            + ("" if args.bytecode else " --no-bytecode")
+            + " (whole processes, medians, interleaved; bytecode "
+            + ("cached as a user's Python does)" if args.bytecode else "compiled every time)"),
             "",
             format_table(
                 ["command", "wall s", "vs import numpy", "CPU s", "CPU vs numpy's", "target"],
