@@ -18,7 +18,7 @@ __all__ = [
     "NUMBA_BLOCKS",
     "SMALL_CUT_PIXELS",
     "dp_l_cut",
-    "dp_meeting",
+    "dp_l_cuts",
     "dp_to_bottom",
     "old_side_of_barrier",
     "trace_down",
@@ -78,55 +78,63 @@ def trace_down(step: np.ndarray, r: int, c: int) -> np.ndarray:
     return np.array(cols, np.intp)
 
 
-def dp_meeting(e: np.ndarray, ovl: int, ovt: int):
-    """Where the dp arms of an L-cut join (first row-major corner pixel of least
-    ``E_v + E_h - e``) and the step tables of the left strip and of the transposed top strip.
+def dp_l_cuts(errors: np.ndarray, ovl: int, ovt: int) -> list[tuple]:
+    """:func:`dp_l_cut` of a stack of equally shaped float64 maps (n, bh, bw) at once: the row
+    by row sums and the flood fills run once for the whole stack (a batch of quilting blocks).
 
-    Both arms run through one :func:`dp_to_bottom` call, stacked: the shorter one padded with
-    rows above it and both with ``inf`` columns on the right, which no path ever takes."""
-    bh, bw = e.shape
+    Each map's two arms are stacked for one :func:`dp_to_bottom` pass: the left strip and the
+    transposed top strip, the shorter one padded with rows above it and both with ``inf``
+    columns on the right, which no path ever takes. Returns one (path, old side, qr, qc) per
+    map."""
+    nb, bh, bw = errors.shape
     n, m = max(bh, bw), max(ovl, ovt)
-    arms = np.full((2, n, m), np.inf)
-    arms[0, n - bh :, :ovl] = e[:, :ovl]
-    arms[1, n - bw :, :ovt] = e[:ovt].T
+    arms = np.full((nb, 2, n, m), np.inf)
+    arms[:, 0, n - bh :, :ovl] = errors[:, :, :ovl]
+    arms[:, 1, n - bw :, :ovt] = errors[:, :ovt].transpose(0, 2, 1)
     cost, step = dp_to_bottom(arms)
-    v_cost, v_step = cost[0, n - bh :, :ovl], step[0, n - bh :, :ovl]
-    h_cost, h_step = cost[1, n - bw :, :ovt], step[1, n - bw :, :ovt]
-    joint = v_cost[:ovt] + h_cost[:ovl].T - e[:ovt, :ovl]
-    qr, qc = divmod(int(np.argmin(joint)), ovl)
-    return qr, qc, v_step, h_step
+    v_cost, v_step = cost[:, 0, n - bh :, :ovl], step[:, 0, n - bh :, :ovl]
+    h_cost, h_step = cost[:, 1, n - bw :, :ovt], step[:, 1, n - bw :, :ovt]
+    # where the arms join: the first (row-major) corner pixel of least E_v + E_h - e
+    joint = v_cost[:, :ovt] + h_cost[:, :ovl].transpose(0, 2, 1) - errors[:, :ovt, :ovl]
+    meets = np.argmin(joint.reshape(nb, -1), axis=1)
+    barriers = np.zeros((nb, bh, bw), bool)
+    paths, corners = [], []
+    for b in range(nb):
+        qr, qc = divmod(int(meets[b]), ovl)
+        down = trace_down(v_step[b], qr, qc)  # columns of rows qr .. bh - 1
+        right = trace_down(h_step[b], qc, qr)  # rows of columns qc .. bw - 1
+        # up the left arm to q, then right along the top arm, each pixel once (first visit)
+        rows = np.concatenate([np.arange(bh - 1, qr - 1, -1), right])
+        cols = np.concatenate([down[::-1], np.arange(qc, bw)])
+        flat = rows * bw + cols
+        _, first = np.unique(flat, return_index=True)
+        first.sort()
+        paths.append(np.column_stack([rows[first], cols[first]]).astype(np.intp))
+        corners.append((qr, qc))
+        barriers[b].flat[flat] = True
+    olds = old_side_of_barrier(barriers, True, True)
+    return [(p, o, qr, qc) for p, o, (qr, qc) in zip(paths, olds, corners, strict=True)]
 
 
 def dp_l_cut(e: np.ndarray, ovl: int, ovt: int):
-    """The dp L-cut of an (bh, bw) error map with both arms: path, old side, meeting point
-    (as ``engine.stitch._dp_l_cut``: up the left arm to q, then right along the top arm, each
-    pixel once, first visit kept)."""
-    bh, bw = e.shape
-    qr, qc, v_step, h_step = dp_meeting(e, ovl, ovt)
-    down = trace_down(v_step, qr, qc)  # columns of rows qr .. bh - 1
-    right = trace_down(h_step, qc, qr)  # rows of columns qc .. bw - 1
-    rows = np.concatenate([np.arange(bh - 1, qr - 1, -1), right])
-    cols = np.concatenate([down[::-1], np.arange(qc, bw)])
-    flat = rows * bw + cols
-    _, first = np.unique(flat, return_index=True)
-    first.sort()
-    path = np.column_stack([rows[first], cols[first]]).astype(np.intp)
-    barrier = np.zeros((bh, bw), bool)
-    barrier.flat[flat] = True
-    return path, old_side_of_barrier(barrier, True, True), qr, qc
+    """The dp L-cut of an (bh, bw) float64 error map with both arms: path, old side, meeting
+    point (as ``engine.stitch._dp_l_cut``: up the left arm to the corner pixel q of least
+    ``E_v(q) + E_h(q) - e(q)``, then right along the top arm, each pixel once)."""
+    return dp_l_cuts(e[None], ovl, ovt)[0]
 
 
 def _fill(free: np.ndarray, seeds: np.ndarray) -> np.ndarray:
-    """Every pixel of ``free`` 4-connected to ``seeds`` within ``free`` (a flood fill by whole
-    runs: a row sweep, then a column sweep, until neither adds a pixel)."""
-    h, w = free.shape
+    """Every pixel of ``free`` (..., h, w) 4-connected to ``seeds`` within ``free``, per map (a
+    flood fill by whole runs: a row sweep, then a column sweep, until neither adds a pixel)."""
+    *lead, h, w = free.shape
+    k = int(np.prod(lead, dtype=np.int64))
     wall = ~free
-    row_run = np.cumsum(wall, axis=1) + (w + 1) * np.arange(h)[:, None]
-    col_run = np.cumsum(wall, axis=0) + (h + 1) * np.arange(w)[None, :]
+    row_run = np.cumsum(wall, axis=-1) + (w + 1) * np.arange(k * h).reshape(*lead, h, 1)
+    col_run = np.cumsum(wall, axis=-2) + (h + 1) * np.arange(k * w).reshape(*lead, 1, w)
     region = seeds & free
     n = int(region.sum())
     while True:
-        for run, size in ((row_run, h * (w + 1) + 1), (col_run, w * (h + 1) + 1)):
+        for run, size in ((row_run, k * h * (w + 1)), (col_run, k * w * (h + 1))):
             hit = np.zeros(size, bool)
             hit[run[region]] = True
             region = hit[run] & free
@@ -137,20 +145,18 @@ def _fill(free: np.ndarray, seeds: np.ndarray) -> np.ndarray:
 
 
 def old_side_of_barrier(barrier: np.ndarray, seed_left: bool, seed_top: bool) -> np.ndarray:
-    """Old region of a cut given as a barrier (h, w) bool (as
-    ``engine.stitch._old_side_of_barrier``): the barrier, every pixel 4-connected to the left
-    (``seed_left``) or top (``seed_top``) edge without crossing it, and every pocket of the rest
-    not 4-connected to the block's border."""
-    h, w = barrier.shape
-    edge = np.zeros((h, w), bool)
+    """Old region of a cut given as a barrier (h, w) bool, or of a stack of them (..., h, w)
+    (as ``engine.stitch._old_side_of_barrier``): the barrier, every pixel 4-connected to the
+    left (``seed_left``) or top (``seed_top``) edge without crossing it, and every pocket of the
+    rest not 4-connected to the block's border."""
+    edge = np.zeros(barrier.shape, bool)
     if seed_left:
-        edge[:, 0] = True
+        edge[..., :, 0] = True
     if seed_top:
-        edge[0, :] = True
+        edge[..., 0, :] = True
     free = ~barrier
     old = _fill(free, edge)
-    border = np.zeros((h, w), bool)
-    border[[0, -1], :] = True
-    border[:, [0, -1]] = True
-    rest = free & ~old
-    return ~_fill(rest, border)
+    border = np.zeros(barrier.shape, bool)
+    border[..., [0, -1], :] = True
+    border[..., :, [0, -1]] = True
+    return ~_fill(free & ~old, border)

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from engine import _jit as jit
 from engine.cancel import check
 from engine.errormap import colour_channels, error_map_of
 from engine.exclusion import valid_anchors
@@ -27,10 +28,11 @@ from engine.matching import (
     ssd_at,
 )
 from engine.pyramid import PyramidSearch
-from engine.quilting.cut import blend_alpha, cut_overlap, straight_alpha
+from engine.quilting.cut import Cut, blend_alpha, cut_overlap, straight_alpha
 from engine.quilting.estimate import TILE, Plan
 from engine.quilting.layout import arms_of, canvas_index
 from engine.quilting.records import EMPTY_PATH, BlockRecord, read_only
+from engine.stitch_numpy import SMALL_CUT_PIXELS, dp_l_cuts
 
 __all__ = ["BlockWork", "Quilter"]
 
@@ -103,10 +105,42 @@ class Quilter:
         for wk in works:
             self.load(wk)
         self.search(works)
+        self.precut(works)
         out = []
         for wk in works:
             out.extend(self.place(wk))
         return out
+
+    def precut(self, works: list[BlockWork]) -> None:
+        """A small job without numba: choose the batch's blocks and cut their L-shaped dp
+        overlaps in one numpy pass (:func:`engine.stitch_numpy.dp_l_cuts`, the same cuts as one
+        by one); :meth:`place` and :meth:`paste` take them from ``extra``."""
+        if jit.loaded() or self.seam.method != "dp" or self.adaptive_threshold is not None:
+            return
+        groups: dict[tuple, list[BlockWork]] = {}
+        for wk in works:
+            t, left, b, r = wk.arms
+            if wk.old is None or not (t and left) or b or r or wk.h * wk.w > SMALL_CUT_PIXELS:
+                continue
+            wk.extra["choice"] = choice = self.choose(wk)
+            (ay, ax) = choice[0]
+            err = error_map_of(
+                wk.old,
+                colour_channels(self.sample[ay : ay + wk.h, ax : ax + wk.w]),
+                self.seam.metric,
+            )
+            err[~wk.filled] = 0
+            wk.extra["err"] = err
+            if err.any():
+                groups.setdefault((wk.h, wk.w, left, t), []).append(wk)
+        for (_, _, left, t), group in groups.items():
+            if len(group) < 2:
+                continue  # one block: the general path
+            errs = np.stack([wk.extra["err"] for wk in group]).astype(np.float64)
+            cuts = dp_l_cuts(errs, left, t)
+            for wk, e, (path, keep, _, _) in zip(group, errs, cuts, strict=True):
+                values = e[path[:, 0], path[:, 1]]  # as l_cut scores its path
+                wk.extra["cut"] = Cut(keep, path, float(values.sum()), float(values.max()))
 
     # ---------------------------------------------------------------- sample helpers
     @property
@@ -311,7 +345,7 @@ class Quilter:
     def place(self, wk: BlockWork) -> list[tuple[BlockRecord, np.ndarray]]:
         """Choose, cut and paste one block (or its four children); returns its records."""
         check(self.cancel)
-        anchor, e_match, e_min, n = self.choose(wk)
+        anchor, e_match, e_min, n = wk.extra.pop("choice", None) or self.choose(wk)
         if self.should_split(wk, e_min):
             out = []
             ch, cw = self.child_size(wk.h), self.child_size(wk.w)
@@ -335,8 +369,10 @@ class Quilter:
         else:
             old_full = self.canvas[self.idx(wk.y, wk.x, h, w)]
             overlap = wk.filled
-            err = error_map_of(wk.old, colour_channels(new), self.seam.metric)
-            err[~overlap] = 0
+            err = wk.extra.pop("err", None)
+            if err is None:
+                err = error_map_of(wk.old, colour_channels(new), self.seam.metric)
+                err[~overlap] = 0
             if not self.seam.cuts:
                 keep = np.zeros((h, w), dtype=bool)
                 alpha = straight_alpha(wk.arms, (h, w), self.seam.blend)
@@ -345,7 +381,9 @@ class Quilter:
                 # every cut gives the same pixels, so none is searched
                 keep, crit, peak, alpha = overlap.copy(), 0.0, 0.0, None
             else:
-                cut = cut_overlap(err, wk.arms, seam=self.seam, cancel=self.cancel)
+                cut = wk.extra.pop("cut", None) or cut_overlap(
+                    err, wk.arms, seam=self.seam, cancel=self.cancel
+                )
                 keep, path, crit, peak = cut.keep_old, read_only(cut.path), cut.criterion, cut.peak
                 keep &= overlap
                 alpha = None

@@ -56,6 +56,16 @@ def test_the_dp_l_cut_is_the_kernels(e, data):
     assert np.array_equal(mask, k_mask)
 
 
+def test_a_stack_of_l_cuts_is_each_maps_own():
+    rng = np.random.default_rng(4)
+    for bh, bw, ovl, ovt in ((32, 32, 6, 6), (32, 18, 6, 6), (12, 30, 3, 5), (9, 9, 9, 1)):
+        e = rng.integers(0, 3, (5, bh, bw)) * 1.0
+        e[1:3] = rng.random((2, bh, bw))
+        for got, m in zip(stitch_numpy.dp_l_cuts(e, ovl, ovt), e, strict=True):
+            want = stitch._dp_l_cut(m, ovl, ovt)
+            assert all(np.array_equal(g, w) for g, w in zip(got, want, strict=True))
+
+
 @FAST
 @given(st.tuples(st.integers(1, 12), st.integers(1, 12)), st.data())
 def test_the_old_side_of_any_barrier_is_the_kernels(shape, data):
@@ -119,6 +129,8 @@ def test_the_numpy_selection_is_the_kernels(errors, tolerance, zero_level):
 
 
 def test_a_small_quilt_is_the_same_with_and_without_numba(monkeypatch):
+    """Without numba the blocks of a batch are cut together (Quilter.precut); with it, one by
+    one by the kernels: the same image and records."""
     from engine.quilting import quilt
 
     s = np.random.default_rng(2).random((48, 48, 3), dtype=np.float32)
@@ -127,3 +139,7 @@ def test_a_small_quilt_is_the_same_with_and_without_numba(monkeypatch):
     assert np.array_equal(runs[0].image, runs[1].image)
     for a, b in zip(runs[0].blocks, runs[1].blocks, strict=True):
         assert np.array_equal(a.path, b.path) and a.source == b.source
+        same = [a.criterion, a.peak, a.match_error, a.candidates]
+        assert np.array_equal(same, [b.criterion, b.peak, b.match_error, b.candidates], True)
+        for x, y in ((a.keep_old, b.keep_old), (a.error, b.error)):
+            assert (x is None and y is None) or np.array_equal(x, y)
