@@ -402,10 +402,8 @@ REFERENCE_CROPS = 256
 DUPLICATE_LEVEL = 1.0 / 255.0
 #: A pixel "is the template's" when every channel is within this of the template's.
 SHARE_LEVEL = 0.5 / 255.0
-#: Random 8x8 layouts averaged by :func:`lattice` (each with its own crops for the floor): 4
-#: left the figure's seed-to-seed spread at 1-3 dB on non-stationary sources (retina +1.4 with
-#: seed 0, +6.1..+9.1 with seeds 1-7), 16 brings it to about +-0.7 dB
-#: (``benchmarks/metrics_check.py``, the independent implementation, found it).
+#: Random 8x8 layouts averaged by :func:`lattice`, each with its own crops (README: 4 layouts
+#: sharing one set of crops moved retina's figure from +1.4 to +9.1 dB with the seed).
 LATTICE_LAYOUTS = 16
 #: Luminance weights (ITU-R BT.709, as ``skimage.color.rgb2gray``).
 LUMA = (0.2125, 0.7154, 0.0721)
@@ -641,15 +639,12 @@ def _harmonic_spectra(stack, layout) -> tuple[float, float]:
     modulated by ``exp(−iπ (r/h [a>0] + c/w [b>0]))`` (a ∈ {0, R/2}, b ∈ {0, C/2})."""
     R, C = layout.shape
     n, h, w = stack.shape
-    ty = np.arange(R)[:, None]
-    tx = np.arange(C)[None, :]
-    r = np.arange(h)[:, None]
-    c = np.arange(w)[None, :]
+    ty, tx = np.arange(R)[:, None], np.arange(C)[None, :]
+    r, c = np.arange(h)[:, None], np.arange(w)[None, :]
     pairs = [(a, b) for a in (0, 1) for b in (0, 1)]
     weights = np.zeros((4, n), dtype=stack.dtype)
     for k, (a, b) in enumerate(pairs):
         np.add.at(weights[k], layout.ravel(), ((-1.0) ** (ty * a + tx * b)).ravel())
-    # one product for the four sums (in the stack's dtype: no float64 copy of the stack)
     sums = (weights @ stack.reshape(n, h * w)).reshape(4, h, w)
     power = {}
     for k, (a, b) in enumerate(pairs):
@@ -748,9 +743,7 @@ def lattice(
     S = luminance(source)
     vals, floors = [], []
     for i in range(count):
-        # fresh crops for every layout: the floor of one set of crops varies by several dB
-        # from set to set on sources with strong low frequencies (retina, cell: -0.3..10.6 dB
-        # for one layout), so one set would carry its luck into every layout's mean
+        # fresh crops per layout: one set's floor is off by dB on uneven sources
         org = _crop_origins(S.shape, (h, w), k, g)
         ref = np.stack([S[y : y + h, x : x + w] for y, x in org])
         ref[:, ring] = border
