@@ -45,7 +45,7 @@ def dependencies(rects, shape, torus: bool):
             idx = (cy, cx)
         else:  # a footprint wrapping around the torus
             idx = np.ix_(*(np.r_[c] if isinstance(c, slice) else c for c in (cy, cx)))
-        p = [int(v) for v in np.unique(last[idx]) if v >= 0]
+        p = sorted(v for v in set(last[idx].ravel().tolist()) if v >= 0)  # np.unique: 80 us
         preds.append(p)
         levels.append(1 + max((levels[j] for j in p), default=-1))
         last[idx] = k

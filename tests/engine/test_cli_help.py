@@ -66,3 +66,19 @@ def test_the_tables_the_parsers_read_load_without_numpy(module):
     code = f"import sys, json, {module}; print(json.dumps(sorted(sys.modules)))"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert not {m.split(".")[0] for m in json.loads(out.stdout)} & set(HEAVY)
+
+
+def test_a_small_synth_job_loads_neither_numba_nor_scipy(tmp_path):
+    """A small exact dp synthesis (like benchmarks/startup.py's job A) runs on numpy alone:
+    numba's start-up (~0.6 s) and scipy.fft's import (~0.25 s) would be most of its time."""
+    import numpy as np
+
+    from engine.io import save_image
+
+    sample = tmp_path / "s.png"
+    save_image(sample, np.random.default_rng(0).random((64, 64, 3), dtype=np.float32))
+    argv = ["synth", str(sample), "--size", "160x160", "--block", "16", "--overlap", "3"]
+    argv += ["--seed", "1", "-o", str(tmp_path / "out.png")]
+    heavy, _ = _loaded(argv)
+    assert not [m for m in heavy if m.split(".")[0] in ("numba", "scipy")], heavy
+    assert (tmp_path / "out.png").exists()
