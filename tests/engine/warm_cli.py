@@ -31,6 +31,7 @@ from quilt_gui.__main__ import main
 for m in pkgutil.walk_packages(engine.__path__, "engine."):
     if not m.name.startswith("engine.batch") and not m.name.endswith("__main__"):
         importlib.import_module(m.name)
+engine._jit.load()  # numba too: the engine imports it at its first kernel call
 print("ready", flush=True)
 for line in sys.stdin:
     request = json.loads(line)
