@@ -6,7 +6,8 @@ command-line job that calls no kernel (the small-job numpy paths of :mod:`engine
 :mod:`engine.stitch`) should pay neither. ``@njit(...)`` from here registers the function; the
 first call of any registered kernel (or :func:`load`) imports numba, compiles every registered
 kernel lazily as ``numba.njit(...)`` would, and puts the dispatchers in place of the stand-ins
-in the ``engine`` modules, so kernels find each other by their global names as numba needs.
+in the ``engine`` modules, so kernels find each other by their global names as numba needs (a
+stand-in numba still meets, e.g. in a thread racing the swap, is typed as its dispatcher).
 Kernels registered after :func:`load` are dispatchers at once.
 
 :func:`loaded` says whether numba is in use: a caller with an identical numpy path takes it
@@ -79,11 +80,14 @@ def load() -> None:
         if _LOADED:
             return
         import numba
+        from numba.extending import typeof_impl
 
-        swap = {}
+        swap = {id(k): numba.njit(**k.options)(k.py_func) for k in _KERNELS}
+        # a kernel compiled while another thread still sees stand-ins (or one handed a stand-in)
+        # types it as its dispatcher
+        typeof_impl.register(Kernel)(lambda kernel, c: typeof_impl(swap[id(kernel)], c))
         for k in _KERNELS:
-            k.dispatcher = numba.njit(**k.options)(k.py_func)
-            swap[id(k)] = k.dispatcher
+            k.dispatcher = swap[id(k)]
         for name, module in list(sys.modules.items()):
             if module is None or not (name == "engine" or name.startswith("engine.")):
                 continue

@@ -5,7 +5,8 @@ numba (~0.6 s: the import and its first call) than cutting every overlap with th
 function returns exactly what its numba kernel returns (the same float64 sums in the same
 order, the same tie-breaking), so a caller may take either; ``tests/engine/test_stitch_numpy.py``
 checks them against the kernels on random maps. :func:`engine.stitch.l_cut` takes them while
-:func:`engine._jit.loaded` is false and the block is small (:data:`SMALL_CUT_PIXELS`).
+:func:`engine._jit.loaded` is false and the block is small (:data:`SMALL_CUT_PIXELS`), and
+:meth:`engine.quilting.core.Quilter.precut` cuts a batch of blocks in one pass (:func:`dp_l_cuts`).
 """
 
 from __future__ import annotations
