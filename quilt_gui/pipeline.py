@@ -180,12 +180,12 @@ class Pipeline(QObject):
     def _on_template_done(self, template) -> None:
         self.doc.tileset.apply_template_rect(template.rect)
         self.doc.tileset.commit_template_rect(self._template_old_rect)
-        for note in template.warnings:
-            self.message.emit("warning", note)
         x, y, w, h = template.rect
         self.message.emit(
             "info", f"Best tile: {w}x{h} at ({x}, {y}), border cost {template.cost:.4f}"
         )
+        if template.warnings:  # after the info line, so the banner keeps them, all at once
+            self.message.emit("warning", "\n".join(template.warnings))
         self.template_searching.emit(False)
 
     def _on_template_error(self, exc) -> None:

@@ -3,9 +3,10 @@
     xvfb-run -s "-screen 0 1600x1000x24" python tools/screenshots_quality.py
 
 Writes docs/preview_quality.png (cobblestones, the editor's defaults, all candidates picked:
-the figures in one line; it still shows one warning, lattice +1.9 dB above its floor) and
+the figures in one line; it still shows one warning, frame 1.17) and
 docs/preview_warned.png (the evaluation set's procedural bricks under a lighting gradient:
-the frame, ring tone and lattice warnings in words).
+the frame, ring tone and lattice warnings in words) and docs/scale_warning.png (shelves every
+64 px searched with 64 px tiles: the banner says the tile cuts the structures, issue 10 item 6).
 """
 
 from __future__ import annotations
@@ -48,6 +49,17 @@ def main() -> int:
     w.files.open_path(str(path), confirm=False)
     wait_until(idle)
     tile_set("preview_warned.png")
+    path = path.with_name("shelves.png")
+    Image.fromarray(load("shelves")).save(path)
+    w.files.open_path(str(path), confirm=False)
+    wait_until(idle)
+    w.doc.set_params({"tile_size": "64"})
+    w.tabs.setCurrentWidget(w.source_view)
+    w.act_find.trigger()
+    wait_until(idle)
+    app.processEvents()
+    w.grab().save(str(out / "scale_warning.png"))
+    print("wrote", out / "scale_warning.png", w.message_bar.label.text()[:80])
     w.close()
     return 0
 
