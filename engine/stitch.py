@@ -55,6 +55,7 @@ __all__ = [
     "PatchCut",
     "PatchResult",
     "StitchResult",
+    "dp_l_cut_kernel",
     "l_cut",
     "map_points",
     "patch",
@@ -383,6 +384,11 @@ def _dp_l_cut(e, ovl, ovt):  # pragma: no cover - compiled
             path[n, 0], path[n, 1] = r, c
             n += 1
     return path[:n].copy(), _old_side_of_barrier(barrier, True, True), qr, qc
+
+
+dp_l_cut_kernel = _dp_l_cut
+"""The compiled dp L-cut (path, old side, meeting row, meeting col) of a float64 error map with
+both arms, for other kernels to call without the checks of :func:`l_cut` (quilting's)."""
 
 
 def _numpy_cut(e: np.ndarray) -> bool:

@@ -30,7 +30,8 @@ from engine.matching import (
 from engine.pyramid import PyramidSearch
 from engine.quilting.cut import Cut, blend_alpha, cut_overlap, straight_alpha
 from engine.quilting.estimate import TILE, Plan
-from engine.quilting.layout import arms_of, canvas_index
+from engine.quilting.kernels import dp_cut_paste, footprint
+from engine.quilting.layout import canvas_index
 from engine.quilting.records import EMPTY_PATH, BlockRecord, read_only
 from engine.stitch_numpy import SMALL_CUT_PIXELS, dp_l_cuts
 
@@ -51,6 +52,7 @@ class BlockWork:
     old: np.ndarray | None = None
     filled: np.ndarray | None = None
     arms: tuple[int, int, int, int] = (0, 0, 0, 0)
+    count: int = 0  # filled (overlap) pixels
     found: tuple | None = None  # search result: ("map", e) | ("list", anchors, errors) | None
     extra: dict = field(default_factory=dict)  # per-algorithm data (texture transfer)
 
@@ -84,6 +86,9 @@ class Quilter:
         self.origin = None  # (H, W, 2) int32: the sample pixel each canvas pixel came from
         self.fft_workers = 1 if threads > 1 else threads  # the pool already uses every thread
         self.stream = True  # False: no events (the benchmark's streaming-overhead reference)
+        seam = self.seam
+        # the common cut, done by one compiled call per block (same pixels as the general path)
+        self.dp_paste = seam.method == "dp" and seam.blend == "none" and seam.metric == "ssd"
 
     def prepare(self) -> None:
         """Build the structures every search shares (before any thread reads them)."""
@@ -187,7 +192,7 @@ class Quilter:
 
     def zero_level_for(self, wk: BlockWork) -> float:
         """Error below which a candidate counts as an exact copy (see ``tolerance``)."""
-        return self.zero_level(int(wk.filled.sum()))
+        return self.zero_level(wk.count)
 
     def zero_level(self, overlap_pixels: int) -> float:
         return ZERO_ERROR_FRACTION * self.floor * overlap_pixels * self.match_sample.shape[2]
@@ -210,9 +215,10 @@ class Quilter:
 
     def load(self, wk: BlockWork) -> None:
         ix = self.idx(wk.y, wk.x, wk.h, wk.w)
-        wk.filled = self.filled[ix].copy()
-        wk.old = colour_channels(self.canvas[ix]) if wk.filled.any() else None
-        wk.arms = arms_of(wk.filled) if wk.old is not None else (0, 0, 0, 0)
+        wk.filled = np.array(self.filled[ix])
+        wk.count, *arms = footprint(wk.filled)
+        wk.arms = tuple(arms)
+        wk.old = colour_channels(self.canvas[ix]) if wk.count else None
 
     # ---------------------------------------------------------------- search
     def search(self, works: list[BlockWork]) -> None:
@@ -336,7 +342,7 @@ class Quilter:
         child = self.child_size(wk.h), self.child_size(wk.w)
         if min(child) < self.min_block:
             return False
-        per_pixel = e_min / (wk.filled.sum() * self.match_sample.shape[2])
+        per_pixel = e_min / (wk.count * self.match_sample.shape[2])
         return per_pixel > self.adaptive_threshold
 
     def child_size(self, n: int) -> int:
@@ -364,10 +370,24 @@ class Quilter:
         new = self.sample[ay : ay + h, ax : ax + w]
         err = keep = None
         path, crit, peak = EMPTY_PATH, math.nan, math.nan
+        ix = self.idx(wk.y, wk.x, h, w)
         if wk.old is None:
             pixels = new.copy()
+        elif self.dp_paste and wk.arms[0] and wk.arms[1] and not any(wk.arms[2:]):
+            err, keep, path, pixels = dp_cut_paste(
+                wk.old, new, wk.filled, wk.arms[1], wk.arms[0], self.canvas[ix]
+            )
+            crit = peak = 0.0
+            if len(path):
+                values = err[path[:, 0], path[:, 1]].astype(np.float64)
+                crit, peak = float(values.sum()), float(values.max())
+                read_only(path)
+            else:
+                path = EMPTY_PATH
+            read_only(err)
+            read_only(keep)
         else:
-            old_full = self.canvas[self.idx(wk.y, wk.x, h, w)]
+            old_full = self.canvas[ix]
             overlap = wk.filled
             err = wk.extra.pop("err", None)
             if err is None:
@@ -397,7 +417,6 @@ class Quilter:
                 pixels = a * old_full + (1 - a) * new
             read_only(err)
             read_only(keep)
-        ix = self.idx(wk.y, wk.x, h, w)
         self.canvas[ix] = pixels
         self.filled[ix] = True
         if self.origin is not None:
