@@ -118,6 +118,13 @@ class SampleSpectrum:
         y = self.fft.ifft(x, axis=-2, workers=wk)[..., :rows, :]
         return self.fft.irfft(y, n=wp, axis=-1, workers=wk)[..., :cols]
 
+    def _inverse_rows(self, x: np.ndarray, rows: int, workers: int | None = None) -> np.ndarray:
+        """:meth:`_inverse` without dropping the columns past the valid ones (full rows)."""
+        hp, wp = self.padded
+        wk = self.workers if workers is None else workers
+        y = sfft.ifft(x, axis=-2, workers=wk)[..., :rows, :]
+        return sfft.irfft(y, n=wp, axis=-1, workers=wk)
+
     def correlate(self, kernels: np.ndarray) -> np.ndarray:
         """``Σ_c corr(S_c, K_c)`` at every valid position for a batch of kernels (n, C, kh, kw)."""
         k = np.asarray(kernels, dtype=np.float32)
@@ -188,12 +195,10 @@ class SampleSpectrum:
             )
         if bh > h or bw > w:
             raise ValueError(f"block {bw}x{bh} is larger than the sample {w}x{h}")
-        x = _channel_sum(self._forward(k, workers), self._fs)
-        x *= -2
-        x += self._weight_terms(wts, workers)
-        e = self._inverse(x, h - bh + 1, w - bw + 1, workers)
-        e += np.asarray(const, dtype=np.float64).astype(np.float32)[:, None, None]
-        np.maximum(e, 0, out=e)
+        x = _ssd_spectrum(self._forward(k, workers), self._fs, self._weight_terms(wts, workers))
+        y = self._inverse_rows(x, h - bh + 1, workers)
+        e = np.empty((n, h - bh + 1, w - bw + 1), np.float32)
+        _add_clip(y, np.asarray(const, dtype=np.float64).astype(np.float32), e)
         return e
 
 
@@ -243,6 +248,47 @@ def _channel_sum(fk: np.ndarray, fs: np.ndarray) -> np.ndarray:
     for c in range(1, fk.shape[1]):
         x += fk[:, c].conj() * fs[c]
     return x
+
+
+@njit(cache=True, nogil=True)
+def _ssd_spectrum(fk, fs, wt):  # pragma: no cover - compiled
+    """``-2 Σ_c conj(fk[:, c]) · fs[c] + wt`` in one pass: :func:`_channel_sum` of the kernels,
+    times -2, plus the weight terms, with numpy's complex64 arithmetic (its products are
+    fused multiply-adds: ``re = fma(ar, br, -(ai bi))``, ``im = fma(ar, bi, ai br)``, here
+    computed in float64, where the product is exact, and rounded once to float32)."""
+    n, c, hp, wq = fk.shape
+    out = np.empty((n, hp, wq), np.complex64)
+    for i in range(n):
+        for u in range(hp):
+            for v in range(wq):
+                re = np.float32(0)
+                im = np.float32(0)
+                for ch in range(c):
+                    a = fk[i, ch, u, v]
+                    b = fs[ch, u, v]
+                    ar, ai = np.float64(a.real), -np.float64(a.imag)  # conj(a)
+                    br, bi = np.float64(b.real), np.float64(b.imag)
+                    pr = np.float32(ar * br - np.float64(np.float32(ai * bi)))
+                    pi = np.float32(ar * bi + np.float64(np.float32(ai * br)))
+                    if ch == 0:
+                        re, im = pr, pi
+                    else:
+                        re, im = re + pr, im + pi
+                t = wt[i, u, v]
+                out[i, u, v] = complex(re * np.float32(-2) + t.real, im * np.float32(-2) + t.imag)
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _add_clip(y, const, out):  # pragma: no cover - compiled
+    """out[i] = max(y[i, :, :out_w] + const[i], 0) (float32), into a contiguous map."""
+    n, rows, cols = out.shape
+    for i in range(n):
+        c = const[i]
+        for u in range(rows):
+            for v in range(cols):
+                e = y[i, u, v] + c
+                out[i, u, v] = e if e >= 0 or e != e else np.float32(0)
 
 
 def masked_ssd(sample, target, mask, *, threads: int | None = None) -> np.ndarray:
