@@ -195,10 +195,19 @@ class SampleSpectrum:
             )
         if bh > h or bw > w:
             raise ValueError(f"block {bw}x{bh} is larger than the sample {w}x{h}")
+        const = np.asarray(const, dtype=np.float64).astype(np.float32)
+        if not jit.loaded():  # a small job without numba: the same values from numpy
+            x = _channel_sum(self._forward(k, workers), self._fs)
+            x *= -2
+            x += self._weight_terms(wts, workers)
+            e = self._inverse(x, h - bh + 1, w - bw + 1, workers)
+            e += const[:, None, None]
+            np.maximum(e, 0, out=e)
+            return e
         x = _ssd_spectrum(self._forward(k, workers), self._fs, self._weight_terms(wts, workers))
         y = self._inverse_rows(x, h - bh + 1, workers)
         e = np.empty((n, h - bh + 1, w - bw + 1), np.float32)
-        _add_clip(y, np.asarray(const, dtype=np.float64).astype(np.float32), e)
+        _add_clip(y, const, e)
         return e
 
 

@@ -31,7 +31,7 @@ from engine.pyramid import PyramidSearch
 from engine.quilting.cut import Cut, blend_alpha, cut_overlap, straight_alpha
 from engine.quilting.estimate import TILE, Plan
 from engine.quilting.kernels import dp_cut_paste, footprint
-from engine.quilting.layout import canvas_index
+from engine.quilting.layout import arms_of, canvas_index
 from engine.quilting.records import EMPTY_PATH, BlockRecord, read_only
 from engine.stitch_numpy import SMALL_CUT_PIXELS, dp_l_cuts
 
@@ -216,8 +216,12 @@ class Quilter:
     def load(self, wk: BlockWork) -> None:
         ix = self.idx(wk.y, wk.x, wk.h, wk.w)
         wk.filled = np.array(self.filled[ix])
-        wk.count, *arms = footprint(wk.filled)
-        wk.arms = tuple(arms)
+        if jit.loaded():
+            wk.count, *arms = footprint(wk.filled)
+            wk.arms = tuple(arms)
+        else:  # a small job without numba: the same figures from numpy
+            wk.count = int(wk.filled.sum())
+            wk.arms = arms_of(wk.filled) if wk.count else (0, 0, 0, 0)
         wk.old = colour_channels(self.canvas[ix]) if wk.count else None
 
     # ---------------------------------------------------------------- search
@@ -373,7 +377,7 @@ class Quilter:
         ix = self.idx(wk.y, wk.x, h, w)
         if wk.old is None:
             pixels = new.copy()
-        elif self.dp_paste and wk.arms[0] and wk.arms[1] and not any(wk.arms[2:]):
+        elif self.dp_paste and wk.arms[0] and wk.arms[1] and not any(wk.arms[2:]) and jit.loaded():
             err, keep, path, pixels = dp_cut_paste(
                 wk.old, new, wk.filled, wk.arms[1], wk.arms[0], self.canvas[ix]
             )

@@ -6,13 +6,15 @@ of microseconds, so the dozens of numpy calls around it cost as much as the work
 do the steps around the search in one call each, with the same arithmetic as the general path
 (:func:`engine.errormap.error_map_of`, :func:`engine.stitch.l_cut`, :func:`arms_of
 <engine.quilting.layout.arms_of>`): the output is identical whichever path a block takes.
+They are taken only once numba is loaded (:func:`engine._jit.loaded`): a small job without it
+takes the numpy path, as :mod:`engine.stitch_numpy` explains.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from engine._jit import njit
 from engine.stitch import dp_l_cut_kernel
 
 __all__ = ["dp_cut_paste", "footprint"]

@@ -16,8 +16,10 @@ from concurrent.futures import Future, ThreadPoolExecutor
 
 import numpy as np
 
+from engine import _jit as jit
 from engine.cancel import check
 from engine.events import Progress
+from engine.quilting.block_rng import BlockRng
 from engine.quilting.core import BlockWork, Quilter
 from engine.quilting.records import BlockPlaced, BlockRecord
 
@@ -107,9 +109,8 @@ def run_levels(q: Quilter, rects, total_label: str):
     needs = [sorted({batch_of[j] for k in members for j in preds[k]}) for members in batches]
 
     def run(b: int):
-        works = [
-            BlockWork(k, *rects[k], rng=np.random.default_rng([q.seed, k])) for k in batches[b]
-        ]
+        rng = BlockRng if jit.loaded() else _default_rng  # the same generators
+        works = [BlockWork(k, *rects[k], rng=rng(q.seed, k)) for k in batches[b]]
         return q.run_batch(works)
 
     if q.threads > 1 and area >= POOL_MIN_SAMPLE_AREA:
@@ -137,6 +138,10 @@ def run_levels(q: Quilter, rects, total_label: str):
         if placed is not None:
             placed.shutdown()
     return records
+
+
+def _default_rng(seed: int, index: int) -> np.random.Generator:
+    return np.random.default_rng([seed, index])
 
 
 class _DependencyPool:
