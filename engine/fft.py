@@ -9,6 +9,9 @@ what happens to be imported: the same inputs always give the same output.
 
 from __future__ import annotations
 
+import sys
+import threading
+
 import numpy as np
 
 __all__ = ["BACKENDS", "next_fast_len", "transforms"]
@@ -63,43 +66,44 @@ def transforms(backend: str = "scipy"):
     return _scipy()
 
 
-_POCKETFFT = "scipy.fft._pocketfft.pypocketfft"
+_POCKETFFT: list = []  # the extension, once loaded (None: not loadable here)
+_LOCK = threading.Lock()
 
 
 def _scipy():
     """scipy.fft's transforms, from its pocketfft extension loaded by itself when it can be.
 
     Importing :mod:`scipy.fft` costs ~0.25 s (its package loads ``scipy.special``); the compiled
-    extension behind its FFTs loads in a few milliseconds. It is loaded under its own name, so
-    a later ``import scipy.fft`` takes the same module; :class:`_Pocketfft` prepares the
-    arguments as ``scipy.fft`` does: the same results."""
-    import sys
-
-    module = sys.modules.get(_POCKETFFT)
-    if module is None and "scipy.fft" not in sys.modules:
-        module = _load_pocketfft()
-    if module is None:
+    extension behind its FFTs loads in a few milliseconds (privately: no ``scipy`` module is
+    imported, and a later ``import scipy.fft`` loads its own). :class:`_Pocketfft` prepares the
+    arguments as ``scipy.fft`` does: the same results. Once scipy.fft is imported anyway, it is
+    used directly."""
+    if "scipy.fft" in sys.modules:
+        return sys.modules["scipy.fft"]
+    with _LOCK:
+        if not _POCKETFFT:
+            _POCKETFFT.append(_load_pocketfft())
+    if _POCKETFFT[0] is None:
         import scipy.fft
 
         return scipy.fft
-    return _Pocketfft(module)
+    return _Pocketfft(_POCKETFFT[0])
 
 
 def _load_pocketfft():
     import importlib.util
-    import sys
     from pathlib import Path
 
     try:
         spec = importlib.util.find_spec("scipy")
         folder = Path(spec.origin).parent / "fft" / "_pocketfft"
         path = next(folder.glob("pypocketfft.*"))
-        ext = importlib.util.spec_from_file_location(_POCKETFFT, path)
+        ext = importlib.util.spec_from_file_location("pypocketfft", path)
         module = importlib.util.module_from_spec(ext)
         ext.loader.exec_module(module)
     except Exception:  # another scipy layout: import scipy.fft instead
         return None
-    return sys.modules.setdefault(_POCKETFFT, module)
+    return module
 
 
 class _Pocketfft:

@@ -32,7 +32,7 @@ from engine.quilting.layout import grid_rects
 
 __all__ = [
     "AUTO_EXACT_SECONDS",
-    "NUMPY_FFT_WORK",
+    "SMALL_FFT_WORK",
     "SEARCH_BUDGET",
     "Estimated",
     "Plan",
@@ -69,10 +69,12 @@ SEAM_COST = {"dijkstra": 8.0, "minimax": 12.0, "oscillating": 3.0, "oscillating-
 BASE_BYTES = 2 * 2**20
 #: speed-up of the block pool on 2 threads (GIL-bound glue between the FFTs and kernels)
 THREAD_GAIN = 1.6
-NUMPY_FFT_WORK = 2000 * 128 * 128
-"""Blocks x padded sample pixels up to which an exact dp quilting search that needs nothing
-else of scipy takes numpy's transforms (:mod:`engine.fft`): their extra time (~0.1 ms a block
-of a 128² sample) stays under the ~0.25 s the import of scipy.fft costs a whole process."""
+SMALL_FFT_WORK = 2000 * 128 * 128
+"""Blocks x padded sample pixels up to which an exact dp quilting run that needs nothing else
+of scipy is estimated at the development machine's speed: timing the reference transform
+(:func:`machine_factor`) imports scipy.fft (~0.25 s), more than such a run's FFTs take, which
+come from scipy's pocketfft loaded by itself (:mod:`engine.fft`, a few ms). (numpy's
+transforms, taken here before, are about twice slower: ~0.1 ms more a block of a 128² sample.)"""
 
 
 @dataclass(frozen=True)
@@ -95,7 +97,7 @@ class Plan:
     peak_bytes : int
         Estimated peak of the memory the run allocates (the caller's sample not counted).
     fft : {"scipy", "numpy"}
-        Where an exact search's transforms come from (:data:`NUMPY_FFT_WORK`).
+        Where an exact search's transforms come from (scipy's pocketfft for every plan now).
     """
 
     mode: str
@@ -299,9 +301,9 @@ def plan(
         and terms == "overlap"
         and seam.method in ("dp", "straight")
         and seam.blend == "none"
-        and n_blocks * hp * wp <= NUMPY_FFT_WORK
+        and n_blocks * hp * wp <= SMALL_FFT_WORK
     ):
         # a small run that needs nothing else of scipy: shown at the development machine's
         # speed (timing the reference transform would cost it more than it tells)
-        return replace(chosen, fft="numpy")
+        return chosen
     return replace(chosen, seconds=chosen.seconds * machine_factor())

@@ -1,4 +1,7 @@
-"""engine.fft: scipy's fast lengths without scipy, numpy's transforms for small runs only."""
+"""engine.fft: scipy's fast lengths and transforms without importing scipy.fft; numpy's."""
+
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -49,10 +52,30 @@ def _plan(sample_side, out_side, block=32, overlap=6, seam=None):
     return estimate.plan(opts, 1)
 
 
-def test_only_small_dp_runs_take_numpys_transforms(monkeypatch):
-    monkeypatch.setattr(estimate, "machine_factor", lambda: 1.0)
-    assert _plan(128, 512).fft == "numpy"  # synth job A
-    assert _plan(128, 2048).fft == "scipy"  # many blocks
-    assert _plan(512, 512).fft == "scipy"  # a large sample
-    assert _plan(128, 512, seam=SeamSpec("dp", blend="feather")).fft == "scipy"  # scipy anyway
-    assert _plan(128, 512, seam=SeamSpec("dijkstra")).fft == "scipy"
+def test_every_run_takes_scipys_transforms_and_small_ones_time_no_reference(monkeypatch):
+    """Small dp runs load scipy's pocketfft by itself (engine.fft) and skip machine_factor,
+    whose reference FFT imports scipy.fft; numpy's transforms (twice slower) are never planned."""
+    timed = []
+    monkeypatch.setattr(estimate, "machine_factor", lambda: timed.append(1) or 1.0)
+    assert _plan(128, 512).fft == "scipy" and not timed  # synth job A
+    for plan in (
+        _plan(128, 2048),  # many blocks
+        _plan(512, 512),  # a large sample
+        _plan(128, 512, seam=SeamSpec("dp", blend="feather")),  # scipy anyway
+        _plan(128, 512, seam=SeamSpec("dijkstra")),
+    ):
+        assert plan.fft == "scipy"
+    assert len(timed) == 4
+
+
+def test_scipys_transforms_load_without_scipy_fft_and_give_its_numbers():
+    code = (
+        "import sys, numpy as np; from engine.fft import transforms; t = transforms('scipy'); "
+        "x = np.random.default_rng(0).random((3, 20, 24), dtype=np.float32); "
+        "a = t.irfft(t.ifft(t.fft(t.rfft(x, n=32, axis=-1), n=40, axis=-2), axis=-2), n=32); "
+        "assert 'scipy' not in sys.modules, 'scipy imported'; import scipy.fft as f; "
+        "b = f.irfft(f.ifft(f.fft(f.rfft(x, n=32, axis=-1), n=40, axis=-2), axis=-2), n=32); "
+        "assert a.dtype == b.dtype and np.array_equal(a, b); print('ok')"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "ok"
