@@ -69,3 +69,21 @@ def test_the_compiled_steps_give_the_numpy_paths_blocks(monkeypatch, options):
         )
     assert np.array_equal(runs[0].image, runs[1].image)
     assert _records(runs[0]) == _records(runs[1])
+
+
+def test_the_l_cuts_old_side_is_the_whole_block_fills():
+    from engine import stitch
+
+    rng = np.random.default_rng(5)
+    for case in range(600):
+        bh, bw = (int(v) for v in rng.integers(2, 30, size=2))
+        ovl, ovt = int(rng.integers(1, bw + 1)), int(rng.integers(1, bh + 1))
+        e = rng.random((bh, bw))
+        if case % 3 == 1:
+            e = np.round(e * 3)  # ties
+        elif case % 3 == 2:
+            e = (e < 0.3).astype(float)
+        path, mask, _, _ = stitch.dp_l_cut_kernel(e, ovl, ovt)
+        barrier = np.zeros((bh, bw), bool)
+        barrier[path[:, 0], path[:, 1]] = True
+        assert np.array_equal(mask, stitch._old_side_of_barrier(barrier, True, True)), case
