@@ -9,7 +9,6 @@ what happens to be imported: the same inputs always give the same output.
 
 from __future__ import annotations
 
-import sys
 import threading
 
 import numpy as np
@@ -76,10 +75,8 @@ def _scipy():
     Importing :mod:`scipy.fft` costs ~0.25 s (its package loads ``scipy.special``); the compiled
     extension behind its FFTs loads in a few milliseconds (privately: no ``scipy`` module is
     imported, and a later ``import scipy.fft`` loads its own). :class:`_Pocketfft` prepares the
-    arguments as ``scipy.fft`` does: the same results. Once scipy.fft is imported anyway, it is
-    used directly."""
-    if "scipy.fft" in sys.modules:
-        return sys.modules["scipy.fft"]
+    arguments as ``scipy.fft`` does: the same results, and less time per call than scipy.fft's
+    dispatch (its backends) takes."""
     with _LOCK:
         if not _POCKETFFT:
             _POCKETFFT.append(_load_pocketfft())

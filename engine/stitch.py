@@ -37,6 +37,7 @@ from engine.blend import (
 )
 from engine.cancel import check
 from engine.errormap import error_map
+from engine.l_cut_side import old_side_of_l_cut
 from engine.seams._result import Seam
 from engine.seams.graph import graph_path
 from engine.seams.search import MINIMAX_METRIC, find_seam
@@ -383,63 +384,7 @@ def _dp_l_cut(e, ovl, ovt):  # pragma: no cover - compiled
             barrier[r, c] = True
             path[n, 0], path[n, 1] = r, c
             n += 1
-    return path[:n].copy(), _old_side_of_l_cut(barrier, ovl, ovt), qr, qc
-
-
-@njit(cache=True, nogil=True)
-def _old_side_of_l_cut(barrier, ovl, ovt):  # pragma: no cover - compiled
-    """:func:`_old_side_of_barrier` (both edges seeded) of an L-cut's barrier, filling the L
-    only (a third of a 48² block's pixels).
-
-    The cut runs inside the L (``ovt`` top rows, ``ovl`` left columns) from the bottom edge to
-    the right edge, and a 4-connected fill does not cross an 8-connected path: the old side
-    stays in the L, and the rest of the block is new. So the interior is new at once, and an L
-    pixel is new when it connects to the border or to the interior (its pixels next to the
-    interior are seeds too); the same regions as the fill over the whole block."""
-    h, w = barrier.shape
-    state = np.zeros((h, w), np.uint8)  # 0 unvisited, 1 barrier, 2 old side, 3 new side
-    for r in range(ovt, h):
-        for c in range(ovl, w):
-            state[r, c] = 3
-    for r in range(h):
-        for c in range(w if r < ovt else ovl):
-            if barrier[r, c]:
-                state[r, c] = 1
-    stack = np.empty(h * w, np.int64)
-    for fill in (2, 3):
-        n = 0
-        for r in range(h):
-            for c in range(w if r < ovt else ovl):
-                if state[r, c] != 0:
-                    continue
-                if fill == 2:
-                    seed = c == 0 or r == 0
-                else:
-                    seed = (
-                        r == 0
-                        or c == 0
-                        or r == h - 1
-                        or c == w - 1
-                        or (r >= ovt and c == ovl - 1)
-                        or (r == ovt - 1 and c >= ovl)
-                    )
-                if seed:
-                    state[r, c] = fill
-                    stack[n] = r * w + c
-                    n += 1
-        while n:
-            n -= 1
-            r, c = divmod(stack[n], w)
-            for rr, cc in ((r - 1, c), (r + 1, c), (r, c - 1), (r, c + 1)):
-                if 0 <= rr < h and 0 <= cc < w and state[rr, cc] == 0:
-                    state[rr, cc] = fill
-                    stack[n] = rr * w + cc
-                    n += 1
-    old = np.empty((h, w), np.bool_)
-    for r in range(h):
-        for c in range(w):
-            old[r, c] = state[r, c] != 3
-    return old
+    return path[:n].copy(), old_side_of_l_cut(barrier, ovl, ovt), qr, qc
 
 
 dp_l_cut_kernel = _dp_l_cut

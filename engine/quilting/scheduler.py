@@ -81,24 +81,31 @@ it one by one (batched transforms of a large sample only thrash the cache)."""
 
 BATCH = 4
 
+BATCH_ONE_THREAD = 8
+"""Batch size below :data:`POOL_MIN_SAMPLE_AREA` (one thread whatever ``threads`` says): fewer,
+larger FFT calls (job A: ~5 % faster than batches of 4; the same result)."""
+
 
 def run_levels(q: Quilter, rects, total_label: str):
     """Place ``rects`` (top-level blocks, raster order); yields events, returns the records.
 
     Blocks go in level order (level, then raster index), in fixed batches of consecutive blocks
-    of one level (:data:`BATCH`, or one on large samples). A batch is loaded (the canvas under
-    it read), searched and placed as one task as soon as its blocks' predecessors are placed;
-    with ``threads > 1`` the tasks run on a pool (FFTs and numba kernels release the GIL), and
-    blocks of one level are placed side by side (their footprints are disjoint). Records and
-    events come out in level order whatever the number of threads, every block sees exactly the
-    canvas its predecessors left and draws from its own generator, and the batches do not
-    depend on the threads: the result does not depend on the number of threads.
+    of one level (:data:`BATCH`; :data:`BATCH_ONE_THREAD` on small samples, one on large ones). A
+    batch is loaded (the canvas under it read), searched and placed as one task as soon as its
+    blocks' predecessors are placed; with ``threads > 1`` the tasks run on a pool (FFTs and numba
+    kernels release the GIL), and blocks of one level are placed side by side (their footprints
+    are disjoint). Records and events come out in level order whatever the number of threads,
+    every block sees exactly the canvas its predecessors left and draws from its own generator,
+    and the batches do not depend on the threads: the result does not depend on the number of
+    threads.
     """
     q.prepare()  # shared search structures, built once before any thread reads them
     preds, levels = dependencies(rects, q.out_shape, q.tileable)
     order = sorted(range(len(rects)), key=lambda k: (levels[k], k))
     area = q.sample.shape[0] * q.sample.shape[1]
-    size = BATCH if area <= BATCH_MAX_SAMPLE_AREA else 1
+    size = BATCH if area >= POOL_MIN_SAMPLE_AREA else BATCH_ONE_THREAD
+    if area > BATCH_MAX_SAMPLE_AREA:
+        size = 1
     batches: list[list[int]] = []
     for k in order:
         if batches and len(batches[-1]) < size and levels[batches[-1][0]] == levels[k]:
