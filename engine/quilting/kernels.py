@@ -69,7 +69,6 @@ def dp_cut_paste(old, new, filled, ovl, ovt, out):  # pragma: no cover - compile
     (h, w, C) float32 to write.
     """
     h, w, c = old.shape
-    cc = new.shape[2]
     err = np.zeros((h, w), np.float32)
     anything = False
     for u in range(h):
@@ -83,21 +82,17 @@ def dp_cut_paste(old, new, filled, ovl, ovt, out):  # pragma: no cover - compile
                 err[u, v] = s
                 if s != 0:
                     anything = True
+    pixels = new.copy()
     if anything:
         path, keep, _, _ = dp_l_cut_kernel(err.astype(np.float64), ovl, ovt)
-        for u in range(h):
-            for v in range(w):
-                keep[u, v] = keep[u, v] and filled[u, v]
     else:
         path = np.zeros((0, 2), np.intp)
         keep = filled.copy()
-    pixels = np.empty((h, w, cc), np.float32)
     for u in range(h):
         for v in range(w):
             if keep[u, v]:
-                for k in range(cc):
-                    pixels[u, v, k] = out[u, v, k]
-            else:
-                for k in range(cc):
-                    pixels[u, v, k] = new[u, v, k]
+                if filled[u, v]:
+                    pixels[u, v] = out[u, v]
+                else:
+                    keep[u, v] = False
     return err, keep, path, pixels
