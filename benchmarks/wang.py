@@ -27,6 +27,13 @@ Run ``python -m benchmarks.wang`` (``--help`` for options). Tables:
 
    Targets (issue 11): Wang joints median <= 1.1 and max <= 1.6, lattice <= +1 dB,
    frame <= 1.12, detail >= 0.95. ``--docs DIR`` saves both sets' 8x8 layouts there.
+3. **Interior constructions** (``--interiors SET``): the same Wang figures for each
+   construction of :data:`INTERIORS` (where the interior's closed cut may run, its bias, its
+   blend; Cohen's diamonds alone), on one yardstick: the lattice's crops carry each tile's
+   outer pixel only (the one pixel every construction takes from its edge samples), the frame
+   is measured over 2 w_P of the default ring and over half the tile. Medians over
+   ``--seeds`` sets per texture, then the summary over the textures. ``--docs DIR`` saves
+   seed 0's 8x8 layout of every construction there.
 
 Both tables are printed and saved to ``benchmarks/results/wang*.txt``.
 """
@@ -63,6 +70,25 @@ from engine.tiles.wang_layout import wang_layout  # noqa: E402
 
 RESULTS = Path(__file__).resolve().parent / "results"
 SAMPLES = ("brick", "cobblestones", "grass", "gravel", "lichen")
+
+#: Interior constructions compared by ``--interiors``: name -> (options of
+#: :func:`engine.tiles.wang.wang_set`, or a callable of the tile size giving them; what it is).
+#: The closed cut of the interior patch runs at distances ``margin .. patch_overlap - 1`` from
+#: the tile edge, drawn towards the margin by ``outward``.
+INTERIORS = {
+    "default": ({}, "ring w_P (8 px at 128), margin 1, outward 1: cut 1-3 px from the edge"),
+    "free cut": ({"outward": 0.0}, "ring w_P, no outward bias"),
+    "hugging cut": ({"outward": 3.0}, "ring w_P, outward 3"),
+    "ring 16": ({"patch_overlap": 16, "outward": 2.0}, "ring 16 px, outward 2"),
+    "ring 24": ({"patch_overlap": 24, "outward": 4.0}, "ring 24 px, outward 4"),
+    "margin 4": ({"margin": 4, "patch_overlap": 16}, "cut at 4-15 px, outward 1"),
+    "Cohen + centre": (
+        lambda T: {"margin": T // 6, "patch_overlap": T // 3, "outward": 0.0},
+        "Cohen's diamonds, a centre patch cut at T/6-T/3 from the edges",
+    ),
+    "Cohen diamonds": ({"interior": "diamonds"}, "the four diamonds alone"),
+    "gradient blend": ("poisson", "ring w_P, gradient-domain blend of the patch"),
+}
 
 
 def _stamp() -> str:
@@ -154,34 +180,61 @@ def _pairs(tiles, touches) -> list[float]:
     return out
 
 
+def _options(construction, T: int) -> dict:
+    """:func:`wang_set` options of an :data:`INTERIORS` entry for T px tiles."""
+    opts, _ = INTERIORS[construction]
+    if opts == "poisson":
+        from engine.seams import SeamSpec
+
+        return {"seam": SeamSpec(blend="poisson")}
+    return dict(opts(T) if callable(opts) else opts)
+
+
+def _default_ring(T: int) -> int:
+    from engine.tiles.candidates import default_patch_overlap
+    from engine.tiles.template import default_overlap
+
+    return default_patch_overlap(default_overlap(T))
+
+
+def wang_figures(S, T: int, seed: int, options: dict, docs_file: Path | None = None):
+    """One Wang set's figures: joint ratios (list), lattice dB above its floor, frame over
+    2 w_P of the default ring, frame over half the tile, median detail, corners, joints."""
+    ws = wang_set(S, tile_size=T, rng=seed, **options)
+    sigs = ws.signatures
+
+    def touches(a, b, direction):
+        i, j = (1, 3) if direction == "horizontal" else (2, 0)
+        return a.signature[i] == b.signature[j]
+
+    pairs = _pairs(ws.tiles, touches)
+    layouts = [
+        wang_layout(sigs, 8, 8, rng=100 * seed + k, no_equal_neighbours=True) for k in range(4)
+    ]
+    # the crops carry each tile's outer pixel: what every construction takes from its edge
+    # samples (a wider margin would hide a construction's own shared ring)
+    lat = lattice(ws.tiles, S, margin=1, layouts=layouts)
+    fr = frame(ws.tiles, S, limit=2 * _default_ring(T), wrap=False)
+    half = frame(ws.tiles, S, limit=T // 2, wrap=False)
+    det = float(np.median([detail_ratio(t.tile, S) for t in ws.tiles]))
+    img = assemble(ws.tiles, layouts[0])
+    corner = corner_border_ratio(img, T, radius=2)
+    joints = grid_border_ratio(img, T)
+    if docs_file is not None:
+        from engine.io import save_image
+
+        save_image(docs_file, img)
+    return pairs, lat.above, fr.value, half.value, det, corner, joints
+
+
 def wang_row(S, T: int, docs: Path | None, name: str, seeds: int = 1):
     """Wang figures of ``seeds`` sets (seeds 0 ..): medians over them; the joints' max is the
     largest of any set. Layouts as the CLI's and the editor's previews (no equal neighbours)."""
     figures = []
     for seed in range(seeds):
-        ws = wang_set(S, tile_size=T, rng=seed)
-        sigs = ws.signatures
-
-        def touches(a, b, direction):
-            i, j = (1, 3) if direction == "horizontal" else (2, 0)
-            return a.signature[i] == b.signature[j]
-
-        pairs = _pairs(ws.tiles, touches)
-        layouts = [
-            wang_layout(sigs, 8, 8, rng=100 * seed + k, no_equal_neighbours=True) for k in range(4)
-        ]
-        m = ws.parameters["margin"]
-        lat = lattice(ws.tiles, S, margin=m, layouts=layouts)
-        fr = frame(ws.tiles, S, limit=2 * ws.parameters["patch_overlap"], wrap=False)
-        det = float(np.median([detail_ratio(t.tile, S) for t in ws.tiles]))
-        img = assemble(ws.tiles, layouts[0])
-        corner = corner_border_ratio(img, T, radius=2)
-        joints = grid_border_ratio(img, T)
-        if docs is not None and seed == 0:
-            from engine.io import save_image
-
-            save_image(docs / f"{name}_wang.png", img)
-        figures.append((np.median(pairs), max(pairs), lat.above, fr.value, det, corner, joints))
+        out = None if docs is None or seed else docs / f"{name}_wang.png"
+        pairs, lat, fr, _, det, corner, joints = wang_figures(S, T, seed, {}, out)
+        figures.append((np.median(pairs), max(pairs), lat, fr, det, corner, joints))
     med = np.median(np.array(figures), axis=0)
     return (med[0], max(f[1] for f in figures), *med[2:])
 
@@ -242,14 +295,82 @@ def quality(which: str, tile: int, docs: Path | None, seeds: int = 3) -> str:
     )
 
 
+def interiors(which: str, tile: int, docs: Path | None, seeds: int = 2) -> str:
+    """The :data:`INTERIORS` constructions on one texture set (see the module docstring)."""
+    names = list(INTERIORS)
+    per: dict[str, list] = {n: [] for n in names}  # construction -> per texture figures
+    textures = []
+    for tex, S in _textures(which):
+        T = _fit(S, tile)
+        textures.append(tex)
+        for n in names:
+            figs = []
+            for seed in range(seeds):
+                out = None
+                if docs is not None and seed == 0:
+                    out = docs / f"{tex}_{n.replace(' ', '_').replace('+', 'and')}.png"
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")
+                    pairs, lat, fr, half, det, _, _ = wang_figures(S, T, seed, _options(n, T), out)
+                figs.append((lat, fr, half, det, max(pairs)))
+            m = np.median(np.array(figs), axis=0)
+            m[4] = max(f[4] for f in figs)
+            per[n].append(m)
+            print(f"{tex} | {n} | " + " | ".join(f"{v:.2f}" for v in m), file=sys.stderr)
+    rows = []
+    for n in names:
+        a = np.array(per[n])
+        lat_ok, fr_ok, det_ok = a[:, 0] <= 1.0, a[:, 1] <= 1.12, a[:, 3] >= 0.95
+        rows.append(
+            [
+                n,
+                f"{np.median(a[:, 0]):+.2f} / {a[:, 0].mean():+.2f}",
+                f"{np.median(a[:, 1]):.2f}",
+                f"{np.median(a[:, 2]):.2f}",
+                f"{np.median(a[:, 3]):.2f} (min {a[:, 3].min():.2f})",
+                f"{a[:, 4].max():.2f}",
+                f"{lat_ok.sum()} / {fr_ok.sum()} / {(lat_ok & fr_ok).sum()}",
+                f"{(lat_ok & fr_ok & det_ok).sum()} of {len(a)}",
+            ]
+        )
+    heads = ["construction", "lattice dB med / mean", "frame 2 w_P", "frame T/2"]
+    heads += ["detail med", "joints max", "lattice / frame / both ok", "all three ok"]
+    detail_heads = ["texture", *names]
+    detail_rows = [
+        [tex, *[f"{per[n][i][0]:+.1f} / {per[n][i][1]:.2f}" for n in names]]
+        for i, tex in enumerate(textures)
+    ]
+    what = "\n".join(f"- {n}: {INTERIORS[n][1]}" for n in names)
+    return (
+        f"Interior constructions on the {which} textures: K = 2 Wang sets (16 tiles), 128 px "
+        f"or the largest tile that fits, medians over seeds 0..{seeds - 1} per texture; "
+        "lattice dB above the floor of crops carrying each tile's outer pixel, frame over 2 w_P "
+        "of the default ring (16 px at 128) and over half the tile, both Wang tiles reflected. "
+        "Targets: lattice <= +1 dB, frame <= 1.12, detail >= 0.95.\n\n"
+        f"{what}\n\n{format_table(heads, rows)}\n\nPer texture (lattice dB / frame 2 w_P):"
+        f"\n\n{format_table(detail_heads, detail_rows)}\n"
+    )
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--repeats", type=int, default=5, help="speed runs per worker count")
     ap.add_argument("--no-speed", action="store_true", help="skip the speed table")
     ap.add_argument("--quality", choices=("samples", "public", "private"), default=None)
+    ap.add_argument(
+        "--interiors",
+        choices=("samples", "public", "private"),
+        default=None,
+        help="compare the interior constructions (INTERIORS) on this set",
+    )
     ap.add_argument("--tile", type=int, default=128, help="tile size of the quality table")
     ap.add_argument("--docs", type=Path, default=None, help="save the 8x8 layouts here")
-    ap.add_argument("--seeds", type=int, default=3, help="Wang sets per texture (medians)")
+    ap.add_argument(
+        "--seeds",
+        type=int,
+        default=None,
+        help="Wang sets per texture (medians; default 3, 2 for --interiors)",
+    )
     args = ap.parse_args(argv)
     RESULTS.mkdir(exist_ok=True)
     if args.docs is not None:
@@ -259,9 +380,20 @@ def main(argv=None) -> int:
         print(text)
         (RESULTS / "wang.txt").write_text(text)
     if args.quality:
-        text = f"{_stamp()}\n\n{quality(args.quality, args.tile, args.docs, args.seeds)}"
+        seeds = 3 if args.seeds is None else args.seeds
+        text = f"{_stamp()}\n\n{quality(args.quality, args.tile, args.docs, seeds)}"
         print(text)
         (RESULTS / f"wang_quality_{args.quality}.txt").write_text(text)
+    if args.interiors:
+        seeds = 2 if args.seeds is None else args.seeds
+        load = _load_avg()
+        table = interiors(args.interiors, args.tile, args.docs, seeds)
+        text = (
+            f"{_stamp()} (1-minute load {load:.1f} -> {_load_avg():.1f}; quality figures do "
+            f"not depend on load)\n\n{table}"
+        )
+        print(text)
+        (RESULTS / f"wang_interiors_{args.interiors}.txt").write_text(text)
     return 0
 
 
