@@ -16,9 +16,9 @@ Run ``python -m benchmarks.wang`` (``--help`` for options). Tables:
 
    * joints: border ratio median / max over every pair of tiles that may touch, both
      directions (Wang: the pairs whose touching colours match; Somol: all pairs);
-   * lattice (dB above its floor, :func:`engine.metrics.lattice`): Wang over 4 random valid
+   * lattice (dB above its floor, :func:`engine.metrics.lattice`): Wang over 16 random valid
      8x8 layouts without equal neighbours (as the previews) against crops carrying each
-     tile's own outer margin; Somol over 4 random 8x8 layouts against crops carrying the
+     tile's own outer margin; Somol over 16 random 8x8 layouts against crops carrying the
      template's margin;
    * frame (:func:`engine.metrics.frame`, limit 2 w_P; Wang tiles reflected at their border,
      Somol tiles wrapped), detail (median detail ratio of the tiles);
@@ -57,6 +57,7 @@ import resources  # noqa: E402
 from benchmarks._util import format_table  # noqa: E402
 from engine.io import load_image  # noqa: E402
 from engine.metrics import (  # noqa: E402
+    LATTICE_LAYOUTS,
     border_ratio,
     corner_border_ratio,
     detail_ratio,
@@ -209,7 +210,8 @@ def wang_figures(S, T: int, seed: int, options: dict, docs_file: Path | None = N
 
     pairs = _pairs(ws.tiles, touches)
     layouts = [
-        wang_layout(sigs, 8, 8, rng=100 * seed + k, no_equal_neighbours=True) for k in range(4)
+        wang_layout(sigs, 8, 8, rng=100 * seed + k, no_equal_neighbours=True)
+        for k in range(LATTICE_LAYOUTS)
     ]
     # the crops carry each tile's outer pixel: what every construction takes from its edge
     # samples (a wider margin would hide a construction's own shared ring)
