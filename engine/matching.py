@@ -179,7 +179,7 @@ class SampleSpectrum:
         if c != self.channels:
             raise ValueError(f"targets must have {self.channels} channels, got {c}")
         tt = np.moveaxis(t, 3, 1)  # (n, C, bh, bw)
-        k = wts[:, self.group_of] * tt
+        k = (wts if len(self.groups) == 1 else wts[:, self.group_of]) * tt  # broadcast: same
         const = np.einsum("nchw,nchw->n", k, tt, dtype=np.float64)
         return self.ssd_terms(k, wts, const, workers=workers)
 
