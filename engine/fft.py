@@ -79,7 +79,8 @@ def _scipy():
     dispatch (its backends) takes."""
     with _LOCK:
         if not _POCKETFFT:
-            _POCKETFFT.append(_load_pocketfft())
+            module = _load_pocketfft()
+            _POCKETFFT.append(module if module is not None and _works(module) else None)
     if _POCKETFFT[0] is None:
         import scipy.fft
 
@@ -101,6 +102,25 @@ def _load_pocketfft():
     except Exception:  # another scipy layout: import scipy.fft instead
         return None
     return module
+
+
+def _works(module) -> bool:
+    """Whether the extension, called as :class:`_Pocketfft` calls it, gives numpy's transforms
+    of a small array: its call signature is scipy's private API, so a scipy release that changes
+    it falls back to ``scipy.fft`` instead of failing in the middle of a search."""
+    x = np.random.default_rng(0).random((6, 10), dtype=np.float32)
+    try:
+        t = _Pocketfft(module)
+        f = t.fft(t.rfft(x, n=12), n=8, axis=0)
+        back = t.irfft(t.ifft(f, axis=0), n=12)
+    except Exception:
+        return False
+    ref = np.fft.fft(np.fft.rfft(x, n=12), n=8, axis=0)
+    return bool(
+        np.allclose(f, ref, rtol=1e-4, atol=1e-4)
+        and np.allclose(back[:6, :10], x, atol=1e-5)
+        and back.dtype == np.float32
+    )
 
 
 class _Pocketfft:

@@ -79,3 +79,22 @@ def test_scipys_transforms_load_without_scipy_fft_and_give_its_numbers():
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "ok"
+
+
+def test_an_extension_that_no_longer_takes_scipys_arguments_falls_back_to_scipy_fft(monkeypatch):
+    import scipy.fft as sfft
+
+    from engine import fft
+
+    class Changed:  # a scipy release whose private extension changed its call signature
+        def r2c(self, *args):
+            raise TypeError("r2c() takes 3 positional arguments")
+
+        c2c = c2r = r2c
+
+    monkeypatch.setattr(fft, "_POCKETFFT", [])
+    monkeypatch.setattr(fft, "_load_pocketfft", Changed)
+    assert fft.transforms("scipy") is sfft
+    monkeypatch.setattr(fft, "_POCKETFFT", [])
+    monkeypatch.undo()
+    assert fft._works(fft._load_pocketfft())  # the installed scipy's extension passes the check
