@@ -190,6 +190,7 @@ def whole_structure_range(scale: Scale, lo, hi, *, per_tile: float = STRUCTURES_
             f"the texture repeats about every {what} (measured by autocorrelation), more than a "
             f"third of the largest tile {hi[1]}x{hi[0]}: every tile cuts its structures and a "
             f"layout shows the cuts at the tile edges; try a tile of at least "
-            f"{need[1]}x{need[0]} (a larger tile_max or tile size), or a Wang set"
+            f"{need[1]}x{need[0]} (a larger tile size: --tile-max, or Tile size in the editor), or "
+            "a Wang set"
         )
     return tuple(new_lo), tuple(new_hi), notes
