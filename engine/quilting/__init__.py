@@ -45,7 +45,7 @@ Determinism and threads
     of threads (:mod:`~engine.quilting.scheduler`).
 """
 
-import importlib
+from engine._lazy import lazy_exports
 
 # Names are loaded on first use (PEP 562): the command line's parsers read the tables of
 # engine.quilting.names without loading numpy, and a module imports what it uses once.
@@ -65,13 +65,4 @@ _EXPORTS = {
 __all__ = sorted(_EXPORTS)
 
 
-def __getattr__(name: str):
-    if name not in _EXPORTS:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(importlib.import_module(_EXPORTS[name]), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted({*globals(), *_EXPORTS})
+__getattr__, __dir__ = lazy_exports(globals(), _EXPORTS)

@@ -48,7 +48,7 @@ block's colours as ``image`` give the paper's step cost. See :mod:`engine.seams.
 
 from __future__ import annotations
 
-import importlib
+from engine._lazy import lazy_exports
 
 # Names are loaded on first use (PEP 562), so that importing the light tables of
 # :mod:`engine.seams.spec` (the command line's parsers do) does not load the numba solvers.
@@ -74,13 +74,4 @@ _EXPORTS = {
 __all__ = sorted(_EXPORTS)
 
 
-def __getattr__(name: str):
-    if name not in _EXPORTS:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(importlib.import_module(_EXPORTS[name]), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted({*globals(), *_EXPORTS})
+__getattr__, __dir__ = lazy_exports(globals(), _EXPORTS)
