@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import os
 import shutil
 import signal
 import statistics
@@ -127,6 +128,13 @@ def _run_batch(photos, lib: Path, *, jobs=None, scheduler="") -> float:
     return dt
 
 
+def restore_environ(environ: dict) -> None:
+    """Put ``os.environ`` back to ``environ`` (what the process had before a cluster changed it)."""
+    for key in set(os.environ) - set(environ):
+        del os.environ[key]
+    os.environ.update(environ)
+
+
 def throughput(n_photos: int, repeats: int) -> str:
     from engine.batch.cluster import local_cluster
 
@@ -138,7 +146,12 @@ def throughput(n_photos: int, repeats: int) -> str:
         "Dask, 2 workers": [],
     }
     try:
+        environ = dict(os.environ)
         with local_cluster(2) as cluster:
+            # LocalCluster sets MALLOC_TRIM_THRESHOLD_, OMP_NUM_THREADS... in this process for
+            # its workers; the local pool's workers would inherit them (glibc trimming at 64 KiB
+            # made the local runs 20-30 % slower): they run in the environment a user has
+            restore_environ(environ)
             configs = {
                 "local, 1 process": {"jobs": 1},
                 "local, 2 processes": {"jobs": 2},
