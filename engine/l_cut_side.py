@@ -6,7 +6,23 @@ import numpy as np
 
 from engine._jit import njit
 
-__all__ = ["old_side_of_l_cut"]
+__all__ = ["old_side_of_l_cut", "spread"]
+
+
+@njit(cache=True, nogil=True)
+def spread(state, stack, n, fill):  # pragma: no cover - compiled
+    """Flood ``fill`` from the ``n`` pixels on ``stack`` (flat indices) over the 4-connected
+    unvisited (0) pixels of ``state``: one step of the cut-side fills here and in
+    ``engine.stitch``."""
+    h, w = state.shape
+    while n:
+        n -= 1
+        r, c = divmod(stack[n], w)
+        for rr, cc in ((r - 1, c), (r + 1, c), (r, c - 1), (r, c + 1)):
+            if 0 <= rr < h and 0 <= cc < w and state[rr, cc] == 0:
+                state[rr, cc] = fill
+                stack[n] = rr * w + cc
+                n += 1
 
 
 @njit(cache=True, nogil=True)
@@ -50,16 +66,5 @@ def old_side_of_l_cut(barrier, ovl, ovt):  # pragma: no cover - compiled
                     state[r, c] = fill
                     stack[n] = r * w + c
                     n += 1
-        while n:
-            n -= 1
-            r, c = divmod(stack[n], w)
-            for rr, cc in ((r - 1, c), (r + 1, c), (r, c - 1), (r, c + 1)):
-                if 0 <= rr < h and 0 <= cc < w and state[rr, cc] == 0:
-                    state[rr, cc] = fill
-                    stack[n] = rr * w + cc
-                    n += 1
-    old = np.empty((h, w), np.bool_)
-    for r in range(h):
-        for c in range(w):
-            old[r, c] = state[r, c] != 3
-    return old
+        spread(state, stack, n, fill)
+    return state != 3

@@ -37,7 +37,7 @@ from engine.blend import (
 )
 from engine.cancel import check
 from engine.errormap import error_map
-from engine.l_cut_side import old_side_of_l_cut
+from engine.l_cut_side import old_side_of_l_cut, spread
 from engine.seams._result import Seam
 from engine.seams.graph import graph_path
 from engine.seams.search import MINIMAX_METRIC, find_seam
@@ -319,19 +319,8 @@ def _old_side_of_barrier(barrier, seed_left, seed_top):  # pragma: no cover - co
                     state[r, c] = fill
                     stack[n] = r * w + c
                     n += 1
-        while n:
-            n -= 1
-            r, c = divmod(stack[n], w)
-            for rr, cc in ((r - 1, c), (r + 1, c), (r, c - 1), (r, c + 1)):
-                if 0 <= rr < h and 0 <= cc < w and state[rr, cc] == 0:
-                    state[rr, cc] = fill
-                    stack[n] = rr * w + cc
-                    n += 1
-    old = np.empty((h, w), np.bool_)
-    for r in range(h):
-        for c in range(w):
-            old[r, c] = state[r, c] != 3
-    return old
+        spread(state, stack, n, fill)
+    return state != 3
 
 
 def _old_side(path: np.ndarray, shape, seed_left: bool, seed_top: bool) -> np.ndarray:
