@@ -29,7 +29,14 @@ Definitions (the issue, item 1; the README's "Interior metrics"):
   layout (same indices) of random crops whose outer ``margin`` pixels are the template's; the
   figure is tiles − floor, a mean over several layouts;
 * **template share**: per candidate, the fraction of pixels whose every channel is within
-  0.5/255 of the template's (the mean over candidates is reported).
+  0.5/255 of the template's (the mean over candidates is reported);
+* **the crops** (frame, ring tone and the lattice floor): random positions of the source; along
+  every axis where the texture has a period (its autocorrelation, lighting removed and each
+  row/column centred, has a first clear peak) and the tile holds a whole number of periods,
+  each drawn position is moved to the best match of the template's structure within one
+  period around it (the template's phase: an aligned set of a periodic texture *is* the
+  texture, and random phases read its period as a frame and a lattice) — unless the texture
+  repeats exactly (the in-phase crops are copies of the template), where they stay random.
 """
 
 from __future__ import annotations
@@ -91,6 +98,74 @@ def crop_corners(shape, size, n, rng) -> list[tuple[int, int]]:
     return list(zip(ys.tolist(), xs.tolist(), strict=True))
 
 
+# ----------------------------------------------------------- the crops: in the template's phase
+def autocorrelation_period(Y: np.ndarray) -> float:
+    """The period along axis 1 of ``Y`` (lighting already removed): the lag of the first
+    autocorrelation peak >= 0.25 that rises >= 0.1 above the lowest value before it (rows
+    centred, summed over the rows, each lag over its number of pairs); 0 without one."""
+    Z = Y - Y.mean(axis=1, keepdims=True)
+    n = Z.shape[1]
+    acf = np.zeros(n // 2 + 1)
+    for lag in range(n // 2 + 1):
+        acf[lag] = (Z[:, : n - lag] * Z[:, lag:]).sum() / (n - lag)
+    if acf[0] <= 0:
+        return 0.0
+    acf /= acf[0]
+    low = acf[1]
+    for k in range(2, len(acf) - 1):
+        low = min(low, acf[k])
+        if acf[k] >= max(acf[k - 1], 0.25) and acf[k] > acf[k + 1] and acf[k] - low >= 0.1:
+            a, b, c = acf[k - 1], acf[k], acf[k + 1]
+            return float(k + (0.5 * (a - c) / (a - 2 * b + c) if a - 2 * b + c < 0 else 0.0))
+    return 0.0
+
+
+def reference_corners(Y: np.ndarray, size, template=None):
+    """A function (n, rng) -> n crop corners: random, moved into the template's phase along
+    the axes where the texture is periodic and the tile holds whole periods."""
+    h, w = size
+    plain = lambda n, rng: crop_corners(Y.shape, size, n, rng)  # noqa: E731
+    if template is None:
+        return plain
+    flat = Y - ndimage.gaussian_filter(Y, max(Y.shape) / 8)
+    periods = (autocorrelation_period(flat.T), autocorrelation_period(flat))
+    snap = []
+    for p, n in zip(periods, size, strict=True):
+        k = round(n / p) if p > 0 else 0
+        snap.append(k >= 1 and abs(n - k * p) <= max(1.0, 0.02 * n))
+    if not any(snap):
+        return plain
+    from scipy import signal
+
+    hs = Y - ndimage.gaussian_filter(Y, max(h, w) / 4)
+    ht = template - ndimage.gaussian_filter(template, max(h, w) / 4, mode="wrap")
+    ht = ht - ht.mean()
+    box = np.ones((h, w))
+    local = signal.correlate(hs, box, mode="valid", method="fft")
+    energy = signal.correlate(hs * hs, box, mode="valid", method="fft") - local**2 / (h * w)
+    ncc = signal.correlate(hs, ht, mode="valid", method="fft")
+    ncc /= np.sqrt(np.maximum(energy, 1e-12) * (ht * ht).sum())
+
+    def moved(n, rng):
+        out = []
+        for y, x in crop_corners(Y.shape, size, n, rng):
+            lo, hi = [y, x], [y + 1, x + 1]
+            for i, c in enumerate((y, x)):
+                if snap[i]:
+                    span = min(ncc.shape[i], int(np.ceil(periods[i])))
+                    lo[i] = min(max(0, c - span // 2), ncc.shape[i] - span)
+                    hi[i] = lo[i] + span
+            win = ncc[lo[0] : hi[0], lo[1] : hi[1]]
+            dy, dx = np.unravel_index(int(np.argmax(win)), win.shape)
+            out.append((lo[0] + int(dy), lo[1] + int(dx)))
+        return out
+
+    probe = moved(32, np.random.default_rng(0))
+    if np.median([ncc[y, x] for y, x in probe]) >= 0.97:
+        return plain  # an exact repeat: every in-phase crop is a copy of the template
+    return moved
+
+
 def profile(images, dist, dmax) -> np.ndarray:
     """Mean of ``images`` (each (h, w)) at each distance 0..dmax-1."""
     total = np.zeros(dmax)
@@ -103,7 +178,7 @@ def profile(images, dist, dmax) -> np.ndarray:
     return total / np.maximum(count, 1)
 
 
-def frame_check(tiles, source, limit: int, seed: int = 1) -> tuple[float, float]:
+def frame_check(tiles, source, limit: int, seed: int = 1, template=None) -> tuple[float, float]:
     """(max, min) over d < ``limit`` of the tiles' edge-distance gradient profile over the
     crops'."""
     T = [luma(tile_pixels(t)) for t in tiles]
@@ -111,14 +186,16 @@ def frame_check(tiles, source, limit: int, seed: int = 1) -> tuple[float, float]
     dist = distance_map(h, w)
     dmax = min(limit, int(dist.max()) + 1)
     tiles_p = profile([gradient_magnitude(t, "wrap") for t in T], dist, dmax)
-    G = gradient_magnitude(luma(tile_pixels(source)), "reflect")
-    corners = crop_corners(G.shape, (h, w), CROPS, np.random.default_rng(seed))
+    Y = luma(tile_pixels(source))
+    G = gradient_magnitude(Y, "reflect")
+    tm = None if template is None else luma(tile_pixels(template))
+    corners = reference_corners(Y, (h, w), tm)(CROPS, np.random.default_rng(seed))
     crops_p = profile([G[y : y + h, x : x + w] for y, x in corners], dist, dmax)
     ratio = tiles_p / np.maximum(crops_p, 1e-12)
     return float(ratio.max()), float(ratio.min())
 
 
-def ring_tone_check(tiles, source, width: int, seed: int = 2) -> float:
+def ring_tone_check(tiles, source, width: int, seed: int = 2, template=None) -> float:
     T = [luma(tile_pixels(t)) for t in tiles]
     h, w = T[0].shape
     ring = distance_map(h, w) < width
@@ -127,7 +204,8 @@ def ring_tone_check(tiles, source, width: int, seed: int = 2) -> float:
         return abs(y[ring].mean() - y[~ring].mean())
 
     Y = luma(tile_pixels(source))
-    corners = crop_corners(Y.shape, (h, w), CROPS, np.random.default_rng(seed))
+    tm = None if template is None else luma(tile_pixels(template))
+    corners = reference_corners(Y, (h, w), tm)(CROPS, np.random.default_rng(seed))
     ref = np.mean([step(Y[y : y + h, x : x + w]) for y, x in corners])
     return float(np.mean([step(t) for t in T]) / max(ref, 1e-12))
 
@@ -167,11 +245,12 @@ def lattice_check(tiles, source, template, margin: int, layouts: int = LAYOUTS, 
     rng = np.random.default_rng(seed)
     inner = np.zeros((h, w), bool)
     inner[margin : h - margin, margin : w - margin] = True
+    where = reference_corners(Y, (h, w), tm)
     above, floors = [], []
     for _ in range(layouts):
         idx = rng.integers(0, len(T), (8, 8))
         crops = []
-        for y, x in crop_corners(Y.shape, (h, w), len(T), rng):
+        for y, x in where(len(T), rng):
             c = tm.copy()
             c[inner] = Y[y : y + h, x : x + w][inner]
             crops.append(c)
@@ -192,13 +271,13 @@ def share_check(tiles, template) -> float:
 
 def measure(tiles, source, template, *, ring: int, margin: int) -> dict:
     """Every figure of this implementation for one set."""
-    fr, low = frame_check(tiles, source, 2 * ring)
+    fr, low = frame_check(tiles, source, 2 * ring, template=template)
     dup_t, dup_p = duplicates_check(tiles, template)
     lat, floor = lattice_check(tiles, source, template, margin)
     return {
         "frame": fr,
         "frame_low": low,
-        "tone": ring_tone_check(tiles, source, ring),
+        "tone": ring_tone_check(tiles, source, ring, template=template),
         "dups": dup_t + dup_p,
         "dups_template": dup_t,
         "dups_pairs": dup_p,
@@ -226,6 +305,7 @@ def compare(which: str, seed: int = 0) -> str:
         e = evaluate_texture(S, seed)
         s = e["result"].settings
         t0 = time.perf_counter()
+        S = e["S"]  # the source the tiles were taken from (flattened with Flatten lighting)
         m = measure(e["cands"], S, e["seamless"].tile, ring=s.patch_overlap, margin=s.margin)
         took = time.perf_counter() - t0
         pairs = {k: e[k] for k in ("pairs med", "pairs max", "wrap", "detail")}

@@ -540,15 +540,16 @@ def evaluate_texture(S: np.ndarray, seed: int = 0, **changes) -> dict:
     of issue 10."""
     from engine.metrics import duplicates, frame, lattice, ring_tone, template_share
     from engine.settings import TilesetSettings
-    from engine.tiles.pipeline import tileset
+    from engine.tiles.pipeline import tileset, working_source
 
     t0 = time.perf_counter()
     res = tileset(S, TilesetSettings(seed=seed, **changes))
     elapsed = time.perf_counter() - t0
     st, cands, s = res.seamless, res.candidates, res.settings
+    S = working_source(S, s)  # with Flatten lighting: the tiles' own (flattened) source
     wp, m = s.patch_overlap, s.margin
     ratios = pair_ratios([c.tile for c in cands]) if len(cands) > 1 else np.ones(1)
-    fr = frame(cands, S, limit=2 * wp)
+    fr = frame(cands, S, limit=2 * wp, template=st.tile)
     lat = lattice(cands, S, template=st.tile, margin=m)
     return {
         "S": S,
@@ -560,7 +561,7 @@ def evaluate_texture(S: np.ndarray, seed: int = 0, **changes) -> dict:
         "w_P": wp,
         "frame": fr.value,
         "frame_low": fr.low,
-        "tone": ring_tone(cands, S, width=wp),
+        "tone": ring_tone(cands, S, width=wp, template=st.tile),
         "dups": duplicates(cands, st.tile).count,
         "lattice": lat.above,
         "lattice_floor": lat.floor,
@@ -569,9 +570,21 @@ def evaluate_texture(S: np.ndarray, seed: int = 0, **changes) -> dict:
         "wrap": wrap_border_ratio(st.tile),
         "detail": detail_ratio(st.tile, S),
         "share": float(template_share(cands, st.tile).mean()),
+        "phase": reference_phase(S, st.tile),
         "warnings": res.warnings,
         "seconds": elapsed,
     }
+
+
+def reference_phase(S, template) -> str:
+    """The axes along which the metrics' reference crops are in the template's phase
+    (:mod:`engine.reference_crops`): "y", "x", "y x" or "-"."""
+    from engine.metrics import luminance
+    from engine.reference_crops import ReferenceCrops
+
+    L, T = luminance(S), luminance(template)
+    axes = ReferenceCrops.build(L, T.shape, T).axes
+    return " ".join(a for a, on in zip("yx", axes, strict=True) if on) or "-"
 
 
 def failures(f: dict) -> list[str]:
@@ -618,6 +631,7 @@ def evaluation(which: str, seed: int, layouts: Path | None, **changes) -> str:
                 f"{S.shape[1]}x{S.shape[0]}",
                 f"{w}x{h}",
                 scale_text(f["result"].scale),
+                f["phase"],
                 f"{f['n']}",
                 f"{f['frame']:.2f} ({f['frame_low']:.2f})",
                 f"{f['tone']:.2f}",
@@ -637,6 +651,7 @@ def evaluation(which: str, seed: int, layouts: Path | None, **changes) -> str:
             "source",
             "tile",
             "scale h x w",
+            "ref. phase",
             "cands",
             "frame (low)",
             "ring tone",

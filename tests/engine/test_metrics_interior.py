@@ -5,7 +5,6 @@ import pytest
 from scipy import ndimage
 
 from engine.metrics import (
-    _harmonic_spectra,
     duplicates,
     edge_distance,
     frame,
@@ -15,6 +14,7 @@ from engine.metrics import (
     ring_tone,
     template_share,
 )
+from engine.tileset_metrics import _harmonic_spectra
 
 
 @pytest.fixture(scope="module")
