@@ -25,7 +25,7 @@ import numpy as np
 
 from engine.budget import check_memory, format_bytes
 from engine.events import Item
-from engine.fft import next_fast_len
+from engine.fft import default_backend, next_fast_len
 from engine.matching import WEIGHT_CACHE_BYTES
 from engine.pyramid import CHILDREN, SEED_NEIGHBOURS, pyramid_levels
 from engine.quilting.layout import grid_rects
@@ -96,8 +96,9 @@ class Plan:
         Estimated wall time on this machine now.
     peak_bytes : int
         Estimated peak of the memory the run allocates (the caller's sample not counted).
-    fft : {"scipy", "numpy"}
-        Where an exact search's transforms come from (scipy's pocketfft for every plan now).
+    fft : {"ducc0", "scipy", "numpy"}
+        Where an exact search's transforms come from: :func:`engine.fft.default_backend`
+        (ducc0 when installed, else scipy's pocketfft) for every plan.
     """
 
     mode: str
@@ -238,7 +239,7 @@ def plan(
 
     def finish(mode, search, levels, seconds, peak):
         secs = (place + seconds) / gain  # the model's seconds; shown scaled by the machine
-        return Plan(mode, search, levels, n_blocks, secs, int(fixed + peak))
+        return Plan(mode, search, levels, n_blocks, secs, int(fixed + peak), default_backend())
 
     if opts["select"] in ("random", "bhatia"):
         return finish("exact", "none", 0, 0.0, 0)

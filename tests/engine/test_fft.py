@@ -1,17 +1,21 @@
-"""engine.fft: scipy's fast lengths and transforms without importing scipy.fft; numpy's."""
+"""engine.fft: scipy's fast lengths; ducc0's transforms (the default when installed) with their
+fallback, scipy's pocketfft without importing scipy.fft; numpy's."""
 
 import subprocess
 import sys
+import threading
 
 import numpy as np
 import pytest
 import scipy.fft
 
-from engine.fft import next_fast_len, transforms
+from engine import fft
+from engine.fft import default_backend, next_fast_len, transforms
 from engine.matching import SampleSpectrum
-from engine.quilting import estimate
+from engine.quilting import Estimated, estimate, iter_quilt, scheduler
 from engine.quilting.options import check_options
 from engine.seams import SeamSpec
+from tests.engine.helpers import events_and_result, smooth_texture
 
 
 def test_next_fast_len_is_scipys():
@@ -52,20 +56,113 @@ def _plan(sample_side, out_side, block=32, overlap=6, seam=None):
     return estimate.plan(opts, 1)
 
 
-def test_every_run_takes_scipys_transforms_and_small_ones_time_no_reference(monkeypatch):
-    """Small dp runs load scipy's pocketfft by itself (engine.fft) and skip machine_factor,
-    whose reference FFT imports scipy.fft; numpy's transforms (twice slower) are never planned."""
+def test_every_run_takes_the_installed_backend_and_small_ones_time_no_reference(monkeypatch):
+    """Every plan takes default_backend()'s transforms: ducc0, a dependency, when installed.
+    Small dp runs skip machine_factor, whose reference FFT imports scipy.fft; numpy's
+    transforms (twice slower) are never planned."""
+    assert default_backend() == "ducc0"
     timed = []
     monkeypatch.setattr(estimate, "machine_factor", lambda: timed.append(1) or 1.0)
-    assert _plan(128, 512).fft == "scipy" and not timed  # synth job A
+    assert _plan(128, 512).fft == "ducc0" and not timed  # synth job A
     for plan in (
         _plan(128, 2048),  # many blocks
         _plan(512, 512),  # a large sample
         _plan(128, 512, seam=SeamSpec("dp", blend="feather")),  # scipy anyway
         _plan(128, 512, seam=SeamSpec("dijkstra")),
     ):
-        assert plan.fft == "scipy"
+        assert plan.fft == "ducc0"
     assert len(timed) == 4
+
+
+def test_without_ducc0_every_run_takes_scipys_pocketfft():
+    """The fallback: with ducc0 not importable the backend is scipy's, chosen before any run,
+    and a quilting job runs on it (no scipy.fft import for a small job either)."""
+    code = (
+        "import sys; sys.modules['ducc0'] = None; import numpy as np; from engine import fft; "
+        "from engine.quilting import iter_quilt, Estimated; "
+        "assert fft.default_backend() == 'scipy'; "
+        "s = np.random.default_rng(0).random((64, 64, 3), dtype=np.float32); "
+        "plans = [e.plan for e in iter_quilt(s, (96, 96), block=24, overlap=6, rng=0, "
+        "mode='exact') if isinstance(e, Estimated)]; "
+        "assert plans[0].fft == 'scipy' and 'scipy.fft' not in sys.modules; print('ok')"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "ok"
+
+
+@pytest.mark.parametrize("backend", ["ducc0", "scipy"])
+def test_the_same_output_for_any_thread_count_on_either_backend(backend, monkeypatch):
+    monkeypatch.setattr(scheduler, "POOL_MIN_SAMPLE_AREA", 0)  # the pool, even for this sample
+    monkeypatch.setattr(fft, "_DUCC", [None] if backend == "scipy" else [])
+    assert default_backend() == backend
+    s = smooth_texture((96, 96), seed=2)
+    runs = [
+        events_and_result(iter_quilt(s, (100, 120), block=24, overlap=6, rng=7, threads=t))
+        for t in (1, 2)
+    ]
+    for events, _ in runs:
+        assert [e.plan.fft for e in events if isinstance(e, Estimated)] == [backend]
+    np.testing.assert_array_equal(runs[0][1].image, runs[1][1].image)
+
+
+def _query(rng, n, c, g, bh, bw):
+    t = rng.random((n, c, bh, bw), dtype=np.float32)
+    w = (rng.random((n, g, bh, bw)) < 0.5).astype(np.float32)
+    return t * w[:, [i % g for i in range(c)]], w, rng.random(n)
+
+
+def test_ducc0s_queries_equal_scipys_up_to_round_off_and_reuse_buffers_safely():
+    """Odd padded sizes, two channel groups (texture transfer), several block shapes and batch
+    sizes in turn: the thread's reused buffers (zero past each kernel) give exactly what a fresh
+    spectrum gives, and scipy's errors up to float round-off."""
+    rng = np.random.default_rng(3)
+    s = rng.random((70, 91, 4), dtype=np.float32)
+    groups = ((0, 1, 2), (3,))
+    used = SampleSpectrum(s, groups=groups, backend="ducc0")
+    for n, bh, bw in ((3, 16, 20), (1, 9, 31), (3, 16, 20), (2, 30, 7), (3, 16, 20)):
+        k, w, const = _query(rng, n, 4, 2, bh, bw)
+        fresh = SampleSpectrum(s, groups=groups, backend="ducc0")
+        ref = SampleSpectrum(s, groups=groups, backend="scipy").ssd_terms(k, w, const)
+        got = used.ssd_terms(k, w, const)
+        np.testing.assert_array_equal(got, fresh.ssd_terms(k, w, const))
+        np.testing.assert_allclose(got, ref, rtol=1e-4, atol=1e-3 * float(np.abs(ref).max()))
+        corr = used.correlate(k)
+        np.testing.assert_allclose(
+            corr, SampleSpectrum(s, groups=groups, backend="scipy").correlate(k), atol=1e-3
+        )
+
+
+def test_one_ducc0_spectrum_queried_from_two_threads_gives_each_query_its_own_result():
+    rng = np.random.default_rng(4)
+    s = rng.random((96, 96, 3), dtype=np.float32)
+    spec = SampleSpectrum(s, backend="ducc0")
+    queries = [_query(rng, 2, 3, 1, bh, bw) for bh, bw in ((20, 20), (12, 24)) * 4]
+    serial = [spec.ssd_terms(*q) for q in queries]
+    out = {}
+
+    def run(i):
+        for _ in range(5):
+            out[i] = spec.ssd_terms(*queries[i])
+
+    threads = [threading.Thread(target=run, args=(i,)) for i in range(len(queries))]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for i, e in enumerate(serial):
+        np.testing.assert_array_equal(out[i], e)
+
+
+def test_ducc0s_transforms_with_scipys_signature_give_numpys():
+    t = transforms("ducc0")
+    x = np.random.default_rng(5).random((5, 14, 18), dtype=np.float32)
+    f = t.fft(t.rfft(x, n=24, axis=-1), n=16, axis=-2)
+    ref = np.fft.fft(np.fft.rfft(x, n=24, axis=-1), n=16, axis=-2)
+    assert f.dtype == np.complex64
+    np.testing.assert_allclose(f, ref, rtol=1e-4, atol=1e-4)
+    back = t.irfft(t.ifft(f, axis=-2), n=24)
+    np.testing.assert_allclose(back[:, :14, :18], x, atol=1e-5)
+    np.testing.assert_allclose(t.rfft(x, n=10), np.fft.rfft(x, n=10), rtol=1e-4, atol=1e-4)
 
 
 def test_scipys_transforms_load_without_scipy_fft_and_give_its_numbers():
@@ -97,4 +194,6 @@ def test_an_extension_that_no_longer_takes_scipys_arguments_falls_back_to_scipy_
     assert fft.transforms("scipy") is sfft
     monkeypatch.setattr(fft, "_POCKETFFT", [])
     monkeypatch.undo()
-    assert fft._works(fft._load_pocketfft())  # the installed scipy's extension passes the check
+    assert fft._works(
+        fft._Pocketfft(fft._load_pocketfft())
+    )  # the installed scipy's extension passes the check
