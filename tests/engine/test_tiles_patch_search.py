@@ -9,7 +9,7 @@ import pytest
 from engine.events import drain
 from engine.metrics import duplicates
 from engine.tiles import candidates, iter_candidates, make_candidate, make_seamless
-from engine.tiles.candidates import CandidatesNotice, default_min_distance
+from engine.tiles.candidates import SEARCH_BAND, CandidatesNotice, default_min_distance
 from tests.engine.helpers import smooth_texture
 
 COURSE = 16  # brick course height (px); mortar rows are the first 3 of every course
@@ -138,3 +138,22 @@ def test_flat_regions_give_no_duplicates_either():
         cands = candidates(S, st, 20, rng=1, workers=1)
     assert len(cands) < 20  # fewer, said why, rather than repeats
     assert duplicates(cands, st.tile).count == 0
+
+
+def test_the_global_search_matches_the_ring_where_the_cut_runs():
+    """The patch must fit the template in the ring's outer SEARCH_BAND px, where the
+    outward-drawn cut runs; what lies further in is the patch's own (matching it too made
+    every tile resemble the template there: a lattice). Of two planted windows, the one that
+    repeats the template's outer band wins over one that repeats the rest of its ring."""
+    S = smooth_texture((200, 200), 3, 11, 1.5)
+    st = make_seamless(S, (10, 10, 64, 64), overlap=8)
+    T = np.asarray(st.tile)
+    h, w = T.shape[:2]
+    r, c = np.mgrid[0:h, 0:w]
+    d = np.minimum.reduce([r, c, h - 1 - r, w - 1 - c])  # distance to the tile edge
+    outer = d < 1 + SEARCH_BAND  # the margin and the searched band
+    inner_ring = ~outer & (d < 8)  # the rest of the ring w_P = 8
+    for (y, x), part in (((120, 120), outer), ((120, 30), inner_ring)):
+        S[y : y + h, x : x + w][part] = T[part]
+    c = make_candidate(S, st, rng=0, tolerance=0.0)
+    assert c.patch_origin == (120, 120)
