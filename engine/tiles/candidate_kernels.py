@@ -1,0 +1,104 @@
+"""Numeric kernels of the candidate tiles (:mod:`engine.tiles.candidates`): the ring-band
+error of the local search, changed-pixel counts, mask runs, and whether a cut shows."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from engine._jit import njit
+
+__all__ = ["band_costs", "count_changed", "cut_shows", "natural_step", "true_runs"]
+
+#: σ (px) of the blur before the steps of :func:`cut_shows` / :func:`natural_step`: the frame
+#: metric's (:data:`engine.metrics.FRAME_SIGMA`), what a person sees at 100 %
+STEP_SIGMA = 1.0
+
+
+@njit(cache=True, nogil=True)
+def band_costs(S, Up, runs, y0, x0, out):  # pragma: no cover
+    """out[i, j] = mean over the band pixels (r, c) of d(S[y0+i+r, x0+j+c], U[r, c]).
+
+    ``S`` is (H, W, C) float32, ``Up`` channel-planar (C, h, w) float32; the band is given
+    as runs ``(r, c0, c1)`` of columns c0..c1-1 in row r. Positions j are the innermost loop
+    (SIMD); each run's sum is accumulated in float32, the total in float64.
+    """
+    ny, nx = out.shape
+    C = Up.shape[0]
+    n = 0
+    for k in range(runs.shape[0]):
+        n += runs[k, 2] - runs[k, 1]
+    acc = np.zeros((ny, nx))
+    row = np.empty(nx, dtype=np.float32)
+    for k in range(runs.shape[0]):
+        r, c0, c1 = runs[k, 0], runs[k, 1], runs[k, 2]
+        for i in range(ny):
+            y = y0 + i + r
+            row[:] = 0.0
+            for c in range(c0, c1):
+                x = x0 + c
+                if C == 3:
+                    u0, u1, u2 = Up[0, r, c], Up[1, r, c], Up[2, r, c]
+                    for j in range(nx):
+                        d0 = S[y, x + j, 0] - u0
+                        d1 = S[y, x + j, 1] - u1
+                        d2 = S[y, x + j, 2] - u2
+                        row[j] += math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+                else:
+                    for j in range(nx):
+                        t = np.float32(0.0)
+                        for ch in range(C):
+                            d = S[y, x + j, ch] - Up[ch, r, c]
+                            t += d * d
+                        row[j] += math.sqrt(t)
+            for j in range(nx):
+                acc[i, j] += row[j]
+    for i in range(ny):
+        for j in range(nx):
+            out[i, j] = acc[i, j] / n
+
+
+@njit(cache=True, nogil=True)
+def count_changed(a, b):  # pragma: no cover
+    """Number of pixels of (h, w, C) ``a`` and ``b`` that differ in any channel."""
+    n = 0
+    for y in range(a.shape[0]):
+        for x in range(a.shape[1]):
+            for c in range(a.shape[2]):
+                if a[y, x, c] != b[y, x, c]:
+                    n += 1
+                    break
+    return n
+
+
+def true_runs(mask: np.ndarray) -> np.ndarray:
+    """The True runs of a 2-D mask as rows ``(r, c0, c1)`` (columns c0..c1-1), row-major."""
+    m = np.pad(mask.astype(np.int8), ((0, 0), (1, 1)))
+    d = np.diff(m, axis=1)
+    r0, c0 = np.nonzero(d == 1)
+    _, c1 = np.nonzero(d == -1)
+    return np.ascontiguousarray(np.column_stack([r0, c0, c1]), dtype=np.int64)
+
+
+def _steps(lum: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """|vertical| and |horizontal| neighbour steps of a 2-D image blurred by STEP_SIGMA."""
+    from scipy import ndimage
+
+    b = ndimage.gaussian_filter(lum.astype(np.float32, copy=False), STEP_SIGMA, mode="nearest")
+    return np.abs(np.diff(b, axis=0)), np.abs(np.diff(b, axis=1))
+
+
+def natural_step(lum: np.ndarray) -> float:
+    """The texture's own mean neighbour step of a (H, W) luminance, blurred as in
+    :func:`cut_shows`."""
+    dy, dx = _steps(lum)
+    return float((dy.mean() + dx.mean()) / 2)
+
+
+def cut_shows(lum: np.ndarray, mask: np.ndarray, natural: float, limit: float) -> bool:
+    """Whether a cut shows: the mean step of the blurred luminance ``lum`` (h, w) between
+    4-neighbours on either side of ``mask``'s boundary is above ``limit`` x ``natural``."""
+    dy, dx = _steps(lum)
+    across = np.concatenate([dy[np.diff(mask, axis=0)], dx[np.diff(mask, axis=1)]])
+    return bool(across.size) and float(across.mean()) > limit * natural
