@@ -86,6 +86,10 @@ def wang_interior(value, name):
     return choice(value, name, ("patch", "diamonds"))
 
 
+def wang_interior_blend(value, name):
+    return choice(value, name, ("auto", *TILE_BLEND_MODES))
+
+
 def patch_search_mode(value, name):
     return choice(value, name, ("global", "local"))
 
@@ -138,7 +142,8 @@ class TilesetSettings:
     Wang set instead (:mod:`engine.tiles.wang`, when ``wang`` = K colours per edge direction
     is set): square tiles of ``tile_min`` = ``tile_max`` (None: a quarter of the source's
     shorter side), ``wang_variants`` per edge signature, ``wang_interior`` ("patch" or
-    "diamonds"), ``wang_band`` (None: about a tenth of the tile), ``wang_outward``,
+    "diamonds"), ``wang_interior_blend`` ("auto": gradient domain unless the seam's blend is
+    "none"), ``wang_band`` (None: about a tenth of the tile), ``wang_outward``,
     ``wang_tolerance``, ``wang_min_distance`` (None: half the tile); ``seed``, ``seam``,
     ``patch_overlap``, ``margin`` (None: 1), the preview and the exclusion as above.
     """
@@ -168,6 +173,7 @@ class TilesetSettings:
     wang: int | None = setting(None, optional(at_least(1)))
     wang_variants: int = setting(1, at_least(1))
     wang_interior: str = setting("patch", wang_interior)
+    wang_interior_blend: str = setting("auto", wang_interior_blend)
     wang_band: int | None = setting(None, optional(at_least(1)))
     wang_outward: float = setting(1.0, number)
     wang_tolerance: float = setting(0.1, number)

@@ -47,6 +47,13 @@ def add_wang_options(p, size) -> None:
         "the four edge diamonds alone (Cohen's construction)",
     )
     g.add_argument(
+        "--interior-blend",
+        choices=("auto", "none", "feather", "adaptive", "poisson"),
+        help="how the interior patch is blended into the tile's shared ring: auto (default) "
+        "in the gradient domain (tone continues across the tile lines) unless --blend none; "
+        "else this blend for the interior alone",
+    )
+    g.add_argument(
         "--wang-band",
         type=int_at_least(1),
         metavar="N",
@@ -79,6 +86,7 @@ _FIELDS = {
     "wang": "wang",
     "variants": "wang_variants",
     "interior": "wang_interior",
+    "interior_blend": "wang_interior_blend",
     "wang_band": "wang_band",
     "outward": "wang_outward",
     "wang_min_distance": "wang_min_distance",

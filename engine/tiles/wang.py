@@ -21,16 +21,18 @@ edge, whose halves lie in the two tiles. The complete set has one tile per edge 
    matcher against the frame's ring (offsets ``margin .. patch_overlap - 1``), drawn within
    ``tolerance`` and away from the samples and the other tiles' windows, stitched in along a
    closed cut inside that ring (:func:`engine.stitch.patch_cut`; the outer ``margin`` pixels
-   stay the frame's). Without it (``interior="diamonds"``, Cohen's construction) every pixel
-   of a tile is one of its four samples: a tile repeats a quarter of every tile of the same
-   colour, which a large layout shows as a lattice of repeated diamonds. With it only the
-   thin ring outside the cut is shared, and ``variants`` tiles per signature differ inside.
+   stay the frame's), blended in the gradient domain (``interior_blend``) so that its tone
+   continues the shared ring's. Without it (``interior="diamonds"``, Cohen's construction)
+   every pixel of a tile is one of its four samples: a tile repeats a quarter of every tile of
+   the same colour, which a large layout shows as a lattice of repeated diamonds. With it only
+   the thin ring outside the cut is shared, and ``variants`` tiles per signature differ inside.
 
 Tiles stream as :class:`WangTile` items (after one :class:`WangSamples` item); tile ``k`` is
 seeded from ``(seed, k)`` and its interior avoids the windows of tiles ``0 .. k-1`` only, so the
 same seed gives the same set on 1 or 2 workers. Material maps follow every cut
-(:func:`engine.materials.apply_cut`: normals renormalised); pixels away from the blends are
-copies of the source (16-bit values stay exact).
+(:func:`engine.materials.apply_cut`: normals renormalised); with hard cuts (``seam`` blend
+"none") every pixel is a copy of the source (16-bit values stay exact); the gradient-domain
+interior changes the values its correction reaches (the edge pixels stay the samples' own).
 """
 
 from __future__ import annotations
@@ -48,6 +50,7 @@ from engine.tiles.candidates import base_seed
 from engine.tiles.wang_setup import WangSetup
 from engine.tiles.wang_types import (
     AXES,
+    INTERIOR_BLENDS,
     INTERIORS,
     WANG_DEFAULTS,
     WangSample,
@@ -65,6 +68,7 @@ from engine.tiles.wang_types import (
 __all__ = [
     "AXES",
     "INTERIORS",
+    "INTERIOR_BLENDS",
     "WANG_DEFAULTS",
     "WangSample",
     "WangSamples",
@@ -161,6 +165,12 @@ def iter_wang_set(
         Tiles per edge signature (each with its own interior patch).
     interior : {"patch", "diamonds"}
         A matched source window inside each tile (default) or Cohen's four diamonds alone.
+    interior_blend : {"auto", "none", "feather", "adaptive", "poisson"}
+        How the interior patch is blended along its closed cut: ``"auto"`` (default) in the
+        gradient domain (:mod:`engine.poisson`, screened: the step between the window and
+        the shared ring is spread over both sides, so tone continues across the tile lines)
+        unless ``seam`` asks for hard cuts (blend "none"); otherwise that blend for the
+        interior alone (the frame's corner cuts always take ``seam``'s).
     patch_overlap, margin
         The ring the interior's closed cut runs in (default as the Somol set's w_P for a
         template overlap of T / 10) and the outer pixels that always stay the edge samples'

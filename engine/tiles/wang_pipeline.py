@@ -63,6 +63,7 @@ def wang_options(s: TilesetSettings) -> dict:
         colours=s.wang,
         variants=s.wang_variants,
         interior=s.wang_interior,
+        interior_blend=s.wang_interior_blend,
         band=s.wang_band,
         patch_overlap=s.patch_overlap,
         margin=s.margin,

@@ -15,7 +15,7 @@ from engine.events import frozen_array
 from engine.exclusion import valid_anchors
 from engine.matching import ZERO_ERROR_FRACTION, SampleSpectrum, error_floor
 from engine.matching import select_within_tolerance as _select
-from engine.seams.spec import as_seam_spec
+from engine.seams.spec import POISSON, as_seam_spec
 from engine.stitch import PATCH_SEAM
 from engine.tiles.candidates import check_ring, default_patch_overlap, stitch_patch
 from engine.tiles.seamless import MAIN, as_maps, check_weights, seam_error
@@ -26,6 +26,7 @@ from engine.tiles.wang_types import (
     CORNER_QUANTILE,
     CORNER_STEPS,
     DETAIL_QUANTILE,
+    INTERIOR_BLENDS,
     INTERIORS,
     PATCH_LABEL,
     ROLE_AXIS,
@@ -51,6 +52,7 @@ class WangSetup:
         opts = {**WANG_DEFAULTS, **options}
         colours, band, variants = opts.pop("colours"), opts.pop("band"), opts.pop("variants")
         interior, patch_overlap = opts.pop("interior"), opts.pop("patch_overlap")
+        interior_blend = opts.pop("interior_blend")
         margin, outward = opts.pop("margin"), opts.pop("outward")
         min_distance, tolerance = opts.pop("min_distance"), opts.pop("tolerance")
         seam = opts.pop("seam")
@@ -74,6 +76,13 @@ class WangSetup:
                 "signature would be the same tile)"
             )
         self.seam = as_seam_spec(seam, default=PATCH_SEAM)
+        self.interior_blend = choice(interior_blend, "interior_blend", INTERIOR_BLENDS)
+        if self.interior_blend == "auto":
+            blend = "none" if self.seam.blend == "none" else POISSON
+        else:
+            blend = self.interior_blend
+        #: the interior patch's cut: the seam with the interior's blend
+        self.interior_seam = self.seam.replace(blend=blend)
         self.reach = frame_reach(T, self.band, ramp_reach(self.seam))
         if min(H, W) < max(T, 2 * self.reach):
             need = 2 * self.reach
@@ -423,7 +432,7 @@ class WangSetup:
                 framed,
                 ring=self.ring,
                 margin=self.margin,
-                seam=self.seam,
+                seam=self.interior_seam,
                 weights=self.weights,
                 outward=self.outward,
                 depth=self.depth,
@@ -459,6 +468,7 @@ class WangSetup:
             "reach": self.reach,
             "variants": self.variants,
             "interior": self.interior,
+            "interior_blend": self.interior_blend,
             "patch_overlap": self.ring,
             "margin": self.margin,
             "outward": self.outward,

@@ -15,6 +15,7 @@ from engine.stitch import PATCH_SEAM
 __all__ = [
     "AXES",
     "INTERIORS",
+    "INTERIOR_BLENDS",
     "WANG_DEFAULTS",
     "WangSample",
     "WangSamples",
@@ -42,12 +43,18 @@ DETAIL_QUANTILE = 0.25
 CORNER_STEPS = 2.0
 CORNER_QUANTILE = 0.05
 
+#: How the interior patch is blended (``interior_blend``): "auto" = gradient domain unless the
+#: seam's blend is "none" (hard cuts asked for: every pixel stays a source copy), or one of
+#: :data:`engine.seams.spec.TILE_BLEND_MODES` for the interior alone.
+INTERIOR_BLENDS = ("auto", "none", "feather", "adaptive", "poisson")
+
 #: Options of :func:`iter_wang_set` and their defaults.
 WANG_DEFAULTS = {
     "colours": 2,
     "band": None,
     "variants": 1,
     "interior": "patch",
+    "interior_blend": "auto",
     "patch_overlap": None,
     "margin": 1,
     "outward": 1.0,

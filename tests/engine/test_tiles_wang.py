@@ -104,11 +104,19 @@ def test_interior_patch_is_stitched_inside_the_margin(source, k2):
         assert (t.labels[:m] != 4).all() and (t.labels[:, :m] != 4).all()
         assert (t.labels[-m:] != 4).all() and (t.labels[:, -m:] != 4).all()
         y, x = t.patch_origin
-        # deep inside the loop, pixels are the source window's
+        # deep inside the loop, pixels are the source window's plus the gradient-domain
+        # blend's smooth correction (screened: its Laplacian is the correction / reach²)
         deep = ndimage.binary_erosion(t.labels == 4, iterations=8)
-        np.testing.assert_array_equal(t.tile[deep], source[y : y + T, x : x + T][deep])
+        d = (t.tile - source[y : y + T, x : x + T]).astype(np.float64)
+        lap = np.stack([ndimage.laplace(d[..., c]) for c in range(d.shape[2])], axis=-1)
+        assert np.abs(lap[deep]).max() < 0.01
         origins.add(t.patch_origin)
     assert len(origins) == 16  # no two tiles share an interior
+    # hard-cut interiors: deep inside the loop the pixels are the window's own
+    (t,) = wang_set(source, tile_size=T, rng=5, tiles=[3], interior_blend="none").tiles
+    y, x = t.patch_origin
+    deep = ndimage.binary_erosion(t.labels == 4, iterations=8)
+    np.testing.assert_array_equal(t.tile[deep], source[y : y + T, x : x + T][deep])
 
 
 def test_streams_samples_then_tiles_and_progress(source):
@@ -349,3 +357,29 @@ def test_h_samples_keep_the_corner_steps_low(source, k2):
     e = setup.corner_errors([k2.sample("h", 0)])
     y, x = s.origin[0] - setup.reach, s.origin[1]
     assert np.mean(e < e[y, x]) < 0.08  # without the filter: 0.11 here (random: 0.5)
+
+
+def test_the_interior_is_blended_in_the_gradient_domain_unless_hard_cuts_are_asked_for(source):
+    from engine.tiles.wang import WangSetup
+
+    def blend(**kw):
+        return WangSetup(source, tile_size=T, **kw).interior_seam.blend
+
+    assert blend() == "poisson"
+    assert blend(seam=SeamSpec(blend="none")) == "none"  # hard cuts: every pixel a source copy
+    assert blend(interior_blend="adaptive", seam=SeamSpec(blend="none")) == "adaptive"
+    with pytest.raises(ValueError, match="interior_blend"):
+        WangSetup(source, tile_size=T, interior_blend="smooth")
+    # the same window, hard and blended: the blend changes pixels inside the tile, never the
+    # edge pixels the neighbours share
+    hard = make_wang_tile(source, samples_of(source), 3, tile_size=T, seed=1,
+                          interior_blend="none")  # fmt: skip
+    soft = make_wang_tile(source, samples_of(source), 3, tile_size=T, seed=1,
+                          patch_origin=hard.patch_origin)  # fmt: skip
+    for role in "nesw":
+        np.testing.assert_array_equal(tile_edge(soft.tile, role), tile_edge(hard.tile, role))
+    assert not np.array_equal(soft.tile, hard.tile)
+
+
+def samples_of(source):
+    return list(wang_set(source, tile_size=T, rng=5, tiles=[0]).samples)
