@@ -80,7 +80,15 @@ SAMPLES = ("brick", "cobblestones", "grass", "gravel", "lichen")
 #: The closed cut of the interior patch runs at distances ``margin .. patch_overlap - 1`` from
 #: the tile edge, drawn towards the margin by ``outward``.
 INTERIORS = {
-    "default": ({}, "ring w_P (8 px at 128), margin 1, outward 1: cut 1-3 px from the edge"),
+    "default": (
+        {},
+        "ring w_P (8 px at 128), margin 1, outward 1: cut 1-3 px from the edge, "
+        "gradient-domain interior (interior_blend auto)",
+    ),
+    "adaptive interior": (
+        {"interior_blend": "adaptive"},
+        "the same cut blended adaptively (the default before the gradient-domain interior)",
+    ),
     "free cut": ({"outward": 0.0}, "ring w_P, no outward bias"),
     "hugging cut": ({"outward": 3.0}, "ring w_P, outward 3"),
     "ring 16": ({"patch_overlap": 16, "outward": 2.0}, "ring 16 px, outward 2"),
@@ -91,7 +99,7 @@ INTERIORS = {
         "Cohen's diamonds, a centre patch cut at T/6-T/3 from the edges",
     ),
     "Cohen diamonds": ({"interior": "diamonds"}, "the four diamonds alone"),
-    "gradient blend": ("poisson", "ring w_P, gradient-domain blend of the patch"),
+    "gradient blend": ("poisson", "ring w_P, gradient-domain blend, frame cuts hard too"),
 }
 
 
