@@ -314,7 +314,7 @@ def quality(which: str, tile: int, docs: Path | None, seeds: int = 3) -> str:
                 T,
                 f"{wmed:.2f} / {wmax:.2f}",
                 f"{wcont:+.2f} ({wl:+.2f})",
-                f"{wf:.2f}",
+                f"{wf:.3f}",
                 f"{wd:.2f} ({wraw:.2f})",
                 f"{wc:.2f} ({wj:.2f})",
                 *somol,
