@@ -258,10 +258,11 @@ class _Ducc:
         )
 
 
+F32, C64 = np.dtype(np.float32), np.dtype(np.complex64)
 BUFFER_BYTES = 16 * 2**20
 """Largest work buffer a thread keeps between queries of one :class:`PrunedTransforms` (larger
 ones, e.g. a large sample's, are allocated per call: their transforms dwarf the allocation); a
-thread keeps at most twice this, in at most 8 buffers (a query needs 7)."""
+thread keeps about twice this at most."""
 
 
 class PrunedTransforms:
@@ -278,19 +279,24 @@ class PrunedTransforms:
         self.padded = padded
         self._local = threading.local()
 
-    def _buffer(self, name: str, shape: tuple, dtype) -> np.ndarray | None:
-        """A zero-filled buffer the calling thread keeps (None: too large to keep)."""
-        size = math.prod(shape) * np.dtype(dtype).itemsize
-        if size > BUFFER_BYTES:
-            return None
+    def _scratch(self, name: str, shape: tuple, dtype, tag=None):
+        """``(buffer, same)``: a buffer of ``shape`` the calling thread keeps for queries of the
+        same batch and channel count (None if too large to keep); ``same`` tells that its last
+        use had this shape and ``tag``, so what the caller left zero then is zero still."""
         bufs = self._local.__dict__.setdefault("bufs", {})
-        key = (name, shape, dtype)
-        buf = bufs.get(key)
-        if buf is None:
-            if len(bufs) >= 8 or sum(b.nbytes for b in bufs.values()) + size > 2 * BUFFER_BYTES:
-                bufs.clear()  # another shape (edge blocks): keep only what this one needs
-            buf = bufs[key] = np.zeros(shape, dtype)
-        return buf
+        key = (name, shape[:-2], dtype)
+        entry = bufs.get(key)
+        size = math.prod(shape)
+        if entry is None or entry[0].size < size:
+            nbytes = size * np.dtype(dtype).itemsize
+            if nbytes > BUFFER_BYTES:
+                return None, False
+            if len(bufs) >= 16 or sum(e[0].nbytes for e in bufs.values()) > BUFFER_BYTES:
+                bufs.clear()
+            entry = bufs[key] = [np.zeros(size, dtype), None]
+        same = entry[1] == (shape, tag)
+        entry[1] = (shape, tag)
+        return entry[0][:size].reshape(shape), same
 
     def spectra(self, k: np.ndarray, workers: int, *, conj: bool, keep: bool = False):
         """The 2-D DFT (``conj``: its complex conjugate, by the transforms of opposite sign) of
@@ -301,18 +307,22 @@ class PrunedTransforms:
         lead = tuple(lead)
         wh = wp // 2 + 1
         fwd = not conj
-        # columns past kw and rows past kh stay 0 in the thread's buffers
-        pad = None if keep else self._buffer(f"pad{kw}", (*lead, kh, wp), np.float32)
+        # columns past kw and rows past kh are zero (set again only when the shape changed)
+        pad, same = (None, False) if keep else self._scratch("pad", (*lead, kh, wp), F32, kw)
         if pad is None:
             pad = np.zeros((*lead, kh, wp), np.float32)
+        elif not same:
+            pad[..., kw:] = 0
         pad[..., :kw] = k
-        rows = None if keep else self._buffer(f"rows{kh}", (*lead, hp, wh), np.complex64)
+        rows, same = (None, False) if keep else self._scratch("rows", (*lead, hp, wh), C64, kh)
         if rows is None:
             rows = np.zeros((*lead, hp, wh), np.complex64)
             self.m.r2c(pad, axes=(-1,), forward=fwd, out=rows[..., :kh, :], nthreads=workers)
             return self.m.c2c(rows, axes=(-2,), forward=fwd, out=rows, nthreads=workers)
+        if not same:
+            rows[..., kh:, :] = 0
         self.m.r2c(pad, axes=(-1,), forward=fwd, out=rows[..., :kh, :], nthreads=workers)
-        out = self._buffer("spectra", rows.shape, np.complex64)
+        out, _ = self._scratch("spectra", rows.shape, C64)
         return self.m.c2c(rows, axes=(-2,), forward=fwd, out=out, nthreads=workers)
 
     def inverse(self, x: np.ndarray, rows: int, workers: int) -> np.ndarray:
@@ -321,7 +331,7 @@ class PrunedTransforms:
         its next call). ``x`` is overwritten."""
         hp, wp = self.padded
         self.m.c2c(x, axes=(-2,), forward=False, out=x, nthreads=workers)
-        out = self._buffer("inverse", (*x.shape[:-2], rows, wp), np.float32)
+        out, _ = self._scratch("inverse", (*x.shape[:-2], rows, wp), F32)
         return self.m.c2r(
             x[..., :rows, :], axes=(-1,), lastsize=wp, forward=False, out=out, nthreads=workers
         )

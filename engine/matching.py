@@ -534,7 +534,7 @@ def _estimates(q, features, base, base_row, invalid, out):  # pragma: no cover -
         for j in range(nn):
             row[j] = b[j]
         for k in range(kk):
-            c = -2.0 * q[i, k]
+            c = np.float32(-2.0) * q[i, k]  # float32 products: twice the vector width
             if c == 0.0:
                 continue
             f = features[k]
