@@ -20,7 +20,9 @@ helper threads spent during the runs (0 when every product stays on the calling 
 should on a small shared machine). Then: the streaming overhead (``quilt`` draining every event
 vs the same run creating none, the two run in turn), and the quality figures: grid border ratio
 of best+dp vs best+straight vs random on every bundled sample, and the mean seam peak of Long &
-Mould's minimax at half-block overlap vs dp at the same overlap. Between them the large jobs of
+Mould's minimax at half-block overlap vs dp at the same overlap. After the speed rows, the FFT
+backends compared (:mod:`benchmarks.fft_backends`: ducc0 vs scipy's pocketfft). Between them the
+large jobs of
 :mod:`benchmarks.quilting_large` (4096² and 8192² samples in ``auto``, transfer at 4096²;
 ``--large-quality`` adds auto vs exact at 4096²). Everything printed is also written to
 ``benchmarks/results/quilting.txt``.
@@ -43,7 +45,7 @@ from scipy import signal
 if __package__ in (None, ""):  # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from benchmarks import quilting_large  # noqa: E402
+from benchmarks import fft_backends, quilting_large  # noqa: E402
 from benchmarks._util import Tee, format_table, median_time, provenance  # noqa: E402
 from engine.errormap import error_map  # noqa: E402
 from engine.io import load_image  # noqa: E402
@@ -453,6 +455,7 @@ def main(argv=None) -> int:
     )
     p.add_argument("--skip-speed", action="store_true")
     p.add_argument("--skip-quality", action="store_true")
+    p.add_argument("--skip-fft", action="store_true", help="skip the FFT backends' comparison")
     p.add_argument("--skip-large", action="store_true", help="skip the 4096²/8192² jobs")
     p.add_argument(
         "--large-quality",
@@ -472,6 +475,9 @@ def main(argv=None) -> int:
         if not args.skip_speed:
             speed(args)
             streaming(args)
+        if not args.skip_fft:
+            jobs = {k: JOBS[k] for k in args.jobs}
+            fft_backends.compare(load_sample(args.sample, 256), jobs, repeats=args.repeats)
         if not args.skip_large:
             quilting_large.large(
                 argparse.Namespace(**{**vars(args), "repeats": args.large_repeats})

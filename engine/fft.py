@@ -13,6 +13,7 @@ last bits). scipy's transforms come from its pocketfft extension loaded by itsel
 from __future__ import annotations
 
 import math
+import os
 import threading
 
 import numpy as np
@@ -20,6 +21,7 @@ import numpy as np
 __all__ = [
     "BACKENDS",
     "BUFFER_BYTES",
+    "ENV",
     "PrunedTransforms",
     "default_backend",
     "next_fast_len",
@@ -81,13 +83,20 @@ def transforms(backend: str = "scipy"):
     return _scipy()
 
 
+ENV = "QUILT_STUDIO_FFT"
+"""Environment variable that picks the search's transforms: ``scipy`` (or ``ducc0``)."""
+
+
 def default_backend() -> str:
     """``"ducc0"`` when ducc0 is installed (and computes a small transform right), else
-    ``"scipy"``. The rule behind every exact search's transforms: it depends on what is
-    installed only, never on timing or on what happens to be imported, so the same inputs give
-    the same output in every run on one installation (the two round differently in the last
-    bits)."""
-    return "scipy" if _ducc0() is None else "ducc0"
+    ``"scipy"``; ``QUILT_STUDIO_FFT=scipy`` in the environment asks for scipy's (benchmarks
+    compare the two). The rule behind every exact search's transforms: it depends on what is
+    installed and on that variable only, never on timing or on what happens to be imported, so
+    the same inputs give the same output in every run on one installation (the two round
+    differently in the last bits)."""
+    if os.environ.get(ENV, "").strip().lower() == "scipy" or _ducc0() is None:
+        return "scipy"
+    return "ducc0"
 
 
 _DUCC: list = []  # ducc0.fft once imported (None: not installed or not working)

@@ -74,6 +74,14 @@ def test_every_run_takes_the_installed_backend_and_small_ones_time_no_reference(
     assert len(timed) == 4
 
 
+def test_the_environment_can_ask_for_scipys_transforms(monkeypatch):
+    monkeypatch.setenv(fft.ENV, "scipy")
+    assert default_backend() == "scipy" and _plan(128, 512).fft == "scipy"
+    assert SampleSpectrum(np.zeros((20, 20, 3), np.float32)).backend == "scipy"
+    monkeypatch.setenv(fft.ENV, "ducc0")
+    assert default_backend() == "ducc0"
+
+
 def test_without_ducc0_every_run_takes_scipys_pocketfft():
     """The fallback: with ducc0 not importable the backend is scipy's, chosen before any run,
     and a quilting job runs on it (no scipy.fft import for a small job either)."""
