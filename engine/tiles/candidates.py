@@ -107,6 +107,12 @@ OUTWARD = 1.0
 #: (tone blocks and hard tile edges gone) but lattice +5.0 -> +8.4 dB; coins frame 2.02 ->
 #: 1.07; the others unchanged. 0 turns it off.
 SEAM_SHOWS = 1.75
+#: ... but only for patch windows of at most this many pixels: one solve of a 1024 x 1024 window
+#: costs about a second, and the upsampled 4096 px stand-in photo of the speed benchmark has
+#: cuts that show, so 30 such candidates took 4x the 10 s of issue 10's speed line (measured:
+#: 4 candidates 3.5 -> 8.9 s under load). Larger tiles keep the hard cut unless
+#: ``--blend poisson`` is asked for.
+SEAM_SHOWS_MAX_PIXELS = 512 * 512
 #: blend "poisson": the correction fades over about this many rings' widths from the cut (a
 #: screened solve), so a patch keeps its own tone inside instead of taking the shared ring's
 POISSON_REACH = 2.0
@@ -319,7 +325,12 @@ class _Setup:
         # inner edge (added to the error map the cut is searched on)
         depth = np.clip((d - self.margin) / max(1, self.ring - 1 - self.margin), 0, 1)
         self.bias = np.where(d < self.ring, depth, 0.0)
-        reblend = self.seam_shows > 0 and self.seam.blend == "adaptive" and self.margin > 0
+        reblend = (
+            self.seam_shows > 0
+            and self.seam.blend == "adaptive"
+            and self.margin > 0
+            and ph * pw <= SEAM_SHOWS_MAX_PIXELS
+        )
         y, x = max(0, (H - 1024) // 2), max(0, (W - 1024) // 2)  # a central crop is enough
         crop = self.S[y : y + 1024, x : x + 1024]
         self.natural = natural_step(self._luminance(crop)) if reblend else None
@@ -577,7 +588,8 @@ def iter_candidates(
     seam_shows : float
         With the default blend "adaptive": a candidate whose cut's step is above this
         multiple of the source's own step is blended in the gradient domain instead
-        (:data:`SEAM_SHOWS`; 0 = never; its ``scores["gradient_blend"]`` is 1).
+        (:data:`SEAM_SHOWS`; 0 = never; its ``scores["gradient_blend"]`` is 1); patches
+        larger than :data:`SEAM_SHOWS_MAX_PIXELS` never are.
     seam : SeamSpec, optional
         Seam method and options, error metric and blending of the patch cuts (default
         :data:`engine.stitch.PATCH_SEAM`: dp with adaptive blending).

@@ -36,3 +36,18 @@ def test_cuts_that_show_are_blended_and_the_border_is_kept():
         assert np.array_equal(t[0], T[0]) and np.array_equal(t[:, -1], T[:, -1])
         if not c.scores["gradient_blend"]:
             assert np.array_equal(t, np.asarray(h.tile))
+
+
+def test_large_patches_keep_the_hard_cut(monkeypatch):
+    """Above SEAM_SHOWS_MAX_PIXELS the re-blend is skipped (its solve would break the speed
+    line of 1024 px tiles)."""
+    import importlib
+
+    module = importlib.import_module("engine.tiles.candidates")
+    monkeypatch.setattr(module, "SEAM_SHOWS_MAX_PIXELS", 64 * 64 - 1)
+    S = smooth_texture((160, 160), 3, 4, 4.0)
+    st = make_seamless(S, (20, 20, 64, 64), overlap=8)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        cands = candidates(S, st, 8, rng=1, workers=1)
+    assert not any(c.scores["gradient_blend"] for c in cands)
