@@ -8,7 +8,7 @@ manifest and project, the editor reads and writes the same dict in its project f
 project moves between them with every option.
 
 Adding an option is one line: a field with its default and its check, e.g.
-``flatten: bool = setting(False, boolean)``. ``None`` means "chosen from the source" where a
+``whole_structures: bool = setting(True, boolean)``. ``None`` means "chosen from the source" where a
 field allows it (:func:`engine.tiles.pipeline.resolve` fills those in).
 
 Project files keep the dict under ``parameters["tileset"]``; :func:`settings_from_parameters`
@@ -135,7 +135,10 @@ class TilesetSettings:
     w_P - 1), ``patch_search`` ("global": the best ring matches over the whole source, kept
     ``min_distance`` apart (None: :func:`engine.tiles.default_min_distance`); "local": the
     paper's random position refined within ``neighbourhood``). ``flatten``: Flatten lighting
-    of the source (albedo only) before everything (:mod:`engine.tone`). Preview: ``preview`` (rows,
+    of the source (albedo only) before everything (:mod:`engine.tone`); None (default): "from
+    the source" — when the stationarity check finds the lighting uneven on an otherwise
+    stationary photo, flatten it and blend the cuts in the gradient domain
+    (:func:`engine.tiles.pipeline.auto_tone`). Preview: ``preview`` (rows,
     cols), ``no_equal_neighbours``, ``layout_seed`` (None: ``seed``). ``exclude_color``: a
     colour range (lo, hi) no tile or patch may contain.
 
@@ -165,7 +168,7 @@ class TilesetSettings:
     neighbourhood: int = setting(5, at_least(0))
     patch_search: str = setting("global", patch_search_mode)
     min_distance: int | None = setting(None, optional(at_least(0)))
-    flatten: bool = setting(False, boolean)
+    flatten: bool | None = setting(None, optional(boolean))
     preview: tuple[int, int] = setting((8, 8), as_size)
     no_equal_neighbours: bool = setting(True, boolean)
     layout_seed: int | None = setting(None, optional(at_least(0)))

@@ -92,7 +92,7 @@ class HealTool(QObject):
             label=f"Healing {int(mask.sum())} pixels",
             exclusion=self.pipeline.exclusion(),
             maps=doc.source.extra_maps or None,
-            seam=self.pipeline.settings().seam,
+            seam=doc.tileset.settings().seam,  # the parameters' own (Auto tone is for tiles)
             rng=int(doc.params["seed"]),
             threads=2,
             on_event=self._on_event,

@@ -188,6 +188,18 @@ PARAMS: tuple[Param, ...] = (
         step=0.1,
         paper="Our addition to Somol & Haindl's search: κ, the weight of the detail term",
     ),
+    _P(
+        "flatten",
+        "auto",
+        "Flatten lighting",
+        "Divide out the photo's uneven lighting (a smooth light field at the tile's scale) "
+        "before everything; the colour map only, never normal or height maps. Auto: on, with "
+        "the gradient-domain seam blending, when the lighting varies across an otherwise even "
+        "photo (the banner says so).",
+        "Tile",
+        paper="Issue 10: Flatten lighting (quilt-studio tileset --flatten / --no-flatten)",
+        **_choices(("auto", "on", "off"), {"auto": "Auto", "on": "On", "off": "Off"}),
+    ),
     # -- seams
     _P(
         "method",

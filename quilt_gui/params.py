@@ -123,8 +123,10 @@ _RENAMED = {"n_candidates": "candidates"}
 #: editor parameters that make up one settings field (or its seam)
 _COMPOSED = frozenset(
     {"tile_size", "method", "metric", "blend", "width", "rho", "template_blend"}
-    | {"preview_rows", "preview_cols", "exclude_color", "exclude_tolerance"}
+    | {"preview_rows", "preview_cols", "exclude_color", "exclude_tolerance", "flatten"}
 )
+#: the Flatten lighting parameter's values and the settings' (None: "from the source")
+_FLATTEN = {"auto": None, "on": True, "off": False}
 _FIELDS = {f.name for f in dataclasses.fields(TilesetSettings)}
 #: the parameters :func:`tileset_settings` reads (the other parameters are the editor's own)
 TILESET_KEYS = frozenset(k for k in BY_KEY if k in _FIELDS or k in _RENAMED or k in _COMPOSED) - {
@@ -188,7 +190,7 @@ def output_shape(p: dict, source_shape) -> tuple[int, int]:
 
 #: the settings fields :func:`tileset_settings` makes from parameters of other names
 _SET_HERE = {"tile_size", "tile_min", "tile_max", "overlap", "seam", "template_blend"}
-_SET_HERE |= {"patch_size", "patch_overlap", "preview", "exclude_color"}
+_SET_HERE |= {"patch_size", "patch_overlap", "preview", "exclude_color", "flatten"}
 #: the settings fields no editor parameter shows: a project's values of them are kept under
 #: this key of the parameters and used as they are (an option added to TilesetSettings before
 #: the editor has a control for it still travels from the command line to the editor and back)
@@ -215,6 +217,7 @@ def tileset_settings(p: dict, shape=None) -> TilesetSettings:
         patch_overlap=p["patch_overlap"] if p["patch_overlap"] >= 2 else None,  # 0: auto
         preview=(p["preview_rows"], p["preview_cols"]),
         exclude_color=colour_range_around(p["exclude_color"], p["exclude_tolerance"]),
+        flatten=_FLATTEN[p["flatten"]],
     )
     return base.replace(**values)
 
@@ -250,6 +253,7 @@ def settings_params(s: TilesetSettings) -> dict:
         patch_overlap=s.patch_overlap or 0,
         patch_size=min(s.patch_size) if s.patch_size else 0,
         layout_seed=s.seed if s.layout_seed is None else s.layout_seed,
+        flatten={v: k for k, v in _FLATTEN.items()}[s.flatten],
     )
     for option, value in seam.options.items():
         key = _option_key(option, seam.method)

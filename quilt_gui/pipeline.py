@@ -184,8 +184,10 @@ class Pipeline(QObject):
         self.message.emit(
             "info", f"Best tile: {w}x{h} at ({x}, {y}), border cost {template.cost:.4f}"
         )
-        if template.warnings:  # after the info line, so the banner keeps them, all at once
-            self.message.emit("warning", "\n".join(template.warnings))
+        self.settings()  # the source's Auto tone note, said with the search's warnings
+        notes = [self.doc.tileset.tone_note, *template.warnings]
+        if any(notes):  # after the info line, so the banner keeps them, all at once
+            self.message.emit("warning", "\n".join(n for n in notes if n))
         self.template_searching.emit(False)
 
     def _on_template_error(self, exc) -> None:
@@ -282,8 +284,9 @@ class Pipeline(QObject):
             self._error(exc)
 
     def settings(self):
-        """The tile set's :class:`engine.tiles.TilesetSettings`, from the parameters."""
-        return self.doc.tileset.settings()
+        """The tile set's :class:`engine.tiles.TilesetSettings`, from the parameters (Flatten
+        lighting's Auto decided for the source: ``doc.tileset.working_settings()``)."""
+        return self.doc.tileset.working_settings()
 
     def flatten_scale(self) -> int | None:
         """The scale the tiles' source is flattened at (TilesetSettings.flatten), or None."""

@@ -44,6 +44,8 @@ class TileSetDocument(QObject):
         self.waypoints: dict[str, list[tuple[int, int]]] = {k: [] for k in WAYPOINT_KEYS}
         self.map_weights: dict[str, float] = {}  # seam-error weight per map; {} = main only
         self.seamless = None  # engine SeamlessTile (derived)
+        self.tone_note: str | None = None  # what Flatten lighting's Auto switched on
+        self._tone = None  # (inputs, settings, note) of the last Auto decision
         self.candidates: list[CandidateTile] = []
         self.picks: list[int] = []
         self.layout: np.ndarray | None = None
@@ -110,6 +112,23 @@ class TileSetDocument(QObject):
         """The tile set's :class:`engine.settings.TilesetSettings` for the source at hand."""
         source = self.root.source
         return params.tileset_settings(self.root.params, None if source is None else source.shape)
+
+    def working_settings(self):
+        """:meth:`settings` with Flatten lighting's Auto decided for the source at hand
+        (:func:`engine.tiles.pipeline.auto_tone`: the settings every job runs with) and
+        :attr:`tone_note`, the sentence saying what Auto switched on (None: nothing)."""
+        from engine.tiles.pipeline import auto_tone
+
+        s, source = self.settings(), self.root.source
+        self.tone_note = None
+        if source is None or s.flatten is not None:
+            return s
+        key = (id(source.main), source.main.shape, s)
+        cached = getattr(self, "_tone", None)
+        if cached is None or cached[0] != key:
+            self._tone = (key, *auto_tone(s, source.main))
+        self.tone_note = self._tone[2]
+        return self._tone[1]
 
     def overlap(self) -> int:
         """w_T, the Seam search width: the parameter, or (auto) about a tenth of the tile."""

@@ -68,7 +68,13 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "--flatten",
         action="store_true",
         help="flatten each photo's lighting before the template search (the low-frequency "
-        "illumination removed, as the tileset command's --flatten)",
+        "illumination removed, as the tileset command's --flatten; default: automatic, as "
+        "there)",
+    )
+    p.add_argument(
+        "--no-flatten",
+        action="store_true",
+        help="never flatten the lighting (the tileset command's --no-flatten)",
     )
     p.add_argument(
         "--settings",
@@ -125,7 +131,7 @@ def _settings(args, fail):
             ("candidates", args.candidates),
             ("wang", args.wang),
             ("seed", args.seed),
-            ("flatten", True if args.flatten else None),
+            ("flatten", True if args.flatten else False if args.no_flatten else None),
         )
         if v is not None
     }

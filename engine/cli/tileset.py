@@ -217,7 +217,15 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         default=None,
         help="Flatten lighting: divide out the source's low-frequency illumination (a smooth "
         "field at the scale of the largest tile, mean colour kept) before the search; the "
-        "albedo only, never the --map material maps",
+        "albedo only, never the --map material maps. Default: automatic — on, with the "
+        "gradient-domain blend of the cuts, when the lighting varies across an otherwise "
+        "even photo (said on stderr and in the manifest's warnings)",
+    )
+    p.add_argument(
+        "--no-flatten",
+        dest="flatten",
+        action="store_false",
+        help="never flatten the lighting (and keep the default blending)",
     )
     p.add_argument("--seam", choices=METHODS, help=f"seam method (default {d.seam.method})")
     add_seam_options(p)

@@ -148,7 +148,8 @@ class PreviewView(QWidget):
             return
         from engine.tiles.pipeline import resolve
 
-        s = resolve(doc.tileset.settings(), doc.source.shape, overlap=doc.tileset.overlap())
+        s = doc.tileset.working_settings()
+        s = resolve(s, doc.source.shape, overlap=doc.tileset.overlap())
         jobs.start(
             "set_quality",
             set_quality,

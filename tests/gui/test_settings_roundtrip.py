@@ -47,7 +47,7 @@ FLAGS = {
     "--neighbourhood": "2",
     "--preview": "3x4",
     "--exclude-color": "0,0,0:0.12,0.12,0.12",
-    "--patch-search": "local",  # the editor has no control for these three yet: they are
+    "--patch-search": "local",  # the editor has no control for these two yet: they are
     "--min-distance": "7",  # kept with the project and used as they are
     "--flatten": None,
     "--cut-structures": None,
@@ -169,6 +169,7 @@ NOT_IN_FLAGS = {
     "--exclude-mask": "given above (the painted mask)",
     "--pick": "given above",
     "--equal-neighbours": "given above",
+    "--no-flatten": "the same field as --flatten (given above), set to False",
     # a Wang set is another workflow; its settings fields are in EVERY_FIELD below
     "--wang": "Wang",
     "--tile-size": "Wang",
