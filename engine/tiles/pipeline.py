@@ -150,7 +150,7 @@ def auto_tone(settings: TilesetSettings, source) -> tuple[TilesetSettings, str |
         return settings.replace(flatten=False), None
     default = TilesetSettings()
     blend = settings.seam.blend == default.seam.blend
-    blend = blend and settings.template_blend == default.template_blend
+    blend = blend and settings.template_blend in (default.template_blend, None)  # None: as seam
     changes = {"flatten": True}
     if blend:
         changes.update(seam=settings.seam.replace(blend=POISSON), template_blend=None)
