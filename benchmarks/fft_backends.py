@@ -1,7 +1,8 @@
 """The block search's FFT backends compared: ducc0 (the default when installed) and scipy's
 pocketfft (the fallback), on the exact search of quilting jobs A and B (:mod:`benchmarks.quilting`).
 
-Run ``python benchmarks/fft_backends.py`` (also run by ``benchmarks/quilting.py``). Rows: one
+Run ``python benchmarks/fft_backends.py`` (also run by ``benchmarks/quilting.py``; alone it
+writes ``benchmarks/results/fft_backends.txt``). Rows: one
 query (:meth:`engine.matching.SampleSpectrum.ssd` of a batch of blocks, as the job sends it) and
 the whole job on 1 and 2 threads, each backend in turn (``QUILT_STUDIO_FFT``), medians of
 interleaved repeats; the load average is printed (rerun on a quiet machine).
@@ -10,6 +11,8 @@ interleaved repeats; the load average is printed (rerun on a quiet machine).
 from __future__ import annotations
 
 import argparse
+import contextlib
+import io
 import os
 import sys
 import time
@@ -20,7 +23,7 @@ import numpy as np
 if __package__ in (None, ""):  # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from benchmarks._util import format_table  # noqa: E402
+from benchmarks._util import Tee, format_table, provenance  # noqa: E402
 from engine import fft  # noqa: E402
 from engine.matching import SampleSpectrum  # noqa: E402
 from engine.quilting import quilt  # noqa: E402
@@ -116,8 +119,16 @@ def main(argv=None) -> int:
     args = p.parse_args(argv)
     sample = load_sample("cobblestones", 256)
     quilt(sample[:128, :128], (256, 256), block=32, overlap=6, rng=0, mode="fast")  # kernels
-    compare(sample, JOBS, repeats=args.repeats)
+    out = io.StringIO()
+    with contextlib.redirect_stdout(Tee(sys.stdout, out)):
+        print(f"{provenance()}\npython benchmarks/fft_backends.py\n")
+        compare(sample, JOBS, repeats=args.repeats)
+    RESULTS.parent.mkdir(exist_ok=True)
+    RESULTS.write_text(out.getvalue())
     return 0
+
+
+RESULTS = Path(__file__).resolve().parent / "results" / "fft_backends.txt"
 
 
 if __name__ == "__main__":

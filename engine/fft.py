@@ -1,8 +1,7 @@
 """The block search's FFTs: ducc0 when installed, else scipy's pocketfft (or numpy.fft).
 
-ducc0 (by pocketfft's author) is the default: 20-30 % faster at the search's sizes, and its
-``out=`` buffers and unnormalised transforms let :class:`PrunedTransforms` skip the
-allocations, zero-filling and normalisation passes of a query. Which backend a run uses is
+ducc0 (by pocketfft's author) is the default: a query of job B's exact search takes 8-13 %
+less time with it (``benchmarks/fft_backends.py``, README). Which backend a run uses is
 :func:`default_backend`'s rule: ducc0 if it is installed (and works), else scipy's pocketfft —
 decided by the installation alone, never by timing or by what happens to be imported, so the
 same inputs give the same output on one installation (the backends round differently in the
@@ -12,7 +11,6 @@ last bits). scipy's transforms come from its pocketfft extension loaded by itsel
 
 from __future__ import annotations
 
-import math
 import os
 import threading
 
@@ -20,9 +18,7 @@ import numpy as np
 
 __all__ = [
     "BACKENDS",
-    "BUFFER_BYTES",
     "ENV",
-    "PrunedTransforms",
     "default_backend",
     "next_fast_len",
     "transforms",
@@ -109,7 +105,7 @@ def _ducc0():
                 import ducc0.fft as module
             except ImportError:
                 module = None
-            ok = module is not None and _works(_Ducc(module)) and _pruned_works(module)
+            ok = module is not None and _works(_Ducc(module))
             _DUCC.append(module if ok else None)
     return _DUCC[0]
 
@@ -173,26 +169,6 @@ def _works(t) -> bool:
     )
 
 
-def _pruned_works(module) -> bool:
-    """Whether :class:`PrunedTransforms` (the ``out=``, ``forward=`` and ``lastsize=`` of
-    ducc0's calls) gives numpy's 2-D transforms of a small array and back."""
-    x = np.random.default_rng(0).random((2, 5, 7), dtype=np.float32)
-    ref = np.fft.rfft2(x, s=(8, 12))
-    try:
-        p = PrunedTransforms(module, (8, 12))
-        f = p.spectra(x, 1, conj=False, keep=True)
-        g = p.spectra(x, 1, conj=True)
-        back = p.inverse(f.copy(), 5, 1) / 96
-    except Exception:
-        return False
-    return bool(
-        np.allclose(f, ref, rtol=1e-4, atol=1e-4)
-        and np.allclose(g, ref.conj(), rtol=1e-4, atol=1e-4)
-        and np.allclose(back[..., :7], x, atol=1e-5)
-        and back.dtype == np.float32
-    )
-
-
 class _Pocketfft:
     """scipy.fft's ``rfft``, ``fft``, ``ifft``, ``irfft`` (for native float32/complex64 input,
     default norm) calling its extension as scipy.fft does (``scipy/fft/_pocketfft/basic.py``)."""
@@ -235,9 +211,7 @@ class _Pocketfft:
 
 class _Ducc:
     """``rfft``, ``fft``, ``ifft``, ``irfft`` with scipy.fft's signature from ``ducc0.fft``
-    (the successor of pocketfft by its author: 20-30 % faster at the search's sizes, measured
-    in benchmarks/quilting.py). :class:`engine.matching.SampleSpectrum` also calls the module
-    (``.m``) directly, with buffers of its own."""
+    (the successor of pocketfft by its author)."""
 
     def __init__(self, module):
         self.m = module
@@ -264,83 +238,4 @@ class _Ducc:
         tmp, _ = self._padded(x, n // 2 + 1, axis)
         return self.m.c2r(
             tmp, axes=(axis,), lastsize=n, forward=False, inorm=2, nthreads=workers or 1
-        )
-
-
-F32, C64 = np.dtype(np.float32), np.dtype(np.complex64)
-BUFFER_BYTES = 16 * 2**20
-"""Largest work buffer a thread keeps between queries of one :class:`PrunedTransforms` (larger
-ones, e.g. a large sample's, are allocated per call: their transforms dwarf the allocation); a
-thread keeps about twice this at most."""
-
-
-class PrunedTransforms:
-    """The block search's 2-D transforms at one padded shape (hp, wp), from ducc0.
-
-    Kernels are small (kh, kw) arrays zero-padded to (hp, wp): the row transforms run over
-    their kh rows only, and the column transforms read a buffer whose rows past kh stay zero;
-    the padded inputs and the spectra live in buffers each thread reuses (no allocation, no
-    zero-filling per query). Nothing is normalised: the caller folds 1 / (hp wp) into the
-    sample's spectra (:class:`engine.matching.SampleSpectrum`)."""
-
-    def __init__(self, module, padded: tuple[int, int]):
-        self.m = module
-        self.padded = padded
-        self._local = threading.local()
-
-    def _scratch(self, name: str, shape: tuple, dtype, tag=None):
-        """``(buffer, same)``: a buffer of ``shape`` the calling thread keeps for queries of the
-        same batch and channel count (None if too large to keep); ``same`` tells that its last
-        use had this shape and ``tag``, so what the caller left zero then is zero still."""
-        bufs = self._local.__dict__.setdefault("bufs", {})
-        key = (name, shape[:-2], dtype)
-        entry = bufs.get(key)
-        size = math.prod(shape)
-        if entry is None or entry[0].size < size:
-            nbytes = size * np.dtype(dtype).itemsize
-            if nbytes > BUFFER_BYTES:
-                return None, False
-            if len(bufs) >= 16 or sum(e[0].nbytes for e in bufs.values()) > BUFFER_BYTES:
-                bufs.clear()
-            entry = bufs[key] = [np.zeros(size, dtype), None]
-        same = entry[1] == (shape, tag)
-        entry[1] = (shape, tag)
-        return entry[0][:size].reshape(shape), same
-
-    def spectra(self, k: np.ndarray, workers: int, *, conj: bool, keep: bool = False):
-        """The 2-D DFT (``conj``: its complex conjugate, by the transforms of opposite sign) of
-        float32 kernels (..., kh, kw) zero-padded to ``padded``: (..., hp, wp // 2 + 1).
-        ``keep``: a fresh array (else one of the thread's buffers, valid until its next call)."""
-        hp, wp = self.padded
-        *lead, kh, kw = k.shape
-        lead = tuple(lead)
-        wh = wp // 2 + 1
-        fwd = not conj
-        # columns past kw and rows past kh are zero (set again only when the shape changed)
-        pad, same = (None, False) if keep else self._scratch("pad", (*lead, kh, wp), F32, kw)
-        if pad is None:
-            pad = np.zeros((*lead, kh, wp), np.float32)
-        elif not same:
-            pad[..., kw:] = 0
-        pad[..., :kw] = k
-        rows, same = (None, False) if keep else self._scratch("rows", (*lead, hp, wh), C64, kh)
-        if rows is None:
-            rows = np.zeros((*lead, hp, wh), np.complex64)
-            self.m.r2c(pad, axes=(-1,), forward=fwd, out=rows[..., :kh, :], nthreads=workers)
-            return self.m.c2c(rows, axes=(-2,), forward=fwd, out=rows, nthreads=workers)
-        if not same:
-            rows[..., kh:, :] = 0
-        self.m.r2c(pad, axes=(-1,), forward=fwd, out=rows[..., :kh, :], nthreads=workers)
-        out, _ = self._scratch("spectra", rows.shape, C64)
-        return self.m.c2c(rows, axes=(-2,), forward=fwd, out=out, nthreads=workers)
-
-    def inverse(self, x: np.ndarray, rows: int, workers: int) -> np.ndarray:
-        """The unnormalised inverse 2-D DFT of spectra ``x`` (..., hp, wp // 2 + 1), its
-        first ``rows`` rows: (..., rows, wp) float32 in one of the thread's buffers (valid until
-        its next call). ``x`` is overwritten."""
-        hp, wp = self.padded
-        self.m.c2c(x, axes=(-2,), forward=False, out=x, nthreads=workers)
-        out, _ = self._scratch("inverse", (*x.shape[:-2], rows, wp), F32)
-        return self.m.c2r(
-            x[..., :rows, :], axes=(-1,), lastsize=wp, forward=False, out=out, nthreads=workers
         )

@@ -27,7 +27,7 @@ import numpy as np
 from engine import _jit as jit
 from engine._jit import njit
 from engine._validate import as_image, as_rng, positive_int
-from engine.fft import PrunedTransforms, default_backend, next_fast_len, transforms
+from engine.fft import default_backend, next_fast_len, transforms
 
 __all__ = [
     "ZERO_ERROR_FRACTION",
@@ -76,24 +76,13 @@ class SampleSpectrum:
         self._setup(sample, groups, workers, backend)
         chans = np.moveaxis(self.sample, 2, 0)
         sq = np.stack([np.sum(chans[list(g)] ** 2, axis=0) for g in self.groups])
-        self._wcache: dict = {}
-        if self._pruned is not None:
-            # F(S_c) · (-2 / N) and F(Σ S_c²) / N (N = hp wp): queries multiply the conjugate
-            # spectra of their kernels by these, sum, and take an unnormalised inverse
-            p, wk = self._pruned, self.workers
-            scale = np.float32(1.0 / (self.padded[0] * self.padded[1]))
-            self._hs = p.spectra(chans, wk, conj=False, keep=True)
-            self._fsq = p.spectra(sq, wk, conj=False, keep=True)
-            for f, a in ((np.float32(-2) * scale, self._hs), (scale, self._fsq)):
-                a.real *= f
-                a.imag *= f
-            return
         # -2 conj(F(S_c)): queries sum Σ_c F(K_c) · this and conjugate once (the same values
         # as -2 Σ_c conj(F(K_c)) F(S_c): the factor is a power of two, conj is exact)
         self._hs = np.conjugate(self._forward(chans))
         self._hs.real *= np.float32(-2)
         self._hs.imag *= np.float32(-2)
         self._fsq = self._forward(sq)
+        self._wcache: dict = {}
 
     def _setup(self, sample, groups, workers, backend) -> None:
         s = np.ascontiguousarray(np.asarray(sample, dtype=np.float32))
@@ -113,9 +102,6 @@ class SampleSpectrum:
         self.backend = default_backend() if backend is None else backend
         self.fft = transforms(self.backend)
         self.padded = (next_fast_len(h), next_fast_len(w))
-        self._pruned = (
-            PrunedTransforms(self.fft.m, self.padded) if self.backend == "ducc0" else None
-        )
 
     @property
     def nbytes(self) -> int:
@@ -148,16 +134,11 @@ class SampleSpectrum:
         """``Σ_c corr(S_c, K_c)`` at every valid position for a batch of kernels (n, C, kh, kw)."""
         k = np.asarray(kernels, dtype=np.float32)
         n, c, kh, kw = k.shape
-        h, w = self.shape
-        if self._pruned is not None:
-            x = _product_sum(self._pruned.spectra(k, self.workers, conj=True), self._hs)
-            x.real *= np.float32(-0.5)
-            x.imag *= np.float32(-0.5)
-            return self._pruned.inverse(x, h - kh + 1, self.workers)[..., : w - kw + 1].copy()
         x = _product_sum(self._forward(k), self._hs)
         np.conjugate(x, out=x)
         x.real *= np.float32(-0.5)
         x.imag *= np.float32(-0.5)
+        h, w = self.shape
         return self._inverse(x, h - kh + 1, w - kw + 1)
 
     def _weight_terms(self, wts: np.ndarray, workers) -> list[np.ndarray]:
@@ -167,12 +148,8 @@ class SampleSpectrum:
         keys = [(w.shape, w.tobytes()) for w in wts]
         out = [self._wcache.get(key) for key in keys]
         todo = [i for i, v in enumerate(out) if v is None]
-        if todo and self._pruned is not None:
-            wk = self.workers if workers is None else workers
-            fresh = _product_sum(self._pruned.spectra(wts[todo], wk, conj=True), self._fsq)
-        elif todo:
-            fresh = _channel_sum(self._forward(wts[todo], workers), self._fsq)
         if todo:
+            fresh = _channel_sum(self._forward(wts[todo], workers), self._fsq)
             for i, v in zip(todo, fresh, strict=True):
                 out[i] = v
                 if (len(self._wcache) + 1) * v.nbytes <= WEIGHT_CACHE_BYTES:
@@ -227,24 +204,16 @@ class SampleSpectrum:
         if bh > h or bw > w:
             raise ValueError(f"block {bw}x{bh} is larger than the sample {w}x{h}")
         const = np.asarray(const, dtype=np.float64).astype(np.float32)
-        if self._pruned is not None:
-            wk = self.workers if workers is None else workers
-            x = _product_sum(self._pruned.spectra(k, wk, conj=True), self._hs)
-        else:
-            x = _product_sum(self._forward(k, workers), self._hs)
-            np.conjugate(x, out=x)
+        x = _product_sum(self._forward(k, workers), self._hs)
+        np.conjugate(x, out=x)
         for xi, wt in zip(x, self._weight_terms(wts, workers), strict=True):
             xi += wt
-        if self._pruned is not None:
-            y = self._pruned.inverse(x, h - bh + 1, wk)
-        elif not jit.loaded():
-            y = self._inverse(x, h - bh + 1, w - bw + 1, workers)
-        else:
-            y = self._inverse_rows(x, h - bh + 1, workers)
         if not jit.loaded():  # a small job without numba: the same values from numpy
-            e = y[..., : w - bw + 1] + const[:, None, None]
+            e = self._inverse(x, h - bh + 1, w - bw + 1, workers)
+            e += const[:, None, None]
             np.maximum(e, 0, out=e)
             return e
+        y = self._inverse_rows(x, h - bh + 1, workers)
         e = np.empty((n, h - bh + 1, w - bw + 1), np.float32)
         _add_clip(y, const, e)
         return e
@@ -262,7 +231,6 @@ class TiledSpectrum(SampleSpectrum):
 
     def __init__(self, sample: np.ndarray, *, groups=None, workers: int = 1, tile: int = 1024):
         self._setup(sample, groups, workers, None)
-        self._pruned = None  # the tiles' spectra have their own
         self.tile = positive_int(tile, "tile")
 
     @property

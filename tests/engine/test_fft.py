@@ -119,10 +119,10 @@ def _query(rng, n, c, g, bh, bw):
     return t * w[:, [i % g for i in range(c)]], w, rng.random(n)
 
 
-def test_ducc0s_queries_equal_scipys_up_to_round_off_and_reuse_buffers_safely():
+def test_ducc0s_queries_equal_scipys_up_to_round_off():
     """Odd padded sizes, two channel groups (texture transfer), several block shapes and batch
-    sizes in turn: the thread's reused buffers (zero past each kernel) give exactly what a fresh
-    spectrum gives, and scipy's errors up to float round-off."""
+    sizes in turn: one spectrum gives what a fresh one gives, and scipy's errors up to float
+    round-off."""
     rng = np.random.default_rng(3)
     s = rng.random((70, 91, 4), dtype=np.float32)
     groups = ((0, 1, 2), (3,))
