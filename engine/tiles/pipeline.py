@@ -157,8 +157,8 @@ def auto_tone(settings: TilesetSettings, source) -> tuple[TilesetSettings, str |
     what = "Flatten lighting and the gradient-domain blend are" if blend else "Flatten lighting is"
     return settings.replace(**changes), (
         f"the lighting varies across the photo (a smooth trend of about ±{50 * st.lighting:.0f} % "
-        f"in brightness): {what} on (automatic; --no-flatten keeps the photo's lighting and "
-        "the blending)"
+        f"in brightness): {what} on (automatic; --no-flatten, or Flatten lighting: Off in "
+        "the editor, keeps the photo's lighting and the blending)"
     )
 
 
