@@ -35,6 +35,7 @@ class TileSetDocument(QObject):
     picks_changed = Signal()
     layout_changed = Signal()
     preview_changed = Signal()
+    tone_changed = Signal()  # what Flatten lighting's Auto switched on (tone_note, auto_blend)
 
     def __init__(self, root, undo_stack) -> None:
         super().__init__(root)
@@ -45,6 +46,7 @@ class TileSetDocument(QObject):
         self.map_weights: dict[str, float] = {}  # seam-error weight per map; {} = main only
         self.seamless = None  # engine SeamlessTile (derived)
         self.tone_note: str | None = None  # what Flatten lighting's Auto switched on
+        self.auto_blend: str | None = None  # the seam blend Auto put in place of the chosen one
         self._tone = None  # (inputs, settings, note) of the last Auto decision
         self.candidates: list[CandidateTile] = []
         self.picks: list[int] = []
@@ -120,15 +122,20 @@ class TileSetDocument(QObject):
         from engine.tiles.pipeline import auto_tone
 
         s, source = self.settings(), self.root.source
-        self.tone_note = None
-        if source is None or s.flatten is not None:
-            return s
-        key = (id(source.main), source.main.shape, s)
-        cached = getattr(self, "_tone", None)
-        if cached is None or cached[0] != key:
-            self._tone = (key, *auto_tone(s, source.main))
-        self.tone_note = self._tone[2]
-        return self._tone[1]
+        said = (self.tone_note, self.auto_blend)
+        self.tone_note = self.auto_blend = None
+        resolved = s
+        if source is not None and s.flatten is None:
+            key = (id(source.main), source.main.shape, s)
+            cached = getattr(self, "_tone", None)
+            if cached is None or cached[0] != key:
+                self._tone = (key, *auto_tone(s, source.main))
+            resolved, self.tone_note = self._tone[1], self._tone[2]
+            if resolved.seam.blend != s.seam.blend:
+                self.auto_blend = resolved.seam.blend
+        if (self.tone_note, self.auto_blend) != said:
+            self.tone_changed.emit()
+        return resolved
 
     def overlap(self) -> int:
         """w_T, the Seam search width: the parameter, or (auto) about a tenth of the tile."""

@@ -104,6 +104,11 @@ class ParamsPanel(QWidget):
                 form.addRow(label, w)
                 self.widgets[p.key] = w
                 self.labels[p.key] = label
+                if p.key == "blend":  # what Flatten lighting's Auto uses instead, said here
+                    self.tone_hint = QLabel()
+                    self.tone_hint.setWordWrap(True)
+                    form.addRow(self.tone_hint)
+                    form.setRowVisible(self.tone_hint, False)
             buttons = (actions or {}).get(group, [])
             if buttons:
                 self._has_actions.add(group)
@@ -157,6 +162,7 @@ class ParamsPanel(QWidget):
         self.view = settings.get("params_view") if settings.get("params_view") in VIEWS else BASIC
         self.view_buttons.button(VIEWS.index(self.view)).setChecked(True)
         doc.params_changed.connect(self._on_params_changed)
+        doc.tileset.tone_changed.connect(self._on_tone_changed)
         self._on_params_changed(frozenset(params.DEFAULTS))
 
     # ------------------------------------------------------------------ what is shown
@@ -231,6 +237,19 @@ class ParamsPanel(QWidget):
             w, tip = self.widgets[key], params.BY_KEY[key].tooltip
             w.setEnabled(key not in unused)
             w.setToolTip(f"{tip}\n({unused[key]})" if key in unused else tip)
+
+    @Slot()
+    def _on_tone_changed(self) -> None:
+        """Under Seam blending: the blend Flatten lighting's Auto uses for this photo instead of
+        the one chosen (the box keeps the choice, which applies again with Flatten lighting Off)."""
+        blend = self.doc.tileset.auto_blend
+        if blend is not None:
+            name = params.BY_KEY["blend"].choice_label(blend)
+            self.tone_hint.setText(
+                f"<i>Uneven lighting: Auto tone uses “{name}” for this photo "
+                "(Flatten lighting: Off keeps the choice above)</i>"
+            )
+        self._forms["Seams"].setRowVisible(self.tone_hint, blend is not None)
 
     # ------------------------------------------------------------------ widgets
     def _make_widget(self, p: params.Param) -> QWidget:

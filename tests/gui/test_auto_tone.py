@@ -20,7 +20,11 @@ def test_uneven_lighting_is_flattened_said_on_the_banner_and_can_be_switched_off
     wait_idle(qtbot, w)
     banner = w.message_bar.label.text()
     assert "lighting varies" in banner and "automatic" in banner
+    panel, hint = w.params_panel, w.params_panel.tone_hint
+    assert panel.value("blend") == "adaptive"  # the choice is kept; the hint says what Auto uses
+    assert hint.isVisibleTo(panel) and "Gradient domain" in hint.text()
     w.doc.set_params({"flatten": "off"})
     s = w.pipeline.settings()
     assert s.flatten is False and s.seam.blend == "adaptive"
     assert w.pipeline.flatten_scale() is None and w.doc.tileset.tone_note is None
+    assert not hint.isVisibleTo(panel)
