@@ -169,9 +169,10 @@ def _works(t) -> bool:
     )
 
 
-class _Pocketfft:
-    """scipy.fft's ``rfft``, ``fft``, ``ifft``, ``irfft`` (for native float32/complex64 input,
-    default norm) calling its extension as scipy.fft does (``scipy/fft/_pocketfft/basic.py``)."""
+class _Padded:
+    """scipy.fft's ``rfft``, ``fft``, ``ifft``, ``irfft`` signature (float32/complex64 input,
+    default norm: the inverses scaled by 1/n) over a library's ``_r2c``, ``_c2c``, ``_c2r``;
+    ``n`` pads with zeros or crops along ``axis`` as scipy.fft does."""
 
     def __init__(self, module):
         self.m = module
@@ -191,51 +192,47 @@ class _Pocketfft:
 
     def rfft(self, x, n=None, axis=-1, workers=None):
         tmp, _ = self._padded(x, n, axis)
-        return self.m.r2c(tmp, (axis,), True, 0, None, workers or 1)
+        return self._r2c(tmp, axis, workers or 1)
 
     def fft(self, x, n=None, axis=-1, workers=None):
-        tmp, copied = self._padded(x, n, axis)
-        return self.m.c2c(tmp, (axis,), True, 0, tmp if copied else None, workers or 1)
+        tmp, copied = self._padded(x, n, axis)  # a padded copy is transformed in place
+        return self._c2c(tmp, axis, True, tmp if copied else None, workers or 1)
 
     def ifft(self, x, n=None, axis=-1, workers=None):
         tmp, copied = self._padded(x, n, axis)
-        return self.m.c2c(tmp, (axis,), False, 2, tmp if copied else None, workers or 1)
+        return self._c2c(tmp, axis, False, tmp if copied else None, workers or 1)
 
     def irfft(self, x, n=None, axis=-1, workers=None):
         x = np.asarray(x)
         if n is None:
             n = (x.shape[axis] - 1) * 2
         tmp, _ = self._padded(x, n // 2 + 1, axis)
-        return self.m.c2r(tmp, (axis,), n, False, 2, None, workers or 1)
+        return self._c2r(tmp, axis, n, workers or 1)
 
 
-class _Ducc:
-    """``rfft``, ``fft``, ``ifft``, ``irfft`` with scipy.fft's signature from ``ducc0.fft``
-    (the successor of pocketfft by its author)."""
+class _Pocketfft(_Padded):
+    """scipy's pocketfft extension called as scipy.fft calls it
+    (``scipy/fft/_pocketfft/basic.py``)."""
 
-    def __init__(self, module):
-        self.m = module
+    def _r2c(self, x, axis, workers):
+        return self.m.r2c(x, (axis,), True, 0, None, workers)
 
-    _padded = staticmethod(_Pocketfft._padded)
+    def _c2c(self, x, axis, forward, out, workers):
+        return self.m.c2c(x, (axis,), forward, 0 if forward else 2, out, workers)
 
-    def rfft(self, x, n=None, axis=-1, workers=None):
-        tmp, _ = self._padded(x, n, axis)
-        return self.m.r2c(tmp, axes=(axis,), nthreads=workers or 1)
+    def _c2r(self, x, axis, n, workers):
+        return self.m.c2r(x, (axis,), n, False, 2, None, workers)
 
-    def fft(self, x, n=None, axis=-1, workers=None):
-        tmp, copied = self._padded(x, n, axis)
-        return self.m.c2c(tmp, axes=(axis,), out=tmp if copied else None, nthreads=workers or 1)
 
-    def ifft(self, x, n=None, axis=-1, workers=None):
-        tmp, copied = self._padded(x, n, axis)
-        out = tmp if copied else None
-        return self.m.c2c(tmp, axes=(axis,), forward=False, inorm=2, out=out, nthreads=workers or 1)
+class _Ducc(_Padded):
+    """``ducc0.fft`` (the successor of pocketfft by its author)."""
 
-    def irfft(self, x, n=None, axis=-1, workers=None):
-        x = np.asarray(x)
-        if n is None:
-            n = (x.shape[axis] - 1) * 2
-        tmp, _ = self._padded(x, n // 2 + 1, axis)
-        return self.m.c2r(
-            tmp, axes=(axis,), lastsize=n, forward=False, inorm=2, nthreads=workers or 1
-        )
+    def _r2c(self, x, axis, workers):
+        return self.m.r2c(x, axes=(axis,), nthreads=workers)
+
+    def _c2c(self, x, axis, forward, out, workers):
+        inorm = 0 if forward else 2
+        return self.m.c2c(x, axes=(axis,), forward=forward, inorm=inorm, out=out, nthreads=workers)
+
+    def _c2r(self, x, axis, n, workers):
+        return self.m.c2r(x, axes=(axis,), lastsize=n, forward=False, inorm=2, nthreads=workers)
