@@ -137,8 +137,7 @@ def stitch_patch(q, u, *, ring, margin, seam, weights, outward, depth, cancel=No
     error x ``depth``): ``({map: result}, PatchCut)``. Candidates and Wang interiors.
 
     ``seam.blend == "poisson"``: the hard cut blended in the gradient domain
-    (:func:`engine.poisson.solve_maps`, screened at :data:`POISSON_REACH` x ``ring``), the
-    outer ``margin`` pixels (at least 1) kept bit for bit."""
+    (:func:`gradient_blend`)."""
     err = seam_error(q, u, weights, seam.metric)
     bias = (outward * float(err.mean())) * depth if outward else None
     cut = patch_cut(
@@ -146,9 +145,15 @@ def stitch_patch(q, u, *, ring, margin, seam, weights, outward, depth, cancel=No
     )
     check(cancel)
     if seam.blend == POISSON:
-        reach = POISSON_REACH * ring
-        return solve_maps(q, u, cut.mask, fixed=max(1, margin), reach=reach), cut
+        return gradient_blend(q, u, cut, ring=ring, margin=margin), cut
     return apply_cut(q, u, cut.alpha), cut
+
+
+def gradient_blend(q, u, cut, *, ring, margin):
+    """Window ``q`` stitched into ``u`` along ``cut``'s hard cut, blended in the gradient domain
+    (:func:`engine.poisson.solve_maps`, screened at :data:`POISSON_REACH` x ``ring``), the outer
+    ``margin`` pixels (at least 1) kept bit for bit."""
+    return solve_maps(q, u, cut.mask, fixed=max(1, margin), reach=POISSON_REACH * ring)
 
 
 def default_patch_overlap(overlap: int) -> int:
@@ -480,8 +485,7 @@ class _Setup:
             self._luminance(out[MAIN]), cut.mask, self.natural, self.seam_shows
         )
         if reblended:
-            reach = POISSON_REACH * self.ring
-            out = solve_maps(Q, self.U, cut.mask, fixed=self.margin, reach=reach)
+            out = gradient_blend(Q, self.U, cut, ring=self.ring, margin=self.margin)
         ty, tx, ph, pw = self.ty, self.tx, self.ph, self.pw
         tiles = {}
         for k, v in self.tmaps.items():
