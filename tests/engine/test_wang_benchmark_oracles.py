@@ -3,10 +3,10 @@
 import numpy as np
 from scipy import ndimage
 
-from benchmarks.wang import crop_detail
+from benchmarks.wang import crop_detail, wang_frame
 from benchmarks.wang_lattice import continued_lattice
 from benchmarks.wang_oracle import Field, ideal_set
-from engine.metrics import detail_ratio, lattice
+from engine.metrics import detail_ratio, frame, lattice
 from engine.tiles.wang_layout import wang_layout
 
 
@@ -54,3 +54,33 @@ def test_the_ideal_wang_set_of_a_gaussian_field_sits_on_the_continued_floor():
     assert pasted > 2.5
     assert abs(ideal) < 1.5
     assert floor < ideal - 1.5
+
+
+def _running_bond(rng, shape, course, brick):
+    """Running-bond bricks with a stationary grain: periodic in structure, no two crops alike."""
+    yy, xx = np.mgrid[0 : shape[0], 0 : shape[1]]
+    shift = (yy // course % 2) * (brick // 2)
+    joint = (yy % course < 4) | ((xx + shift) % brick < 4)
+    grain = ndimage.gaussian_filter(rng.standard_normal(shape), 1.2, mode="wrap")
+    grain /= grain.std()
+    return np.where(joint, 0.75, 0.45 + 0.05 * grain)[..., None]
+
+
+def test_wang_frame_reads_an_aligned_set_of_a_periodic_texture_as_no_frame():
+    # crops of a periodic texture all in one phase (what a Wang set continuing the courses
+    # across every joint is) have their mortar lines at the same distances from the tile edge:
+    # against random-phase crops that reads as a frame, against crops in the set's phase not
+    # (the tile, 64 px, holds two courses and one brick: whole periods on both axes)
+    rng = np.random.default_rng(0)
+    S = _running_bond(rng, (384, 384), 32, 64)
+    T, y0, x0 = 64, 9, 21  # a phase that puts a mortar line near the tile edge
+    g = np.random.default_rng(1)
+    ys = y0 + 64 * g.integers(0, 4, 16)
+    xs = x0 + 64 * g.integers(0, 4, 16)
+    aligned = [S[y : y + T, x : x + T] for y, x in zip(ys, xs, strict=True)]
+    assert wang_frame(aligned, S, 16).value < 1.1
+    assert frame(aligned, S, limit=16, wrap=False).value > 1.3
+    # a stochastic texture keeps its random crops: the same figure as before
+    noise = ndimage.gaussian_filter(rng.standard_normal((256, 256)), 2)[..., None]
+    crops = _crops(noise, 48, 16, 2)
+    assert wang_frame(crops, noise, 12).value == frame(crops, noise, limit=12, wrap=False).value
