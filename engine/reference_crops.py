@@ -31,7 +31,7 @@ import numpy as np
 
 from engine._validate import as_rng
 
-__all__ = ["ReferenceCrops", "phase_axes", "random_origins"]
+__all__ = ["ReferenceCrops", "phase_axes", "random_origins", "structure_match"]
 
 #: a texture that repeats exactly (the in-phase crops match the template's structure this
 #: well: copies of it, no set of distinct aligned tiles exists) keeps random crops
@@ -101,6 +101,13 @@ def _match_map(S: np.ndarray, T: np.ndarray) -> np.ndarray:
     energy = _window_sums(hs * hs, h, w) - sums * sums / (h * w)
     norm = np.sqrt(np.maximum(energy, 1e-12) * max(float((ht * ht).sum()), 1e-12))
     return num / norm
+
+
+def structure_match(source_lum: np.ndarray, template_lum: np.ndarray) -> np.ndarray:
+    """(H - h + 1, W - w + 1): how well the template's structure matches the source's at every
+    tile-sized window (the score the crops are moved by; the candidates' patch search keeps
+    its patches in the same phase class: :mod:`engine.tiles.patch_phase`)."""
+    return _match_map(np.asarray(source_lum, np.float64), np.asarray(template_lum, np.float64))
 
 
 @dataclass(frozen=True)

@@ -60,6 +60,7 @@ from engine.tiles.candidate_kernels import (
     natural_step,
     true_runs,
 )
+from engine.tiles.patch_phase import patch_phase_class
 from engine.tiles.seamless import MAIN, SeamlessTile, as_maps, check_weights, seam_error
 from engine.tiles.template import as_size, excluded_mask, flat_warning
 
@@ -235,6 +236,7 @@ class _Setup:
         min_distance=None,
         outward=OUTWARD,
         seam_shows=SEAM_SHOWS,
+        scale=None,
     ):
         if not isinstance(template, SeamlessTile):
             raise TypeError(
@@ -273,6 +275,7 @@ class _Setup:
         self._min_distance = min_distance
         self.outward = non_negative_number(outward, "outward")
         self.seam_shows = non_negative_number(seam_shows, "seam_shows")
+        self.scale = scale  # the texture's structure scale (None: measured when needed)
         tx0, ty0 = template.rect[:2]
         self.template_origin = (ty0 + (th - ph) // 2, tx0 + (tw - pw) // 2)
         self._costs = None
@@ -370,6 +373,9 @@ class _Setup:
         a note when fewer than ``len(seeds)`` could be given."""
         e = self.ring_costs()
         allowed = np.isfinite(e)
+        # periodic textures: the template's phase class first, the other positions after
+        phase = patch_phase_class(self.S, self.tmaps[MAIN], (self.ph, self.pw), scale=self.scale)
+        region = True if phase is None else phase
         self._keep_away(allowed, self.template_origin)
         for o in avoid:
             self._keep_away(allowed, o)
@@ -386,9 +392,12 @@ class _Setup:
             seed = next(gen_seeds, None)
             tries = 0
             while seed is not None:
-                ok = allowed & (e <= limit)
+                ok = allowed & (e <= limit) & region
                 if not ok.any():
-                    break
+                    if region is True:
+                        break
+                    region = True
+                    continue
                 pool = np.flatnonzero(
                     ok & (e <= max(float(e[ok].min()), zero) * (1 + self.tolerance))
                 )
@@ -556,6 +565,7 @@ def iter_candidates(
     maps=None,
     weights=None,
     rng=None,
+    scale=None,
     workers: int = 2,
     cancel=None,
 ):
@@ -603,6 +613,9 @@ def iter_candidates(
         The template's material maps (same names) and the seam error weights.
     rng : int, Generator or None
         The run's seed; candidate k uses :func:`candidate_seed` (seed, k).
+    scale : Scale or None
+        The structure scale (None: measured): on a periodic texture the global search draws
+        from the template's phase class first (:mod:`engine.tiles.patch_phase`).
     workers : int
         Threads (1 runs in the calling thread).
     cancel : CancelToken or None
@@ -629,6 +642,7 @@ def iter_candidates(
         min_distance=min_distance,
         outward=outward,
         seam_shows=seam_shows,
+        scale=scale,
     )
     n = positive_int(n, "n")
     workers = positive_int(workers, "workers")

@@ -247,6 +247,7 @@ def _iter_tileset(source, s, rect, maps, weights, excluded, picks, workers, canc
             maps=maps,
             weights=weights,
             rng=resolved.seed,
+            scale=scale,
             workers=workers,
             cancel=cancel,
         ),
