@@ -64,19 +64,19 @@ def phase_class(
     """
     from engine.metrics import luminance
 
-    S = luminance(source).astype(np.float64)
-    T = luminance(template).astype(np.float64)
-    h, w = T.shape
-    if h > S.shape[0] or w > S.shape[1]:
+    H, W = np.shape(source)[:2]
+    h, w = np.shape(template)[:2]
+    if h > H or w > W:
         return None
     if scale is None:
-        H, W = S.shape
         y, x = max(0, (H - SCALE_CROP) // 2), max(0, (W - SCALE_CROP) // 2)
-        scale = structure_scale(S[y : y + SCALE_CROP, x : x + SCALE_CROP])
+        crop = np.asarray(source)[y : y + SCALE_CROP, x : x + SCALE_CROP]
+        scale = structure_scale(luminance(crop).astype(np.float64))
     axes = phase_axes(scale, (h, w))
     if not any(axes):
-        return None
-    score = structure_match(S, T)
+        return None  # (before the whole source's luminance: a large photo pays nothing)
+    S = luminance(source).astype(np.float64)
+    score = structure_match(S, luminance(template).astype(np.float64))
     span = [math.ceil(p) if a else 1 for p, a in zip(scale.size, axes, strict=True)]
     aligned = window_maxima(score, span)
     grow = [2 * tolerance + 1 if a else 1 for a in axes]

@@ -47,15 +47,16 @@ def check_ring(patch_overlap, margin, *, min_margin: int = 0) -> tuple[int, int]
     return ring, m
 
 
-def continuing_margin(error: np.ndarray, margin: int) -> np.ndarray:
+def continuing_margin(error: np.ndarray, margin: int, *, copy: bool = True) -> np.ndarray:
     """``error`` (h, w) with the pixels at distance ``margin`` from the window's edge (the
     first a cut may use) costing the smaller of their own error and their outer neighbour's
-    (module docstring); unchanged for ``margin`` 0."""
+    (module docstring); unchanged for ``margin`` 0. ``copy=False`` changes ``error`` itself
+    (the outer neighbours it reads are never written)."""
     m = int(margin)
     h, w = error.shape
     if m < 1 or min(h, w) < 2 * m + 2:
         return error
-    e = np.array(error, copy=True)
+    e = np.array(error, copy=True) if copy else error
     for a, b in ((m, m - 1), (h - 1 - m, h - m)):  # top and bottom rows
         e[a, m : w - m] = np.minimum(error[a, m : w - m], error[b, m : w - m])
     for a, b in ((m, m - 1), (w - 1 - m, w - m)):  # left and right columns
@@ -75,7 +76,7 @@ def stitch_patch(
     (:func:`gradient_blend`)."""
     err = seam_error(q, u, weights, seam.metric)
     if continue_margin:
-        err = continuing_margin(err, margin)
+        err = continuing_margin(err, margin, copy=False)  # err is this call's own
     bias = (outward * float(err.mean())) * depth if outward else None
     cut = patch_cut(
         q[MAIN], u[MAIN], ring=ring, margin=margin, seam=seam, error=err, bias=bias, cancel=cancel
