@@ -18,9 +18,12 @@ import numpy as np
 
 __all__ = [
     "BACKENDS",
+    "BUFFER_BYTES",
     "ENV",
     "default_backend",
+    "inverse",
     "next_fast_len",
+    "spectra",
     "transforms",
 ]
 
@@ -159,14 +162,49 @@ def _works(t) -> bool:
     try:
         f = t.fft(t.rfft(x, n=12), n=8, axis=0)
         back = t.irfft(t.ifft(f, axis=0), n=12)
+        g = t.spectra(x, (8, 12), conj=True)  # the opposite sign, out= and inorm of its calls
+        back2 = inverse(t, np.conjugate(g), (8, 12), 6, 10)
     except Exception:
         return False
     ref = np.fft.fft(np.fft.rfft(x, n=12), n=8, axis=0)
+    ref2 = np.fft.fft(np.fft.rfft(x, n=8, axis=0), n=12)
     return bool(
         np.allclose(f, ref, rtol=1e-4, atol=1e-4)
         and np.allclose(back[:6, :10], x, atol=1e-5)
         and back.dtype == np.float32
+        and np.allclose(g, ref2.conj(), rtol=1e-4, atol=1e-4)
+        and np.allclose(back2, x, atol=1e-5)
     )
+
+
+BUFFER_BYTES = 4 * 2**20
+"""Largest zero-padded input a thread keeps between calls of :meth:`_Padded.spectra` (the
+kernels of a batch of three blocks of job B: 2.8 MB): a larger one (a large sample's) is
+allocated per call, where its transforms dwarf the allocation."""
+
+
+def spectra(t, k, shape, *, conj=False, workers=1, reuse=False) -> np.ndarray:
+    """2-D DFT of real ``k`` (..., kh, kw) zero-padded to ``shape`` = (hp, wp), half along the
+    rows: (..., hp // 2 + 1, wp), or its complex conjugate; from transforms ``t``
+    (:func:`transforms`). The columns are transformed first, over the kernel's kw columns only,
+    so the long pass (every kept frequency row) runs along contiguous memory (a third faster
+    than along strided columns). ``reuse``: see :meth:`_Padded.spectra`."""
+    if isinstance(t, _Padded):
+        return t.spectra(k, shape, conj=conj, workers=workers, reuse=reuse)
+    hp, wp = shape
+    f = t.fft(t.rfft(k, n=hp, axis=-2, workers=workers), n=wp, axis=-1, workers=workers)
+    return np.conjugate(f, out=f) if conj else f
+
+
+def inverse(t, x, shape, rows: int, cols: int, *, workers: int = 1) -> np.ndarray:
+    """The first ``rows`` x ``cols`` values of the real inverse of :func:`spectra`'s layout
+    (normalised): a (..., rows, cols) view. ``x`` may be overwritten."""
+    hp, _ = shape
+    if isinstance(t, _Padded):
+        y = t._c2c(x, -1, False, x, workers)[..., :cols]
+        return t._c2r(y, -2, hp, workers)[..., :rows, :]
+    y = t.ifft(x, axis=-1, workers=workers)[..., :cols]
+    return t.irfft(y, n=hp, axis=-2, workers=workers)[..., :rows, :]
 
 
 class _Padded:
@@ -176,6 +214,31 @@ class _Padded:
 
     def __init__(self, module):
         self.m = module
+        self._local = threading.local()
+
+    def spectra(self, k, shape, *, conj=False, workers=1, reuse=False) -> np.ndarray:
+        """:func:`spectra`. ``reuse``: the zero-padded copies of ``k`` live in buffers the
+        calling thread keeps for the next call of the same shape (their padding stays zero: no
+        allocation and no zero-filling per call; one shape, up to :data:`BUFFER_BYTES`). The
+        conjugate comes from the transforms of opposite sign (no pass of its own)."""
+        hp, wp = shape
+        k = np.asarray(k)
+        *lead, kh, kw = k.shape
+        shape_in = (*lead, hp, kw)
+        shape_mid = (*lead, hp // 2 + 1, wp)
+        key = (shape_in, shape_mid, kh)  # rows past kh, columns past kw stay zero
+        kept = getattr(self._local, "kept", None) if reuse else None
+        if kept is not None and kept[0] == key:
+            pad, mid = kept[1]
+        else:
+            pad, mid = np.zeros(shape_in, np.float32), np.zeros(shape_mid, np.complex64)
+            kept = (key, (pad, mid)) if pad.nbytes + mid.nbytes <= BUFFER_BYTES else None
+            if reuse:
+                self._local.kept = kept
+        pad[..., :kh, :] = k
+        self._r2c(pad, -2, workers, not conj, mid[..., :kw])
+        out = None if reuse and kept is not None else mid  # a kept buffer keeps its zeros
+        return self._c2c(mid, -1, not conj, out, workers, inorm=0)
 
     @staticmethod
     def _padded(x, n, axis):
@@ -214,11 +277,12 @@ class _Pocketfft(_Padded):
     """scipy's pocketfft extension called as scipy.fft calls it
     (``scipy/fft/_pocketfft/basic.py``)."""
 
-    def _r2c(self, x, axis, workers):
-        return self.m.r2c(x, (axis,), True, 0, None, workers)
+    def _r2c(self, x, axis, workers, forward=True, out=None):
+        return self.m.r2c(x, (axis,), forward, 0, out, workers)
 
-    def _c2c(self, x, axis, forward, out, workers):
-        return self.m.c2c(x, (axis,), forward, 0 if forward else 2, out, workers)
+    def _c2c(self, x, axis, forward, out, workers, inorm=None):
+        inorm = (0 if forward else 2) if inorm is None else inorm
+        return self.m.c2c(x, (axis,), forward, inorm, out, workers)
 
     def _c2r(self, x, axis, n, workers):
         return self.m.c2r(x, (axis,), n, False, 2, None, workers)
@@ -227,11 +291,11 @@ class _Pocketfft(_Padded):
 class _Ducc(_Padded):
     """``ducc0.fft`` (the successor of pocketfft by its author)."""
 
-    def _r2c(self, x, axis, workers):
-        return self.m.r2c(x, axes=(axis,), nthreads=workers)
+    def _r2c(self, x, axis, workers, forward=True, out=None):
+        return self.m.r2c(x, axes=(axis,), forward=forward, out=out, nthreads=workers)
 
-    def _c2c(self, x, axis, forward, out, workers):
-        inorm = 0 if forward else 2
+    def _c2c(self, x, axis, forward, out, workers, inorm=None):
+        inorm = (0 if forward else 2) if inorm is None else inorm
         return self.m.c2c(x, axes=(axis,), forward=forward, inorm=inorm, out=out, nthreads=workers)
 
     def _c2r(self, x, axis, n, workers):

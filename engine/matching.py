@@ -27,7 +27,7 @@ import numpy as np
 from engine import _jit as jit
 from engine._jit import njit
 from engine._validate import as_image, as_rng, positive_int
-from engine.fft import default_backend, next_fast_len, transforms
+from engine.fft import default_backend, inverse, next_fast_len, spectra, transforms
 
 __all__ = [
     "ZERO_ERROR_FRACTION",
@@ -76,11 +76,10 @@ class SampleSpectrum:
         self._setup(sample, groups, workers, backend)
         chans = np.moveaxis(self.sample, 2, 0)
         sq = np.stack([np.sum(chans[list(g)] ** 2, axis=0) for g in self.groups])
-        # -2 conj(F(S_c)): queries sum Σ_c F(K_c) · this and conjugate once (the same values
-        # as -2 Σ_c conj(F(K_c)) F(S_c): the factor is a power of two, conj is exact)
-        self._hs = np.conjugate(self._forward(chans))
-        self._hs.real *= np.float32(-2)
-        self._hs.imag *= np.float32(-2)
+        # -2 F(S_c): queries sum Σ_c conj(F(K_c)) · this (the kernels' conjugate spectra come
+        # from the transforms of opposite sign; the factor is a power of two: exact)
+        self._hs = self._forward(chans)
+        self._hs *= np.float32(-2)
         self._fsq = self._forward(sq)
         self._wcache: dict = {}
 
@@ -108,48 +107,49 @@ class SampleSpectrum:
         """Memory held by the spectra (the sample itself not counted)."""
         return self._hs.nbytes + self._fsq.nbytes
 
-    def _forward(self, k: np.ndarray, workers: int | None = None) -> np.ndarray:
-        """2-D real FFT of kernels (..., kh, kw) zero-padded to ``padded``; pruned row pass."""
-        hp, wp = self.padded
+    def _forward(self, k: np.ndarray) -> np.ndarray:
+        """2-D real FFT of arrays (..., kh, kw) zero-padded to ``padded``, half along the rows:
+        (..., hp // 2 + 1, wp) (:func:`engine.fft.spectra`)."""
+        return spectra(self.fft, k, self.padded, workers=self.workers)
+
+    def _conj_spectra(self, k: np.ndarray, workers: int | None = None) -> np.ndarray:
+        """The conjugate of :meth:`_forward` for a query's kernels (from the thread's padded
+        buffers)."""
         wk = self.workers if workers is None else workers
-        r = self.fft.rfft(k, n=wp, axis=-1, workers=wk)
-        return self.fft.fft(r, n=hp, axis=-2, workers=wk)
+        return spectra(self.fft, k, self.padded, conj=True, workers=wk, reuse=True)
 
     def _inverse(
         self, x: np.ndarray, rows: int, cols: int, workers: int | None = None
     ) -> np.ndarray:
-        hp, wp = self.padded
-        wk = self.workers if workers is None else workers
-        y = self.fft.ifft(x, axis=-2, workers=wk)[..., :rows, :]
-        return self.fft.irfft(y, n=wp, axis=-1, workers=wk)[..., :cols]
+        """:meth:`_inverse_rows` as a contiguous array."""
+        return np.ascontiguousarray(self._inverse_rows(x, rows, cols, workers))
 
-    def _inverse_rows(self, x: np.ndarray, rows: int, workers: int | None = None) -> np.ndarray:
-        """:meth:`_inverse` without dropping the columns past the valid ones (full rows)."""
-        hp, wp = self.padded
+    def _inverse_rows(
+        self, x: np.ndarray, rows: int, cols: int, workers: int | None = None
+    ) -> np.ndarray:
+        """The first ``rows`` × ``cols`` values of the inverse of :meth:`_forward`'s spectra (a
+        view; ``x`` is overwritten)."""
         wk = self.workers if workers is None else workers
-        y = self.fft.ifft(x, axis=-2, workers=wk)[..., :rows, :]
-        return self.fft.irfft(y, n=wp, axis=-1, workers=wk)
+        return inverse(self.fft, x, self.padded, rows, cols, workers=wk)
 
     def correlate(self, kernels: np.ndarray) -> np.ndarray:
         """``Σ_c corr(S_c, K_c)`` at every valid position for a batch of kernels (n, C, kh, kw)."""
         k = np.asarray(kernels, dtype=np.float32)
         n, c, kh, kw = k.shape
-        x = _product_sum(self._forward(k), self._hs)
-        np.conjugate(x, out=x)
-        x.real *= np.float32(-0.5)
-        x.imag *= np.float32(-0.5)
+        x = _product_sum(self._conj_spectra(k), self._hs)
+        x *= np.float32(-0.5)
         h, w = self.shape
         return self._inverse(x, h - kh + 1, w - kw + 1)
 
     def _weight_terms(self, wts: np.ndarray, workers) -> list[np.ndarray]:
-        """``Σ_g F(W_g)* F(Σ_{c∈g} S_c²)`` of each weight map (n, G, bh, bw), as a list.
+        """``Σ_g conj(F(W_g)) F(Σ_{c∈g} S_c²)`` of each weight map (n, G, bh, bw), as a list.
         Quilting's blocks share a few overlap masks: each one's term is kept (up to
         :data:`WEIGHT_CACHE_BYTES`), so most queries transform only their kernels' colours."""
         keys = [(w.shape, w.tobytes()) for w in wts]
         out = [self._wcache.get(key) for key in keys]
         todo = [i for i, v in enumerate(out) if v is None]
         if todo:
-            fresh = _channel_sum(self._forward(wts[todo], workers), self._fsq)
+            fresh = _product_sum(self._conj_spectra(wts[todo], workers), self._fsq)
             for i, v in zip(todo, fresh, strict=True):
                 out[i] = v
                 if (len(self._wcache) + 1) * v.nbytes <= WEIGHT_CACHE_BYTES:
@@ -204,8 +204,7 @@ class SampleSpectrum:
         if bh > h or bw > w:
             raise ValueError(f"block {bw}x{bh} is larger than the sample {w}x{h}")
         const = np.asarray(const, dtype=np.float64).astype(np.float32)
-        x = _product_sum(self._forward(k, workers), self._hs)
-        np.conjugate(x, out=x)
+        x = _product_sum(self._conj_spectra(k, workers), self._hs)
         for xi, wt in zip(x, self._weight_terms(wts, workers), strict=True):
             xi += wt
         if not jit.loaded():  # a small job without numba: the same values from numpy
@@ -213,7 +212,7 @@ class SampleSpectrum:
             e += const[:, None, None]
             np.maximum(e, 0, out=e)
             return e
-        y = self._inverse_rows(x, h - bh + 1, workers)
+        y = self._inverse_rows(x, h - bh + 1, w - bw + 1, workers)
         e = np.empty((n, h - bh + 1, w - bw + 1), np.float32)
         _add_clip(y, const, e)
         return e
@@ -256,15 +255,6 @@ class TiledSpectrum(SampleSpectrum):
                 part = spec.ssd_terms(k, weights, const, workers=wk)
                 out[:, y0 : y0 + part.shape[1], x0 : x0 + part.shape[2]] = part
         return out
-
-
-def _channel_sum(fk: np.ndarray, fs: np.ndarray) -> np.ndarray:
-    """``Σ_c conj(fk[:, c]) · fs[c]`` — correlations summed over channels in the frequency
-    domain (a channel loop beats einsum and a fused numba loop here)."""
-    x = fk[:, 0].conj() * fs[0]
-    for c in range(1, fk.shape[1]):
-        x += fk[:, c].conj() * fs[c]
-    return x
 
 
 def _product_sum(fk: np.ndarray, hs: np.ndarray) -> np.ndarray:

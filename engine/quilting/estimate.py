@@ -25,7 +25,7 @@ import numpy as np
 
 from engine.budget import check_memory, format_bytes
 from engine.events import Item
-from engine.fft import default_backend, next_fast_len
+from engine.fft import BUFFER_BYTES, default_backend, next_fast_len
 from engine.matching import WEIGHT_CACHE_BYTES
 from engine.pyramid import CHILDREN, SEED_NEIGHBOURS, pyramid_levels
 from engine.quilting.layout import grid_rects
@@ -190,15 +190,17 @@ def _fft_query_seconds(shape, channels: int) -> float:
 def spectra_bytes(shape, channels: int) -> int:
     """Memory of :class:`engine.matching.SampleSpectrum`'s spectra for a sample ``shape``."""
     hp, wp = _fft_shape(*shape)
-    return channels * hp * (wp // 2 + 1) * 8
+    return channels * (hp // 2 + 1) * wp * 8
 
 
 def exact_query_bytes(shape, channels: int) -> int:
     """Temporaries of one exhaustive query on a sample ``shape``: the kernels' spectra, their
-    channel sum, the inverse transform and the error map."""
+    channel sum, the inverse transform and the error map; and the padded kernels' buffer a
+    thread keeps between queries when it is small (:data:`engine.fft.BUFFER_BYTES`)."""
     hp, wp = _fft_shape(*shape)
-    half = hp * (wp // 2 + 1) * 8
-    return (channels + 2) * half + 2 * hp * wp * 4
+    half = (hp // 2 + 1) * wp * 8
+    kept = channels * half if channels * half <= BUFFER_BYTES else 0
+    return (channels + 2) * half + 2 * hp * wp * 4 + kept
 
 
 def plan(

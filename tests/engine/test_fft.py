@@ -173,6 +173,27 @@ def test_ducc0s_transforms_with_scipys_signature_give_numpys():
     np.testing.assert_allclose(t.rfft(x, n=10), np.fft.rfft(x, n=10), rtol=1e-4, atol=1e-4)
 
 
+@pytest.mark.parametrize("backend", ["ducc0", "scipy", "numpy"])
+def test_query_spectra_from_a_threads_kept_buffers_equal_fresh_ones_and_numpys(backend):
+    """engine.fft.spectra: half along the rows, columns first; ``reuse`` keeps the zero-padded
+    buffers of the latest shape (taller, shorter, narrower kernels in turn: no stale rows or
+    columns); the conjugate from the transforms of opposite sign; inverse() takes it back."""
+    t = transforms(backend)
+    rng = np.random.default_rng(6)
+    shape = (24, 20)
+    for kshape in ((2, 3, 10, 12), (2, 3, 7, 12), (2, 3, 10, 5), (2, 3, 10, 12), (1, 9, 4)):
+        k = rng.random(kshape, dtype=np.float32)
+        kept = fft.spectra(t, k, shape, conj=True, reuse=True)
+        np.testing.assert_array_equal(kept, fft.spectra(t, k, shape, conj=True))
+        ref = np.fft.fft(np.fft.rfft(k, n=24, axis=-2), n=20, axis=-1)
+        assert kept.shape == (*kshape[:-2], 13, 20) and kept.dtype == np.complex64
+        np.testing.assert_allclose(kept, ref.conj(), rtol=1e-4, atol=1e-4)
+        f = fft.spectra(t, k, shape)
+        np.testing.assert_allclose(f, ref, rtol=1e-4, atol=1e-4)
+        back = fft.inverse(t, f, shape, kshape[-2] - 1, kshape[-1] - 2)
+        np.testing.assert_allclose(back, k[..., :-1, :-2], atol=1e-5)
+
+
 def test_scipys_transforms_load_without_scipy_fft_and_give_its_numbers():
     code = (
         "import sys, numpy as np; from engine.fft import transforms; t = transforms('scipy'); "
