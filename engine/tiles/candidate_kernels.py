@@ -1,5 +1,6 @@
 """Numeric kernels of the candidate tiles (:mod:`engine.tiles.candidates`): the ring-band
-error of the local search, changed-pixel counts, mask runs, and whether a cut shows."""
+error of the local search, changed-pixel counts, mask runs, whether a cut shows, and the
+interior tone of every patch window."""
 
 from __future__ import annotations
 
@@ -9,7 +10,15 @@ import numpy as np
 
 from engine._jit import njit
 
-__all__ = ["band_costs", "count_changed", "cut_shows", "natural_step", "true_runs"]
+__all__ = [
+    "band_costs",
+    "count_changed",
+    "cut_shows",
+    "coarse_interior_means",
+    "interior_means",
+    "natural_step",
+    "true_runs",
+]
 
 #: σ (px) of the blur before the steps of :func:`cut_shows` / :func:`natural_step`: the frame
 #: metric's (:data:`engine.metrics.FRAME_SIGMA`), what a person sees at 100 %
@@ -102,3 +111,43 @@ def cut_shows(lum: np.ndarray, mask: np.ndarray, natural: float, limit: float) -
     dy, dx = _steps(lum)
     across = np.concatenate([dy[np.diff(mask, axis=0)], dx[np.diff(mask, axis=1)]])
     return bool(across.size) and float(across.mean()) > limit * natural
+
+
+def interior_means(lum: np.ndarray, shape, inset: int) -> np.ndarray:
+    """Mean of every ``shape`` (h, w) window of the 2-D ``lum`` over its interior (the pixels
+    at least ``inset`` from the window's edge): (H - h + 1, W - w + 1), window origins."""
+    h, w = shape
+    i = int(inset)
+    ih, iw = max(1, h - 2 * i), max(1, w - 2 * i)
+    H, W = lum.shape
+    c = np.zeros((H + 1, W + 1))
+    np.cumsum(lum, axis=0, dtype=np.float64, out=c[1:, 1:])
+    np.cumsum(c[1:, 1:], axis=1, out=c[1:, 1:])
+    ny, nx = H - h + 1, W - w + 1
+    a, b = c[i : i + ny], c[i + ih : i + ih + ny]
+    s = (
+        b[:, i + iw : i + iw + nx]
+        - b[:, i : i + nx]
+        - a[:, i + iw : i + iw + nx]
+        + a[:, i : i + nx]
+    )
+    return (s / (ih * iw)).astype(np.float32)
+
+
+def coarse_interior_means(image: np.ndarray, shape, inset: int, step: int) -> np.ndarray:
+    """:func:`interior_means` of the luminance of ``image`` (H, W, C) sampled every ``step``
+    px (a low-frequency figure: windows of ~128 samples a side are enough, and a 4096 px
+    photo's whole luminance would cost ~0.5 s), repeated back to every window origin:
+    (H - h + 1, W - w + 1)."""
+    from engine.metrics import luminance
+
+    k = max(1, int(step))
+    H, W = image.shape[:2]
+    h, w = shape
+    lum = luminance(image[::k, ::k]).astype(np.float32)
+    m = interior_means(lum, (max(1, h // k), max(1, w // k)), -(-int(inset) // k))
+    if k == 1:
+        return m
+    iy = np.minimum(np.arange(H - h + 1) // k, m.shape[0] - 1)
+    ix = np.minimum(np.arange(W - w + 1) // k, m.shape[1] - 1)
+    return m[iy[:, None], ix[None, :]]

@@ -53,6 +53,7 @@ from engine.seams.spec import POISSON, SeamSpec, as_seam_spec
 from engine.stitch import PATCH_SEAM
 from engine.tiles.candidate_kernels import (
     band_costs,
+    coarse_interior_means,
     count_changed,
     cut_shows,
     natural_step,
@@ -116,6 +117,15 @@ SEAM_SHOWS = 1.75
 #: 4 candidates 3.5 -> 8.9 s under load). Larger tiles keep the hard cut unless
 #: ``--blend poisson`` is asked for.
 SEAM_SHOWS_MAX_PIXELS = 512 * 512
+#: global patch search: a window's cost is its ring band's mean squared error against the
+#: template's plus TONE x (mean luminance of its interior − of the template's ring)². All
+#: candidates share the template's ring, so a patch whose interior is lighter or darker than
+#: that ring makes a tone block with a step at its cut even when the cut itself matches; the
+#: source's own windows differ that much (a random layout of plain crops of text shows the
+#: same blocks), so the ring-band error alone cannot avoid them. 4 = an interior off by Δ
+#: costs as a ring band off by 2Δ. Public text: ring tone 1.24 -> 0.68, lattice +1.25 ->
+#: +1.14 dB, the tone blocks of its layout gone (README, "Tone in the patch choice").
+TONE = 4.0
 PATCH_RING_FLOOR = 8  # px: narrower rings leave the closed cut no room (default_patch_overlap)
 
 
@@ -310,17 +320,32 @@ class _Setup:
     # ---- positions
     def ring_costs(self) -> np.ndarray:
         """Mean squared error (per pixel and channel) of every source window's outer ring band
-        (:data:`SEARCH_BAND`) against the template's; ``inf`` where the patch would hold
-        excluded pixels. Computed once."""
+        (:data:`SEARCH_BAND`) against the template's, plus the tone term (:data:`TONE`);
+        ``inf`` where the patch would hold excluded pixels. Computed once."""
         if self._costs is None:
             band = self.search_band.astype(np.float32)
             spec = SampleSpectrum(self.Sc)
             e = spec.ssd(self.Up.transpose(1, 2, 0)[None], band[None])[0]
             e /= band.sum() * self.Sc.shape[2]
+            if TONE > 0:
+                e += TONE * self._tone_costs()
             if self.valid is not None:
                 e[~self.valid] = np.inf
             self._costs = e
         return self._costs
+
+    def _tone_costs(self) -> np.ndarray:
+        """(mean luminance of every window's interior − of the template's ring)², the
+        interior being the pixels at least the patch ring w_P in (the ring is where the cut
+        runs; on blocks of :attr:`_stride` px): the tone step a patch would leave at its
+        cut (:data:`TONE`)."""
+        r = self.ring
+        u = self._luminance(self.U[MAIN])
+        inner = np.zeros(u.shape, dtype=bool)
+        inner[r:-r, r:-r] = True
+        ring = float(u[~inner].mean())
+        m = coarse_interior_means(self.S, (self.ph, self.pw), r, self._stride)
+        return (m - ring) ** 2
 
     def _keep_away(self, allowed: np.ndarray, origin) -> None:
         d = self.min_distance

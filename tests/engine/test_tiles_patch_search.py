@@ -157,3 +157,58 @@ def test_the_global_search_matches_the_ring_where_the_cut_runs():
         S[y : y + h, x : x + w][part] = T[part]
     c = make_candidate(S, st, rng=0, tolerance=0.0)
     assert c.patch_origin == (120, 120)
+
+
+def test_interior_means_against_brute_force():
+    from engine.tiles.candidate_kernels import interior_means
+
+    L = np.random.default_rng(0).random((37, 53)).astype(np.float32)
+    for h, w, i in ((10, 12, 2), (11, 9, 3), (8, 8, 1), (9, 14, 4)):
+        got = interior_means(L, (h, w), i)
+        want = [
+            [L[y + i : y + h - i, x + i : x + w - i].mean() for x in range(53 - w + 1)]
+            for y in range(37 - h + 1)
+        ]
+        np.testing.assert_allclose(got, want, atol=1e-6)
+
+
+def test_patch_interiors_keep_the_ring_tone(monkeypatch):
+    """A photo whose regions differ in tone (blocks of ±0.1): the candidates' interiors are
+    chosen close to the tone of the template's ring they share (engine.tiles.candidates.TONE),
+    so a layout shows no tone blocks; without the tone term they differ ~2x more."""
+    import importlib
+
+    cmod = importlib.import_module("engine.tiles.candidates")
+
+    rng = np.random.default_rng(3)
+    S = 0.5 + 0.5 * (smooth_texture((256, 256), 3, 4, 1.5) - 0.5)
+    S = S + np.kron(rng.uniform(-0.1, 0.1, (8, 8)), np.ones((32, 32)))[..., None]
+    S = np.clip(S, 0, 1).astype(np.float32)
+    st = make_seamless(S, (96, 96, 64, 64), overlap=8)
+    T = np.asarray(st.tile).mean(axis=2)
+    wp = 8
+    ring_tone = np.concatenate(
+        [T[:wp].ravel(), T[-wp:].ravel(), T[:, :wp].ravel(), T[:, -wp:].ravel()]
+    ).mean()
+
+    def gap():
+        cands = candidates(S, st, 10, rng=0, patch_overlap=wp)
+        return np.mean([abs(c.tile.mean(axis=2)[wp:-wp, wp:-wp].mean() - ring_tone) for c in cands])
+
+    with_tone = gap()
+    monkeypatch.setattr(cmod, "TONE", 0.0)
+    without = gap()
+    assert with_tone < 0.5 * without, (with_tone, without)
+
+
+def test_coarse_interior_means_follow_the_exact_ones():
+    from engine.metrics import luminance
+    from engine.tiles.candidate_kernels import coarse_interior_means, interior_means
+
+    S = smooth_texture((300, 280), 3, 1, 6.0)
+    exact = interior_means(luminance(S).astype(np.float32), (100, 90), 6)
+    np.testing.assert_array_equal(coarse_interior_means(S, (100, 90), 6, 1), exact)
+    for k in (2, 4):
+        got = coarse_interior_means(S, (100, 90), 6, k)
+        assert got.shape == exact.shape
+        assert np.abs(got - exact).max() < 0.02
