@@ -3,7 +3,7 @@
 import numpy as np
 from scipy import ndimage
 
-from benchmarks.wang import crop_detail, wang_frame
+from benchmarks.wang import crop_detail, crop_frame, wang_frame
 from benchmarks.wang_lattice import continued_lattice
 from benchmarks.wang_oracle import Field, ideal_set
 from engine.metrics import detail_ratio, frame, lattice
@@ -84,3 +84,12 @@ def test_wang_frame_reads_an_aligned_set_of_a_periodic_texture_as_no_frame():
     noise = ndimage.gaussian_filter(rng.standard_normal((256, 256)), 2)[..., None]
     crops = _crops(noise, 48, 16, 2)
     assert wang_frame(crops, noise, 12).value == frame(crops, noise, limit=12, wrap=False).value
+
+
+def test_crop_frame_is_about_one_on_a_stationary_texture_and_counts_genuine_crops():
+    rng = np.random.default_rng(3)
+    noise = ndimage.gaussian_filter(rng.standard_normal((256, 256)), 2)[..., None]
+    assert 0.95 < crop_frame(noise, 48, 12) < 1.1
+    # on running bonds the crops lie in one phase: an aligned set, no frame either
+    bricks = _running_bond(rng, (384, 384), 32, 64)
+    assert crop_frame(bricks, 64, 16) < 1.1
