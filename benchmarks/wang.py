@@ -294,7 +294,7 @@ def wang_figures(S, T: int, seed: int, options: dict, docs_file: Path | None = N
     # the crops carry each tile's outer pixel: what every construction takes from its edge
     # samples (a wider margin would hide a construction's own shared ring)
     lat = lattice(ws.tiles, S, margin=1, layouts=layouts)
-    cont = continued_lattice(ws.tiles, S, layouts=layouts)[2]
+    cont = continued_lattice(ws.tiles, S, layouts=layouts, template=ws.tiles[0])[2]
     fr = wang_frame(ws.tiles, S, 2 * _default_ring(T))
     half = wang_frame(ws.tiles, S, T // 2)
     raw = float(np.median([detail_ratio(t.tile, S) for t in ws.tiles]))

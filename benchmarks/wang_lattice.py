@@ -27,6 +27,7 @@ from functools import lru_cache
 import numpy as np
 
 from engine.metrics import edge_distance, lattice, luminance
+from engine.reference_crops import ReferenceCrops
 
 __all__ = ["continued_lattice", "kriging_gain"]
 
@@ -77,10 +78,19 @@ def _gain(data: bytes, shape, T: int):
     return gain.astype(np.float32), border
 
 
-def continued_lattice(tiles, source, *, layouts, rng=0) -> tuple[float, float, float]:
+def continued_lattice(
+    tiles, source, *, layouts, rng=0, template=None
+) -> tuple[float, float, float]:
     """(value, floor, above) in dB: the tiles' lattice over the valid ``layouts`` (as
     :func:`engine.metrics.lattice` with ``margin=1``) and the floor of crops carrying each
-    tile's outer pixel ring continued by kriging (module docstring); fresh crops per layout."""
+    tile's outer pixel ring continued by kriging (module docstring); fresh crops per layout.
+
+    ``template`` (a tile of the set): the crops lie in its phase along the axes where the
+    texture is periodic and the tile holds whole periods (:mod:`engine.reference_crops`, as
+    :func:`engine.metrics.lattice`'s ``template``): a set whose courses continue through every
+    tile puts the texture's own harmonics on the lattice's bins, and so do crops in its phase
+    (the oracle: aligned crops of running-bond bricks read +13 dB above random-phase crops,
+    about 0 above crops in their phase). Elsewhere the same draws as without it."""
     stack = np.stack([luminance(getattr(t, "tile", t)) for t in tiles])
     n, T, w = stack.shape
     if w != T:
@@ -90,11 +100,11 @@ def continued_lattice(tiles, source, *, layouts, rng=0) -> tuple[float, float, f
     gain, border = kriging_gain(S, T)
     H, W = S.shape
     g = np.random.default_rng(rng)
+    t = None if template is None else luminance(getattr(template, "tile", template))
+    where = ReferenceCrops.build(S, (T, T), t)
     floors = []
     for idx in layouts:
-        ys = g.integers(0, H - T + 1, n)
-        xs = g.integers(0, W - T + 1, n)
-        crops = np.stack([S[y : y + T, x : x + T] for y, x in zip(ys, xs, strict=True)])
+        crops = np.stack([S[y : y + T, x : x + T] for y, x in where.origins(n, g)])
         miss = (stack[:, border] - crops[:, border]).astype(np.float32)  # (n, nb)
         cont = crops + (miss @ gain.T).reshape(n, T, T)
         cont[:, border] = stack[:, border]

@@ -29,6 +29,7 @@ from engine.tiles.wang_types import (
     INTERIOR_BLENDS,
     INTERIORS,
     PATCH_LABEL,
+    PHASE_SLACK,
     ROLE_AXIS,
     WANG_DEFAULTS,
     WangSample,
@@ -116,6 +117,7 @@ class WangSetup:
         self._detail: dict[tuple[int, int], np.ndarray] = {}
         self._energy_sat: np.ndarray | None = None
         self._corner: tuple | None = None
+        self._phase: tuple | None = None
         step = np.diff(colour_channels(self.S), axis=1)
         #: mean squared colour step between horizontally adjacent source pixels
         self.natural_step = float(np.einsum("yxc,yxc->", step, step, dtype=np.float64)) / (
@@ -262,6 +264,45 @@ class WangSetup:
             self._calm[axis] = calm if axis == "h" else calm.T
         return self._calm[axis]
 
+    def phase(self) -> tuple[float | None, float | None]:
+        """Per axis (y, x): T / k where the texture is periodic and the tile holds k whole
+        periods (:func:`engine.reference_crops.phase_axes`), else None.
+
+        Along such an axis a Wang set can be the texture itself, every course, shelf or
+        board continuing across every joint *and* through every tile, only when all its
+        layers and interiors lie in one phase of the texture modulo T / k; the matcher
+        alone, within its tolerance and kept apart by ``min_distance``, picks windows a few
+        px out of phase (shelf boards stepping inside the tiles)."""
+        if self._phase is None:
+            from engine.reference_crops import phase_axes
+            from engine.tiles.scale import structure_scale
+
+            scale = structure_scale(self.S)
+            axes = phase_axes(scale, (self.T, self.T))
+            self._phase = tuple(
+                self.T / round(self.T / scale.size[i]) if axes[i] else None for i in range(2)
+            )
+        return self._phase
+
+    def keep_phase(self, allowed: np.ndarray, offset, point) -> None:
+        """Clear ``allowed`` (window anchors) where anchor + ``offset`` (the source position
+        of tile pixel (0, 0)) is out of the phase of ``point`` along the axes of
+        :meth:`phase`, by more than :data:`PHASE_SLACK` px; unchanged if nothing would be
+        left."""
+        keep = allowed.copy()
+        for i, p in enumerate(self.phase()):
+            if p is None:
+                continue
+            g = np.arange(keep.shape[i]) + offset[i] - point[i]
+            near = np.abs(g - np.round(g / p) * p) <= PHASE_SLACK
+            keep &= near[:, None] if i == 0 else near[None, :]
+        if keep.any():
+            allowed &= keep
+
+    def tile_origin(self, sample: WangSample) -> tuple[int, int]:
+        """Source position of tile pixel (0, 0) in the sample's N (h) or W (v) layer."""
+        return sample.offset("n" if sample.axis == "h" else "w", self.T)
+
     def role_anchors(self, samples: list[WangSample]) -> list[tuple[int, int]]:
         """Source position of tile pixel (0, 0) for every role of every sample."""
         pts = []
@@ -320,6 +361,9 @@ class WangSetup:
             )
         allowed &= self.calm_joint(axis) & self.detailed((wh, ww))
         h, T = self.reach, self.T
+        if others or same:  # the phase of the samples chosen first
+            ref = self.tile_origin([*others, *same][0])
+            self.keep_phase(allowed, (h, 0) if axis == "h" else (0, h), ref)
         offs = [(h, 0), (h - T, 0)] if axis == "h" else [(0, h), (0, h - T)]
         dist = self.min_distance
         while True:
@@ -394,6 +438,8 @@ class WangSetup:
                 f"no {T}x{T} interior patch fits outside the excluded region: paint a smaller "
                 "exclusion or use interior='diamonds'"
             )
+        if samples:
+            self.keep_phase(allowed, (0, 0), self.tile_origin(samples[0]))
         dist = self.min_distance
         while True:
             ok = allowed.copy()

@@ -42,6 +42,9 @@ DETAIL_QUANTILE = 0.25
 #: within its spread over seeds, but on the periodic weave)
 CORNER_STEPS = 2.0
 CORNER_QUANTILE = 0.05
+#: on a periodic texture whose period the tile holds k times, samples and interiors keep to
+#: the first sample's phase modulo T / k within this many px (see WangSetup.keep_phase)
+PHASE_SLACK = 1.0
 
 #: How the interior patch is blended (``interior_blend``): "auto" = gradient domain unless the
 #: seam's blend is "none" (hard cuts asked for: every pixel stays a source copy), or one of
