@@ -12,7 +12,10 @@ connects to every other.
   window and the template is computed at once by FFT (masked SSD,
   :class:`engine.matching.SampleSpectrum`). Candidate ``k`` is drawn (seeded)
   among the positions within ``1 + tolerance`` of the best remaining one, so structure (brick
-  courses, shelves) lines up across the closed cut. The template's own position and every
+  courses, shelves) lines up across the closed cut — ranked, on non-periodic textures, with a
+  ``spread`` term against windows that resemble the template and the earlier patches (else
+  every tile keeps the template's structure near its edges: the lattice;
+  :mod:`engine.tiles.patch_plan`). The template's own position and every
   earlier candidate's are excluded within ``min_distance`` px (Chebyshev), so no two
   candidates repeat; positions worse than ``1 + quality`` times the source's best match are
   never used: when the source cannot give ``n`` such positions, fewer candidates are made and
@@ -48,9 +51,10 @@ from engine.completions import Completions
 from engine.errormap import colour_channels
 from engine.events import Item, Progress, drain, frozen_array
 from engine.exclusion import valid_anchors
-from engine.matching import ZERO_ERROR_FRACTION, SampleSpectrum, error_floor
+from engine.matching import SampleSpectrum
 from engine.seams.spec import POISSON, SeamSpec, as_seam_spec
 from engine.stitch import PATCH_SEAM
+from engine.tiles import patch_plan
 from engine.tiles.candidate_kernels import (
     band_costs,
     coarse_interior_means,
@@ -59,8 +63,10 @@ from engine.tiles.candidate_kernels import (
     natural_step,
     true_runs,
 )
-from engine.tiles.patch_phase import patch_phase_class
+from engine.tiles.patch_phase import SCALE_CROP
+from engine.tiles.patch_plan import SPREAD, SPREAD_MAX_POSITIONS
 from engine.tiles.patch_stitch import check_ring, gradient_blend, stitch_patch
+from engine.tiles.scale import Scale, structure_scale
 from engine.tiles.seamless import MAIN, SeamlessTile, as_maps, check_weights
 from engine.tiles.template import as_size, excluded_mask, flat_warning
 
@@ -83,7 +89,6 @@ TOLERANCE = 0.25  # global search: draw within (1 + TOLERANCE) x the best remain
 #: with the whole ring matched): the outer band's error varies more from window to window,
 #: and at 2.0 retina kept 25 candidates of 30, coins 13
 QUALITY = 3.0
-SAME_CONTENT = 2.0 / 255  # patch windows closer than this (mean abs luminance) are the same
 #: global search: the ring match is measured on the ring's outer SEARCH_BAND px only (offsets
 #: margin .. margin + SEARCH_BAND - 1). The outward-drawn cut runs there (at d = 1-2 px for
 #: 70-85 % of its length), so that is where the patch must fit; matching the whole ring also
@@ -208,6 +213,7 @@ class _Setup:
         min_distance=None,
         outward=OUTWARD,
         seam_shows=SEAM_SHOWS,
+        spread=SPREAD,
         scale=None,
     ):
         if not isinstance(template, SeamlessTile):
@@ -247,7 +253,10 @@ class _Setup:
         self._min_distance = min_distance
         self.outward = non_negative_number(outward, "outward")
         self.seam_shows = non_negative_number(seam_shows, "seam_shows")
-        self.scale = scale  # the texture's structure scale (None: measured when needed)
+        self.spread = non_negative_number(spread, "spread")
+        if scale is not None and not isinstance(scale, Scale):
+            raise TypeError(f"scale must be a Scale, got {type(scale).__name__}")
+        self.scale = scale
         tx0, ty0 = template.rect[:2]
         self.template_origin = (ty0 + (th - ph) // 2, tx0 + (tw - pw) // 2)
         self._costs = None
@@ -266,6 +275,7 @@ class _Setup:
         self.tmaps = tmaps
         win = (slice(self.ty, self.ty + ph), slice(self.tx, self.tx + pw))
         self.U = {k: v[win] for k, v in tmaps.items()}
+        self.U_main = self.U[MAIN]
         ex = excluded_mask(excluded, (H, W))
         self.valid = None if ex is None else valid_anchors(ex, (ph, pw))
         positions = (H - ph + 1) * (W - pw + 1) if self.valid is None else self.valid.sum()
@@ -355,66 +365,30 @@ class _Setup:
         allowed[max(0, y - d + 1) : y + d, max(0, x - d + 1) : x + d] = False
 
     def plan(self, seeds, avoid=()) -> tuple[list[tuple[int, int]], str | None]:
-        """Global search: the patch origins of candidates with these ``seeds`` (in order),
-        each away from the template's position, from ``avoid`` and from the earlier ones; and
-        a note when fewer than ``len(seeds)`` could be given."""
-        e = self.ring_costs()
-        allowed = np.isfinite(e)
-        # periodic textures: the template's phase class first, the other positions after
-        phase = patch_phase_class(self.S, self.tmaps[MAIN], (self.ph, self.pw), scale=self.scale)
-        region = True if phase is None else phase
-        self._keep_away(allowed, self.template_origin)
-        for o in avoid:
-            self._keep_away(allowed, o)
-        zero = ZERO_ERROR_FRACTION * error_floor(self.Sc)
-        origins: list[tuple[int, int]] = []
-        # content already used: the template's window and every chosen patch (luminance);
-        # a window this close to one of them would make a duplicate candidate
-        step = self._stride
-        seen = [self._luminance(self.U[MAIN][::step, ::step])] + [self._window(o) for o in avoid]
-        same = 0
-        if allowed.any():
-            limit = max(float(e[allowed].min()), zero) * (1 + self.quality)
-            gen_seeds = iter(seeds)
-            seed = next(gen_seeds, None)
-            tries = 0
-            while seed is not None:
-                ok = allowed & (e <= limit) & region
-                if not ok.any():
-                    if region is True:
-                        break
-                    region = True
-                    continue
-                pool = np.flatnonzero(
-                    ok & (e <= max(float(e[ok].min()), zero) * (1 + self.tolerance))
-                )
-                rng = np.random.default_rng([seed, tries] if tries else seed)
-                k = int(pool[rng.integers(pool.size)])
-                origin = (int(k // e.shape[1]), int(k % e.shape[1]))
-                window = self._window(origin)
-                self._keep_away(allowed, origin)
-                if not self.flat and any(np.abs(window - w).mean() < SAME_CONTENT for w in seen):
-                    same += 1  # same content as the template or an earlier patch: redraw
-                    tries += 1
-                    continue
-                origins.append(origin)
-                seen.append(window)
-                seed, tries = next(gen_seeds, None), 0
-        note = None
-        if len(origins) < len(seeds):
-            note = (
-                f"made {len(origins)} of {len(seeds)} candidates: the source has no more patch "
-                f"positions at least {self.min_distance} px from the template's and from each "
-                f"other whose ring matches the template within {1 + self.quality:g}x the best "
-                "match"
-                + (
-                    f" and whose content differs from the others ({same} were alike)"
-                    if same
-                    else ""
-                )
-                + " (a larger source, smaller tiles or a smaller minimum distance give more)"
-            )
-        return origins, note
+        """Global search: the patch origins of candidates with these ``seeds`` (in order)
+        and a note when fewer could be given (:func:`engine.tiles.patch_plan.plan`)."""
+        return patch_plan.plan(self, seeds, avoid)
+
+    def spread_term(self) -> patch_plan.Spread | None:
+        """The global search's resemblance term (:mod:`engine.tiles.patch_plan`), or None when
+        ``spread`` is 0, the source has more than :data:`SPREAD_MAX_POSITIONS` patch positions
+        or the texture is periodic (its patches must keep the template's phase)."""
+        H, W = self.S.shape[:2]
+        if self.spread == 0 or (H - self.ph + 1) * (W - self.pw + 1) > SPREAD_MAX_POSITIONS:
+            return None
+        if any(self.texture_scale().periodic):
+            return None
+        return patch_plan.Spread(self._luminance(self.S), (self.ph, self.pw), self.spread)
+
+    def texture_scale(self) -> Scale:
+        """The texture's structure scale: the one given, else measured once on a central crop
+        of at most :data:`engine.tiles.patch_phase.SCALE_CROP` px (as the phase class is)."""
+        if self.scale is None:
+            H, W = self.S.shape[:2]
+            c = SCALE_CROP
+            y, x = max(0, (H - c) // 2), max(0, (W - c) // 2)
+            self.scale = structure_scale(self.S[y : y + c, x : x + c])
+        return self.scale
 
     def _luminance(self, window: np.ndarray) -> np.ndarray:
         from engine.metrics import luminance
@@ -548,12 +522,13 @@ def iter_candidates(
     min_distance: int | None = None,
     outward: float = OUTWARD,
     seam_shows: float = SEAM_SHOWS,
+    spread: float = SPREAD,
+    scale: Scale | None = None,
     seam: SeamSpec | None = None,
     excluded=None,
     maps=None,
     weights=None,
     rng=None,
-    scale=None,
     workers: int = 2,
     cancel=None,
 ):
@@ -592,6 +567,14 @@ def iter_candidates(
         multiple of the source's own step is blended in the gradient domain instead
         (:data:`SEAM_SHOWS`; 0 = never; its ``scores["gradient_blend"]`` is 1); patches
         larger than :data:`SEAM_SHOWS_MAX_PIXELS` never are.
+    spread : float
+        Global search: weight of a window's resemblance to the template and the patches
+        already chosen in the draw's rank (:mod:`engine.tiles.patch_plan`; :data:`SPREAD`;
+        0 = the band match alone); off on periodic textures.
+    scale : engine.tiles.scale.Scale or None
+        The structure scale, if known (the template search's; None: measured on a central
+        crop): on a periodic texture the global search draws from the template's phase class
+        first (:mod:`engine.tiles.patch_phase`) and without the spread term.
     seam : SeamSpec, optional
         Seam method and options, error metric and blending of the patch cuts (default
         :data:`engine.stitch.PATCH_SEAM`: dp with adaptive blending).
@@ -601,9 +584,6 @@ def iter_candidates(
         The template's material maps (same names) and the seam error weights.
     rng : int, Generator or None
         The run's seed; candidate k uses :func:`candidate_seed` (seed, k).
-    scale : Scale or None
-        The structure scale (None: measured): on a periodic texture the global search draws
-        from the template's phase class first (:mod:`engine.tiles.patch_phase`).
     workers : int
         Threads (1 runs in the calling thread).
     cancel : CancelToken or None
@@ -630,6 +610,7 @@ def iter_candidates(
         min_distance=min_distance,
         outward=outward,
         seam_shows=seam_shows,
+        spread=spread,
         scale=scale,
     )
     n = positive_int(n, "n")
@@ -722,6 +703,8 @@ def make_candidate(
     min_distance: int | None = None,
     outward: float = OUTWARD,
     seam_shows: float = SEAM_SHOWS,
+    spread: float = SPREAD,
+    scale: Scale | None = None,
     patch_size=None,
     patch_overlap=None,
     margin: int = MARGIN,
@@ -758,6 +741,8 @@ def make_candidate(
         min_distance=min_distance,
         outward=outward,
         seam_shows=seam_shows,
+        spread=spread,
+        scale=scale,
     )
     if isinstance(index, bool) or not isinstance(index, numbers.Integral) or index < 0:
         raise ValueError(f"index must be a non-negative integer, got {index!r}")
