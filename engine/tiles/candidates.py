@@ -323,7 +323,7 @@ class _Setup:
         )
         y, x = max(0, (H - 1024) // 2), max(0, (W - 1024) // 2)  # a central crop is enough
         crop = self.S[y : y + 1024, x : x + 1024]
-        self.natural = natural_step(self._luminance(crop)) if reblend else None
+        self.natural = natural_step(self.lum(crop)) if reblend else None
         self.Sc = np.ascontiguousarray(colour_channels(self.S))
         self.Up = np.ascontiguousarray(colour_channels(self.U[MAIN]).transpose(2, 0, 1))
 
@@ -347,17 +347,18 @@ class _Setup:
     def _tone_costs(self) -> np.ndarray:
         """(mean luminance of every window's interior − of the template's ring)², the
         interior being the pixels at least the patch ring w_P in (the ring is where the cut
-        runs; on blocks of :attr:`_stride` px): the tone step a patch would leave at its
+        runs; on blocks of :attr:`stride` px): the tone step a patch would leave at its
         cut (:data:`TONE`)."""
         r = self.ring
-        u = self._luminance(self.U[MAIN])
+        u = self.lum(self.U[MAIN])
         inner = np.zeros(u.shape, dtype=bool)
         inner[r:-r, r:-r] = True
         ring = float(u[~inner].mean())
-        m = coarse_interior_means(self.S, (self.ph, self.pw), r, self._stride)
+        m = coarse_interior_means(self.S, (self.ph, self.pw), r, self.stride)
         return (m - ring) ** 2
 
-    def _keep_away(self, allowed: np.ndarray, origin) -> None:
+    def keep_away(self, allowed: np.ndarray, origin) -> None:
+        """Clear ``allowed`` within ``min_distance`` (Chebyshev) of ``origin``."""
         d = self.min_distance
         if d <= 0:
             return
@@ -378,7 +379,7 @@ class _Setup:
             return None
         if any(self.texture_scale().periodic):
             return None
-        return patch_plan.Spread(self._luminance(self.S), (self.ph, self.pw), self.spread)
+        return patch_plan.Spread(self.lum(self.S), (self.ph, self.pw), self.spread)
 
     def texture_scale(self) -> Scale:
         """The texture's structure scale: the one given, else measured once on a central crop
@@ -390,20 +391,22 @@ class _Setup:
             self.scale = structure_scale(self.S[y : y + c, x : x + c])
         return self.scale
 
-    def _luminance(self, window: np.ndarray) -> np.ndarray:
+    def lum(self, window: np.ndarray) -> np.ndarray:
+        """Luminance (float32) of an image."""
         from engine.metrics import luminance
 
         return luminance(window).astype(np.float32)
 
     @property
-    def _stride(self) -> int:
+    def stride(self) -> int:
         """Every k-th pixel of a window is enough to compare contents (~128 per side)."""
         return max(1, min(self.ph, self.pw) // 128)
 
-    def _window(self, origin) -> np.ndarray:
+    def window_lum(self, origin) -> np.ndarray:
+        """Luminance of the patch window at ``origin``, every :attr:`stride`-th pixel."""
         y, x = origin
-        k = self._stride
-        return self._luminance(self.S[y : y + self.ph : k, x : x + self.pw : k])
+        k = self.stride
+        return self.lum(self.S[y : y + self.ph : k, x : x + self.pw : k])
 
     def random_origin(self, gen: np.random.Generator) -> tuple[int, int]:
         H, W = self.S.shape[:2]
@@ -453,7 +456,7 @@ class _Setup:
             cancel=cancel,
         )
         reblended = self.natural is not None and cut_shows(
-            self._luminance(out[MAIN]), cut.mask, self.natural, self.seam_shows
+            self.lum(out[MAIN]), cut.mask, self.natural, self.seam_shows
         )
         if reblended:
             out = gradient_blend(Q, self.U, cut, ring=self.ring, margin=self.margin)

@@ -123,18 +123,18 @@ def plan(setup, seeds, avoid=()) -> tuple[list[tuple[int, int]], str | None]:
         setup.S, setup.tmaps[MAIN], (setup.ph, setup.pw), scale=setup.texture_scale()
     )
     region = True if phase is None else phase
-    setup._keep_away(allowed, setup.template_origin)
+    setup.keep_away(allowed, setup.template_origin)
     for o in avoid:
-        setup._keep_away(allowed, o)
+        setup.keep_away(allowed, o)
     zero = ZERO_ERROR_FRACTION * error_floor(setup.Sc)
     origins: list[tuple[int, int]] = []
     # content already used: the template's window and every chosen patch (luminance);
     # a window this close to one of them would make a duplicate candidate
-    step = setup._stride
-    seen = [setup._luminance(setup.U_main[::step, ::step])] + [setup._window(o) for o in avoid]
+    step = setup.stride
+    seen = [setup.lum(setup.U_main[::step, ::step])] + [setup.window_lum(o) for o in avoid]
     spread = setup.spread_term()
     if spread is not None:
-        spread.add(setup._luminance(setup.U_main))
+        spread.add(setup.lum(setup.U_main))
         for o in avoid:
             spread.add_origin(o)
     same = 0
@@ -158,8 +158,8 @@ def plan(setup, seeds, avoid=()) -> tuple[list[tuple[int, int]], str | None]:
             rng = np.random.default_rng([seed, tries] if tries else seed)
             k = int(pool[rng.integers(pool.size)])
             origin = (int(k // e.shape[1]), int(k % e.shape[1]))
-            window = setup._window(origin)
-            setup._keep_away(allowed, origin)
+            window = setup.window_lum(origin)
+            setup.keep_away(allowed, origin)
             if not setup.flat and any(np.abs(window - w).mean() < SAME_CONTENT for w in seen):
                 same += 1  # same content as the template or an earlier patch: redraw
                 tries += 1
