@@ -15,8 +15,10 @@ __all__ = [
     "count_changed",
     "cut_shows",
     "coarse_interior_means",
+    "coarse_interior_steps",
     "interior_means",
     "natural_step",
+    "to_origins",
     "true_runs",
 ]
 
@@ -151,3 +153,52 @@ def coarse_interior_means(image: np.ndarray, shape, inset: int, step: int) -> np
     iy = np.minimum(np.arange(H - h + 1) // k, m.shape[0] - 1)
     ix = np.minimum(np.arange(W - w + 1) // k, m.shape[1] - 1)
     return m[iy[:, None], ix[None, :]]
+
+
+def coarse_interior_steps(image: np.ndarray, shape, inset: int, step: int):
+    """Mean |vertical| and |horizontal| neighbour step of the luminance of ``image`` (H, W, C)
+    over the interior (at least ``inset`` px in) of the ``shape`` (h, w) windows whose origins
+    lie every ``step`` k px: two maps on that grid (:func:`to_origins` repeats a map back to
+    every origin). With k > 1 the steps are taken between true neighbours on every k-th row
+    only (and the row below it, for the vertical ones), averaged over k px along the row (a
+    4096 px photo: ~2 % of its pixels, as :func:`coarse_interior_means`)."""
+    k = max(1, int(step))
+    H, W = image.shape[:2]
+    h, w = shape
+    hk, wk = H // k, W // k
+    if k == 1:
+        L = _lum32(image)
+        dy = np.abs(np.diff(L, axis=0))
+        dy = np.concatenate([dy, dy[-1:]])
+    else:  # rows k*i and k*i + 1 (contiguous reads: a column-strided copy costs 5x)
+        L = _lum32(image[: hk * k : k])
+        dy = np.abs(_lum32(image[1 : hk * k : k]) - L)
+        dy = dy[:, : wk * k].reshape(hk, wk, k).mean(axis=2)
+    dx = np.abs(np.diff(L, axis=1))
+    dx = np.concatenate([dx, dx[:, -1:]], axis=1)[:hk, : wk * k].reshape(hk, wk, k).mean(axis=2)
+    size, inner = (max(1, h // k), max(1, w // k)), -(-int(inset) // k)
+    return interior_means(dy, size, inner), interior_means(dx, size, inner)
+
+
+def _lum32(image: np.ndarray) -> np.ndarray:
+    """float32 luminance (BT.709, :func:`engine.metrics.luminance`'s) of (h, w, C)."""
+    from engine.tileset_metrics import LUMA
+
+    x = np.asarray(image, dtype=np.float32)
+    if x.ndim == 2:
+        return x
+    if x.shape[2] < 3:
+        return np.ascontiguousarray(x[:, :, 0])
+    return np.ascontiguousarray(x[:, :, :3]) @ np.asarray(LUMA, dtype=np.float32)
+
+
+def to_origins(coarse: np.ndarray, image_shape, shape, step: int) -> np.ndarray:
+    """A map on the origins every ``step`` px (:func:`coarse_interior_steps`) repeated to
+    every window origin: (H - h + 1, W - w + 1) for an (H, W) image and (h, w) windows."""
+    k = max(1, int(step))
+    if k == 1:
+        return coarse
+    ny, nx = image_shape[0] - shape[0] + 1, image_shape[1] - shape[1] + 1
+    iy = np.minimum(np.arange(ny) // k, coarse.shape[0] - 1)
+    ix = np.minimum(np.arange(nx) // k, coarse.shape[1] - 1)
+    return coarse[iy[:, None], ix[None, :]]

@@ -25,6 +25,18 @@ either axis) the spread is off: there every patch *should* share the template's 
 courses, shelves continue across the cut; the metrics' reference crops are drawn in that
 phase), and spreading the set's mean pulled the patches out of it (bricks frame 1.01 → 1.23,
 coins 1.07 → 1.34, planks 1.28 → 1.51).
+
+**Calm windows** [REC, our design]: every candidate keeps the template's outer margin, so
+every joint between two candidates is the template's own wrap joint, the same step whatever
+the patches. A patch much calmer than that joint (blank paper beside a line of text cut by
+the template's edge) makes it show: beside itself the joint reads
+``joint step / the tile's own mean step``, issue 10's pair ratio. The band match prefers such
+windows wherever the template's ring is calm (public page: 11 of 30 patches were blank paper,
+6 % of the source's windows; pairs max 4.43). So a window is not used when, along either axis,
+its interior's mean luminance step (at least w_P in: the ring is where the cut may replace
+the window's own pixels) is below both the template's joint step across that axis /
+:data:`PAIR_SHOWS` and :data:`CALM` x the median window's (:func:`calm_windows`): only
+windows calm for the texture itself, on textures whose joint would show beside them.
 """
 
 from __future__ import annotations
@@ -32,10 +44,21 @@ from __future__ import annotations
 import numpy as np
 
 from engine.matching import ZERO_ERROR_FRACTION, error_floor
+from engine.tiles.candidate_kernels import coarse_interior_steps, to_origins
 from engine.tiles.patch_phase import patch_phase_class
 from engine.tiles.seamless import MAIN
 
-__all__ = ["SAME_CONTENT", "SPREAD", "SPREAD_MAX_POSITIONS", "SPREAD_SIDE", "Spread", "plan"]
+__all__ = [
+    "CALM",
+    "PAIR_SHOWS",
+    "SAME_CONTENT",
+    "SPREAD",
+    "SPREAD_MAX_POSITIONS",
+    "SPREAD_SIDE",
+    "Spread",
+    "calm_windows",
+    "plan",
+]
 
 SAME_CONTENT = 2.0 / 255  # patch windows closer than this (mean abs luminance) are the same
 #: weight of the resemblance to the set's mean in the global search's rank (0 = off). 0.5 on
@@ -55,6 +78,13 @@ SPREAD_SIDE = 48  # px per side of the block-mean window the resemblance is meas
 #: 3 s of issue 10's 10 s for 30 candidates of 1024 px tiles); larger sources keep the band
 #: match alone
 SPREAD_MAX_POSITIONS = 2**20
+#: calm windows (module docstring): the shared joint may be at most PAIR_SHOWS x a patch's own
+#: mean step (issue 10's pair line is 1.6) ...
+PAIR_SHOWS = 1.5
+#: ... unless the patch is no calmer than CALM x the median window's: a texture whose every
+#: window is calmer than its joint (public shelves: the boards' edges in the template's
+#: top/bottom joint) keeps its patches; 0 turns the rule off
+CALM = 0.5
 
 
 def _block_mean(L: np.ndarray, f: int) -> np.ndarray:
@@ -113,6 +143,26 @@ class Spread:
         return idx[rank <= rank.min() + tolerance]
 
 
+def calm_windows(setup) -> np.ndarray | None:
+    """Boolean map of the patch windows too calm for the template's wrap joint (module
+    docstring, :data:`PAIR_SHOWS`, :data:`CALM`), or None when there are none.
+    ``setup``: the candidates' :class:`engine.tiles.candidates._Setup`."""
+    if CALM <= 0:
+        return None
+    T = setup.lum(setup.tmaps[MAIN])
+    joints = (float(np.abs(T[-1] - T[0]).mean()), float(np.abs(T[:, -1] - T[:, 0]).mean()))
+    if max(joints) == 0:
+        return None
+    k = setup.stride
+    steps = coarse_interior_steps(setup.S, (setup.ph, setup.pw), setup.ring, k)
+    calm = np.zeros(steps[0].shape, dtype=bool)
+    for m, joint in zip(steps, joints, strict=True):
+        calm |= (m * PAIR_SHOWS < joint) & (m < CALM * float(np.median(m)))
+    if not calm.any():
+        return None
+    return to_origins(calm, setup.S.shape, (setup.ph, setup.pw), k)
+
+
 def plan(setup, seeds, avoid=()) -> tuple[list[tuple[int, int]], str | None]:
     """Global search: the patch origins of candidates with these ``seeds`` (in order), each
     away from the template's position, from ``avoid`` and from the earlier ones; and a note
@@ -120,6 +170,9 @@ def plan(setup, seeds, avoid=()) -> tuple[list[tuple[int, int]], str | None]:
     :class:`engine.tiles.candidates._Setup`."""
     e = setup.ring_costs()
     allowed = np.isfinite(e)
+    calm = calm_windows(setup)
+    if calm is not None:
+        allowed &= ~calm
     # periodic textures: the template's phase class first, the other positions after
     # (:mod:`engine.tiles.patch_phase`)
     phase = patch_phase_class(
@@ -180,6 +233,11 @@ def plan(setup, seeds, avoid=()) -> tuple[list[tuple[int, int]], str | None]:
             f"other whose ring matches the template within {1 + setup.quality:g}x the best "
             "match"
             + (f" and whose content differs from the others ({same} were alike)" if same else "")
+            + (
+                f" ({int(calm.sum())} positions are too calm for the tiles' shared joint)"
+                if calm is not None and calm.any()
+                else ""
+            )
             + " (a larger source, smaller tiles or a smaller minimum distance give more)"
         )
     return origins, note
