@@ -109,8 +109,10 @@ class SampleSpectrum:
 
     def _forward(self, k: np.ndarray) -> np.ndarray:
         """2-D real FFT of arrays (..., kh, kw) zero-padded to ``padded``, half along the rows:
-        (..., hp // 2 + 1, wp) (:func:`engine.fft.spectra`)."""
-        return spectra(self.fft, k, self.padded, workers=self.workers)
+        (..., hp // 2 + 1, wp) (:func:`engine.fft.spectra`). On one thread whatever ``workers``
+        says: ducc0 splits batched transforms by thread count and the last bits differ (a run
+        on two threads then scored its blocks differently from one on one thread)."""
+        return spectra(self.fft, k, self.padded, workers=1)
 
     def _conj_spectra(self, k: np.ndarray, workers: int | None = None) -> np.ndarray:
         """The conjugate of :meth:`_forward` for a query's kernels (from the thread's padded

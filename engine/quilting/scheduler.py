@@ -81,9 +81,14 @@ it one by one (batched transforms of a large sample only thrash the cache)."""
 
 BATCH = 3
 """Blocks per batch on samples between :data:`POOL_MIN_SAMPLE_AREA` and
-:data:`BATCH_MAX_SAMPLE_AREA`. Batches chain level by level, so larger ones lengthen the run's
-critical path on two threads: on job B (1024² from 256²) batches of 3 run 2 % slower than
-batches of 4 on one thread and 3 % faster on two; 2 is slower on both."""
+:data:`BATCH_MAX_SAMPLE_AREA` on more than one thread (one thread: one block per batch). Such
+batches search each block alone (:attr:`Quilter.alone`: ducc0's batched transforms differ in the
+last bits with the batch, so the output would otherwise depend on the batches and so on the
+threads). Batches chain level by level, so larger ones lengthen the run's critical path on two
+threads (a unit-cost schedule of job B's 676 blocks: 1.99x one thread with batches of 1, 1.90x
+with 3, 1.83x with 4, 1.65x with 6). Job B on one thread, measured in session 6 under load:
+blocks one by one 1.15x faster than batches of 3 searched together; on two threads batches of 3
+searched block by block 1.05x faster than searched together."""
 
 BATCH_ONE_THREAD = 8
 """Batch size below :data:`POOL_MIN_SAMPLE_AREA` (one thread whatever ``threads`` says): fewer,
@@ -94,20 +99,27 @@ def run_levels(q: Quilter, rects, total_label: str):
     """Place ``rects`` (top-level blocks, raster order); yields events, returns the records.
 
     Blocks go in level order (level, then raster index), in fixed batches of consecutive blocks
-    of one level (:data:`BATCH`; :data:`BATCH_ONE_THREAD` on small samples, one on large ones). A
+    of one level (:data:`BATCH`, one on one thread; :data:`BATCH_ONE_THREAD` on small samples,
+    one on large ones; where the batches depend on the threads, each block is searched alone). A
     batch is loaded (the canvas under it read), searched and placed as one task as soon as its
     blocks' predecessors are placed; with ``threads > 1`` the tasks run on a pool (FFTs and numba
     kernels release the GIL), and blocks of one level are placed side by side (their footprints
     are disjoint). Records and events come out in level order whatever the number of threads,
     every block sees exactly the canvas its predecessors left and draws from its own generator,
-    and the batches do not depend on the threads: the result does not depend on the number of
-    threads.
+    and a block's search does not depend on the batch it is in: the result does not depend on
+    the number of threads.
     """
     q.prepare()  # shared search structures, built once before any thread reads them
     preds, levels = dependencies(rects, q.out_shape, q.tileable)
     order = sorted(range(len(rects)), key=lambda k: (levels[k], k))
     area = q.sample.shape[0] * q.sample.shape[1]
     size = BATCH if area >= POOL_MIN_SAMPLE_AREA else BATCH_ONE_THREAD
+    if area >= POOL_MIN_SAMPLE_AREA:
+        # each block's search a query of its own: ducc0's batched transforms differ in the last
+        # bits with the batch, so only then may the batches depend on the threads
+        q.alone = True
+        if q.threads == 1:
+            size = 1
     if area > BATCH_MAX_SAMPLE_AREA:
         size = 1
     batches: list[list[int]] = []

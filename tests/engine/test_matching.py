@@ -180,3 +180,11 @@ def test_pca_query_ranks_by_estimate_reranks_exactly_and_ignores_the_batch():
     few[5, 7] = few[20, 1] = True  # fewer valid windows than rerank
     ((anchors, errs),) = pca.query(targets[:1], parts[:1], few, rerank=10, mask_list=masks[:1])
     assert sorted(map(tuple, anchors.tolist())) == [(5, 7), (20, 1)] and len(errs) == 2
+
+
+def test_the_sample_spectra_do_not_depend_on_the_workers():
+    """ducc0 splits batched transforms by thread count (the last bits differ): the sample's
+    spectra are made on one thread, so a run on two threads scores as one on one thread."""
+    s = np.random.default_rng(1).random((120, 90, 3), dtype=np.float32)
+    one, two = SampleSpectrum(s, workers=1), SampleSpectrum(s, workers=2)
+    assert np.array_equal(one._hs, two._hs) and np.array_equal(one._fsq, two._fsq)
