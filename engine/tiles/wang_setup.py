@@ -4,6 +4,7 @@ layers, choosing and stitching its interior."""
 
 from __future__ import annotations
 
+import math
 import numbers
 
 import numpy as np
@@ -282,6 +283,9 @@ class WangSetup:
             self._phase = tuple(
                 self.T / round(self.T / scale.size[i]) if axes[i] else None for i in range(2)
             )
+            note = broken_period_note(scale, self.T, axes)
+            if note:
+                self.notes.append(note)
         return self._phase
 
     def keep_phase(self, allowed: np.ndarray, offset, point) -> None:
@@ -522,6 +526,35 @@ class WangSetup:
             "tolerance": self.tolerance,
             "seam": self.seam.to_dict(),
         }
+
+
+def broken_period_note(scale, T: int, whole) -> str | None:
+    """A note when the texture is periodic along an axis (``scale``: a
+    :class:`engine.tiles.scale.Scale`) whose period fits at least once in T but not a whole
+    number of times (``whole``: :func:`engine.reference_crops.phase_axes`), else None.
+
+    Measured on the evaluation set's planks (boards every 48 px, 128 px tiles, 2.67 boards):
+    a tile cannot continue the boards across both of its W and E edges, so every vertical tile
+    line of a layout has a board of another width (31 px between gaps 15-16 px from the line
+    on both sides); at 96 or 144 px the boards run straight through the layout."""
+    parts = []
+    for i, axis in enumerate(("tall", "wide")):
+        p = float(scale.size[i])
+        if whole[i] or not scale.periodic[i] or p <= 0 or p > T:
+            continue
+        k = math.floor(T / p)
+        parts.append(
+            f"{p:.0f} px {axis} ({T / p:.2f} per tile; {round(k * p)} or "
+            f"{round((k + 1) * p)} px hold whole ones)"
+        )
+    if not parts:
+        return None
+    return (
+        f"the texture repeats about every {' and '.join(parts)}, measured by autocorrelation: "
+        f"{T} px Wang tiles do not hold whole periods, so no tile continues the pattern across "
+        "two opposite edges and every tile line breaks it (a structure of another width at "
+        "each line); a tile size that holds whole periods avoids it"
+    )
 
 
 def _band_pixels(T: int, band: int) -> dict[str, tuple[np.ndarray, np.ndarray]]:

@@ -65,3 +65,24 @@ def test_keep_phase_keeps_the_anchors_in_phase_and_never_empties():
     nothing[3, 3] = True  # out of phase, but the only anchor left: kept
     setup.keep_phase(nothing, (0, 0), (20, 0))
     assert nothing.sum() == 1
+
+
+def test_a_tile_that_breaks_the_period_gets_a_note():
+    # planks: boards every 48 px; 128 px tiles hold 2.67 of them, so every vertical tile line
+    # of a layout has a board of another width (seen in the 8x8 layout); 144 px holds three
+    from benchmarks import evalset
+    from engine.bitdepth import to_float
+    from engine.tiles.scale import Scale
+    from engine.tiles.wang_setup import broken_period_note
+
+    note = broken_period_note(Scale(30.0, 48.0, (False, True)), 128, (False, False))
+    assert "48 px wide (2.67 per tile; 96 or 144 px hold whole ones)" in note
+    assert broken_period_note(Scale(30.0, 48.0, (False, True)), 144, (False, True)) is None
+    assert broken_period_note(Scale(30.0, 200.0, (False, True)), 128, (False, False)) is None
+    S = to_float(evalset.load("planks"))
+    setup = WangSetup(S, tile_size=128)
+    setup.phase()
+    assert any("48 px wide" in n for n in setup.notes)
+    setup = WangSetup(S, tile_size=144)
+    setup.phase()
+    assert not any("whole periods" in n for n in setup.notes)
