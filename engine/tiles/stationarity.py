@@ -25,11 +25,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from engine import _jit as jit
+from engine._jit import njit
 from engine._validate import as_image
 from engine.errormap import colour_channels
-from engine.tiles.detail import detail_energy
+from engine.tiles.detail import SMALL_PIXELS, detail_energy
 
-__all__ = ["DETAIL_LIMIT", "LIGHTING_LIMIT", "Stationarity", "check_stationarity"]
+__all__ = [
+    "DETAIL_LIMIT",
+    "LIGHTING_LIMIT",
+    "Stationarity",
+    "check_stationarity",
+    "stationarity_of",
+]
 
 #: ``lighting`` above this: warn (a smooth trend of ±10 % that explains its blocks' tones).
 LIGHTING_LIMIT = 0.2
@@ -56,6 +64,31 @@ def _blocks(x: np.ndarray, n: int) -> np.ndarray:
     return x[oy : oy + gy * b, ox : ox + gx * b].reshape(gy, b, gx, b).mean(axis=(1, 3))
 
 
+def _luminance(S: np.ndarray) -> np.ndarray:
+    """:func:`engine.metrics.luminance` of a validated image (the same float64 values)."""
+    from engine.metrics import LUMA, luminance
+
+    if S.shape[2] not in (1, 3) or (S.shape[0] * S.shape[1] < SMALL_PIXELS and not jit.loaded()):
+        return luminance(S)
+    out = np.empty(S.shape[:2])
+    _luminance_kernel(np.ascontiguousarray(S), np.array(LUMA, dtype=np.float64), out)
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _luminance_kernel(S, luma, out):  # pragma: no cover - compiled
+    """``luminance`` in one pass: ``(r * L0 + g * L1) + b * L2`` in float64 (numpy's order)."""
+    H, W, C = S.shape
+    for y in range(H):
+        for x in range(W):
+            if C == 1:
+                out[y, x] = np.float64(S[y, x, 0])
+            else:
+                r = np.float64(S[y, x, 0]) * luma[0]
+                g = np.float64(S[y, x, 1]) * luma[1]
+                out[y, x] = (r + g) + np.float64(S[y, x, 2]) * luma[2]
+
+
 def _smooth_fit(M: np.ndarray) -> tuple[np.ndarray, float]:
     """Least-squares quadratic surface through the block values ``M``, and its R²."""
     gy, gx = M.shape
@@ -73,12 +106,16 @@ def check_stationarity(source, *, energy: np.ndarray | None = None) -> Stationar
     """How much lighting and detail vary across ``source`` (H, W[, C]); ``energy`` is its
     :func:`~engine.tiles.detail.detail_energy` when already computed. A source of fewer than
     3 x 3 blocks of 8 px is not judged (both figures 0)."""
-    S = colour_channels(as_image(source, "source"))
+    return stationarity_of(colour_channels(as_image(source, "source")), energy=energy)
+
+
+def stationarity_of(S: np.ndarray, *, energy: np.ndarray | None = None) -> Stationarity:
+    """:func:`check_stationarity` of an image already validated (float32 (H, W, C) in [0, 1],
+    colour channels only, as :func:`engine._validate.as_image` and
+    :func:`engine.errormap.colour_channels` give it): no copy of it is made."""
     if min(S.shape[:2]) < 24:
         return Stationarity(0.0, 0.0)
-    from engine.metrics import luminance
-
-    M = _blocks(luminance(S), BLOCKS)
+    M = _blocks(_luminance(S), BLOCKS)
     F, r2 = _smooth_fit(M)
     mean = float(M.mean())
     lighting = float((F.max() - F.min()) / mean * max(r2, 0.0)) if mean > 0 else 0.0

@@ -42,7 +42,7 @@ from engine.errormap import colour_channels
 from engine.events import Item, Progress, Snapshot, drain, frozen_array
 from engine.tiles.detail import DETAIL_WEIGHT, DetailTerm, check_detail_weight
 from engine.tiles.scale import Scale, structure_scale, whole_structure_range
-from engine.tiles.stationarity import check_stationarity
+from engine.tiles.stationarity import stationarity_of
 from engine.tiles.template_scan import (
     Scan,
     argmin_cost,
@@ -480,7 +480,7 @@ def _iter_find_template(
 ):
     H, W = S.shape[:2]
     term = DetailTerm.of(S, kappa)
-    uneven = check_stationarity(S, energy=None if term is None else term.E).warnings
+    uneven = stationarity_of(S, energy=None if term is None else term.E).warnings
     for n in uneven:
         warnings.warn(n, stacklevel=3)
     notes = (*notes, *uneven)
