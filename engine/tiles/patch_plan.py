@@ -41,6 +41,8 @@ windows calm for the texture itself, on textures whose joint would show beside t
 
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
+
 import numpy as np
 
 from engine.matching import ZERO_ERROR_FRACTION, error_floor
@@ -168,21 +170,25 @@ def plan(setup, seeds, avoid=()) -> tuple[list[tuple[int, int]], str | None]:
     away from the template's position, from ``avoid`` and from the earlier ones; and a note
     when fewer than ``len(seeds)`` could be given. ``setup``: the candidates'
     :class:`engine.tiles.candidates._Setup`."""
-    e = setup.ring_costs()
+    # the ring costs (FFTs that release the GIL) on a second thread while this one measures
+    # the phase class, the error floor and the calm windows: the same values, two cores busy
+    with ThreadPoolExecutor(max_workers=1, thread_name_prefix="ring-costs") as ex:
+        costs = ex.submit(setup.ring_costs)
+        # periodic textures: the template's phase class first, the other positions after
+        # (:mod:`engine.tiles.patch_phase`)
+        phase = patch_phase_class(
+            setup.S, setup.tmaps[MAIN], (setup.ph, setup.pw), scale=setup.texture_scale()
+        )
+        zero = ZERO_ERROR_FRACTION * error_floor(setup.Sc)
+        calm = calm_windows(setup)
+        e = costs.result()
     allowed = np.isfinite(e)
-    calm = calm_windows(setup)
     if calm is not None:
         allowed &= ~calm
-    # periodic textures: the template's phase class first, the other positions after
-    # (:mod:`engine.tiles.patch_phase`)
-    phase = patch_phase_class(
-        setup.S, setup.tmaps[MAIN], (setup.ph, setup.pw), scale=setup.texture_scale()
-    )
     region = True if phase is None else phase
     setup.keep_away(allowed, setup.template_origin)
     for o in avoid:
         setup.keep_away(allowed, o)
-    zero = ZERO_ERROR_FRACTION * error_floor(setup.Sc)
     origins: list[tuple[int, int]] = []
     # content already used: the template's window and every chosen patch (luminance);
     # a window this close to one of them would make a duplicate candidate
@@ -196,20 +202,28 @@ def plan(setup, seeds, avoid=()) -> tuple[list[tuple[int, int]], str | None]:
     same = 0
     if allowed.any():
         limit = max(float(e[allowed].min()), zero) * (1 + setup.quality)
+        # only positions within the limit can ever be drawn: keep to them (ascending flat
+        # indices, as np.flatnonzero over the whole array gives them)
+        cand = np.flatnonzero(e <= limit)
+        e_cand = e.ravel()[cand]
         gen_seeds = iter(seeds)
         seed = next(gen_seeds, None)
         tries = 0
         while seed is not None:
-            ok = allowed & (e <= limit) & region
-            if not ok.any():
+            ok_c = allowed.ravel()[cand]
+            if region is not True:
+                ok_c &= region.ravel()[cand]
+            if not ok_c.any():
                 if region is True:
                     break
                 region = True
                 continue
-            best = max(float(e[ok].min()), zero)
+            best = max(float(e_cand[ok_c].min()), zero)
             if spread is None:
-                pool = np.flatnonzero(ok & (e <= best * (1 + setup.tolerance)))
+                pool = cand[ok_c & (e_cand <= best * (1 + setup.tolerance))]
             else:
+                ok = np.zeros(e.shape, dtype=bool)
+                ok.ravel()[cand[ok_c]] = True
                 pool = spread.pool(ok, e, best, setup.tolerance)
             rng = np.random.default_rng([seed, tries] if tries else seed)
             k = int(pool[rng.integers(pool.size)])
