@@ -9,6 +9,7 @@ import math
 import numpy as np
 
 from engine._jit import njit
+from engine.tiles.scale import luminance32
 
 __all__ = [
     "band_costs",
@@ -144,15 +145,10 @@ def coarse_interior_means(image: np.ndarray, shape, inset: int, step: int) -> np
     from engine.metrics import luminance
 
     k = max(1, int(step))
-    H, W = image.shape[:2]
     h, w = shape
     lum = luminance(image[::k, ::k]).astype(np.float32)
     m = interior_means(lum, (max(1, h // k), max(1, w // k)), -(-int(inset) // k))
-    if k == 1:
-        return m
-    iy = np.minimum(np.arange(H - h + 1) // k, m.shape[0] - 1)
-    ix = np.minimum(np.arange(W - w + 1) // k, m.shape[1] - 1)
-    return m[iy[:, None], ix[None, :]]
+    return to_origins(m, image.shape, shape, k)
 
 
 def coarse_interior_steps(image: np.ndarray, shape, inset: int, step: int):
@@ -167,29 +163,17 @@ def coarse_interior_steps(image: np.ndarray, shape, inset: int, step: int):
     h, w = shape
     hk, wk = H // k, W // k
     if k == 1:
-        L = _lum32(image)
+        L = luminance32(image)
         dy = np.abs(np.diff(L, axis=0))
         dy = np.concatenate([dy, dy[-1:]])
     else:  # rows k*i and k*i + 1 (contiguous reads: a column-strided copy costs 5x)
-        L = _lum32(image[: hk * k : k])
-        dy = np.abs(_lum32(image[1 : hk * k : k]) - L)
+        L = luminance32(image[: hk * k : k])
+        dy = np.abs(luminance32(image[1 : hk * k : k]) - L)
         dy = dy[:, : wk * k].reshape(hk, wk, k).mean(axis=2)
     dx = np.abs(np.diff(L, axis=1))
     dx = np.concatenate([dx, dx[:, -1:]], axis=1)[:hk, : wk * k].reshape(hk, wk, k).mean(axis=2)
     size, inner = (max(1, h // k), max(1, w // k)), -(-int(inset) // k)
     return interior_means(dy, size, inner), interior_means(dx, size, inner)
-
-
-def _lum32(image: np.ndarray) -> np.ndarray:
-    """float32 luminance (BT.709, :func:`engine.metrics.luminance`'s) of (h, w, C)."""
-    from engine.tileset_metrics import LUMA
-
-    x = np.asarray(image, dtype=np.float32)
-    if x.ndim == 2:
-        return x
-    if x.shape[2] < 3:
-        return np.ascontiguousarray(x[:, :, 0])
-    return np.ascontiguousarray(x[:, :, :3]) @ np.asarray(LUMA, dtype=np.float32)
 
 
 def to_origins(coarse: np.ndarray, image_shape, shape, step: int) -> np.ndarray:

@@ -38,6 +38,7 @@ __all__ = [
     "DetailTerm",
     "check_detail_weight",
     "detail_energy",
+    "kernel_pays",
     "unrelated_distance",
 ]
 
@@ -53,6 +54,13 @@ REFERENCE_GRID = 64
 SMALL_PIXELS = 1 << 20
 
 
+def kernel_pays(pixels: int) -> bool:
+    """Whether the compiled kernels (the numpy paths' bit-for-bit twins) are worth it for
+    ``pixels``: always once numba is loaded, else only above :data:`SMALL_PIXELS` (small
+    sources do not pay numba's start-up)."""
+    return pixels >= SMALL_PIXELS or jit.loaded()
+
+
 def check_detail_weight(value) -> float:
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise TypeError(f"detail_weight must be a number, got {value!r}")
@@ -64,7 +72,7 @@ def check_detail_weight(value) -> float:
 def detail_energy(S: np.ndarray) -> np.ndarray:
     """(H, W) float64: squared 4-neighbour Laplacian of every channel of ``S`` (H, W, C)
     (reflected at the border), averaged over the channels."""
-    if S.shape[0] * S.shape[1] < SMALL_PIXELS and not jit.loaded():
+    if not kernel_pays(S.shape[0] * S.shape[1]):
         return _detail_energy_numpy(S)
     out = np.empty(S.shape[:2])
     _energy_kernel(np.ascontiguousarray(S), out)
@@ -121,7 +129,7 @@ def _table_kernel(E, T):  # pragma: no cover - compiled
 
 def summed_area(E: np.ndarray) -> np.ndarray:
     """(H + 1, W + 1) summed-area table of ``E`` with a zero first row and column."""
-    if E.size < SMALL_PIXELS and not jit.loaded():
+    if not kernel_pays(E.size):
         return np.pad(E.cumsum(axis=0).cumsum(axis=1), ((1, 0), (1, 0)))
     T = np.empty((E.shape[0] + 1, E.shape[1] + 1))
     _table_kernel(np.ascontiguousarray(E, dtype=np.float64), T)

@@ -35,6 +35,7 @@ __all__ = [
     "PERIOD_SLACK",
     "STRUCTURES_PER_TILE",
     "Scale",
+    "luminance32",
     "structure_scale",
     "whole_structure_range",
 ]
@@ -74,7 +75,10 @@ class Scale:
         }
 
 
-def _luminance(S: np.ndarray) -> np.ndarray:
+def luminance32(S: np.ndarray) -> np.ndarray:
+    """float32 BT.709 luminance of (H, W[, C]) (``engine.metrics.LUMA``'s weights; a gray
+    image is its own, a two-channel one its first channel): the cheap figure for structure
+    and step measurements, where float64 would only cost time."""
     S = np.asarray(S, dtype=np.float32)
     if S.ndim == 2:
         return S
@@ -135,7 +139,7 @@ def structure_scale(source) -> Scale:
     >>> round(s.height), s.periodic[0]
     (32, True)
     """
-    Y = _luminance(source)
+    Y = luminance32(source)
     H, W = Y.shape
     f = max(1, math.ceil(max(H, W) / MAX_SIDE))
     if f > 1:

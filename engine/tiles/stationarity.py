@@ -25,11 +25,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from engine import _jit as jit
 from engine._jit import njit
 from engine._validate import as_image
 from engine.errormap import colour_channels
-from engine.tiles.detail import SMALL_PIXELS, detail_energy
+from engine.tiles.detail import detail_energy, kernel_pays
 
 __all__ = [
     "DETAIL_LIMIT",
@@ -68,7 +67,7 @@ def _luminance(S: np.ndarray) -> np.ndarray:
     """:func:`engine.metrics.luminance` of a validated image (the same float64 values)."""
     from engine.metrics import LUMA, luminance
 
-    if S.shape[2] not in (1, 3) or (S.shape[0] * S.shape[1] < SMALL_PIXELS and not jit.loaded()):
+    if S.shape[2] not in (1, 3) or not kernel_pays(S.shape[0] * S.shape[1]):
         return luminance(S)
     out = np.empty(S.shape[:2])
     _luminance_kernel(np.ascontiguousarray(S), np.array(LUMA, dtype=np.float64), out)
