@@ -11,7 +11,9 @@ float64, union L mask, the compiled dp L-cut, single thread), with ``--start DIR
 of the commit issue 15 started from (a219639, in a process of its own: the "× start" column), the
 exact FFT search and the fast (principal components + exact re-ranking) search, on 1 and 2
 threads. Every time is the median
-of repeats (the load average is printed: on a shared machine rerun when it is near 0).
+of repeats (the load average is printed: on a shared machine rerun when it is near 0); the 1- and
+2-thread runs of a mode alternate, at least 9 rounds (:func:`interleaved_threads`), and the
+2-vs-1-thread line gives the ratio of the medians and the median of the rounds' ratios.
 Samples under 200×200 (job A) run on one thread whatever ``threads`` says
 (:data:`engine.quilting.scheduler.POOL_MIN_SAMPLE_AREA`). Each output's border ratio along the
 block grid (max over the offsets the cuts run in,
@@ -246,7 +248,7 @@ def speed(args) -> None:
                 "",
             ]
         )
-        images, exact_t = {}, {}
+        images, exact_t, ratios = {}, {}, {}
         if args.start:
             for threads in (1, 2):
                 start[job, threads] = start_time(args.start, s, j, threads, args.repeats)
@@ -264,15 +266,10 @@ def speed(args) -> None:
                     ]
                 )
         for mode in ("exact", "fast"):
+            times, ratio = interleaved_threads(s, j, kw, mode, args.repeats, images)
+            ratios[mode] = ratio
             for threads in (1, 2):
-                t, res = median_time(
-                    lambda s=s, j=j, kw=kw, mode=mode, threads=threads: quilt(
-                        s, j["out"], rng=0, mode=mode, threads=threads, **kw
-                    ),
-                    min_repeats=args.repeats,
-                    max_time=args.max_time,
-                )
-                images[mode, threads] = res.image
+                t = times[threads]
                 vs_start = ""
                 if mode == "exact" and (job, threads) in start:
                     gain = start[job, threads] / t
@@ -287,7 +284,7 @@ def speed(args) -> None:
                         f"{base_t / t:.2f}",
                         "" if target is None else f"<= {target}",
                         "" if target is None else ("yes" if t <= target else "NO"),
-                        f"{block_grid_border_ratio(res):.3f}",
+                        f"{block_grid_border_ratio(_Grid(images[mode, threads], **kw)):.3f}",
                         vs_start,
                     ]
                 )
@@ -296,7 +293,11 @@ def speed(args) -> None:
             same = np.array_equal(images[mode, 1], images[mode, 2])
             print(f"job {job} {mode}: identical output on 1 and 2 threads: {same}")
         scale = exact_t[1] / exact_t[2]
-        print(f"job {job} exact: 2 threads {scale:.2f}x faster than 1 (target for B: >= 1.5)")
+        print(
+            f"job {job} exact: 2 threads {scale:.2f}x faster than 1 (target for B: >= 1.5; "
+            f"ratio of the medians; median of the {ratios['exact'][1]} rounds' ratios "
+            f"{ratios['exact'][0]:.2f}x)"
+        )
     print()
     print(
         format_table(
@@ -320,6 +321,28 @@ def speed(args) -> None:
             f"{blas_cpu_seconds() - blas_before:.2f} s (the engine's products stay on one thread)"
         )
     print()
+
+
+INTERLEAVED_ROUNDS = 9
+"""Least number of rounds of the 1- and 2-thread runs of a job (one run of each per round)."""
+
+
+def interleaved_threads(s, j, kw, mode, repeats, images):
+    """Job ``j`` in ``mode`` on 1 and 2 threads, the two run in turn (a change of the machine's
+    load hits both alike) for max(``repeats``, :data:`INTERLEAVED_ROUNDS`) rounds after one
+    untimed run of each: ({threads: median seconds}, (median of the rounds' 1-thread /
+    2-thread ratios, rounds)); the outputs go into ``images[mode, threads]``."""
+    rounds = max(repeats, INTERLEAVED_ROUNDS)
+    times = {1: [], 2: []}
+    for r in range(rounds + 1):
+        for threads in (1, 2):
+            t0 = time.perf_counter()
+            res = quilt(s, j["out"], rng=0, mode=mode, threads=threads, **kw)
+            if r:  # the first round warms up
+                times[threads].append(time.perf_counter() - t0)
+            images[mode, threads] = res.image
+    ratio = float(np.median(np.divide(times[1], times[2])))
+    return {t: float(np.median(v)) for t, v in times.items()}, (ratio, rounds)
 
 
 def alternating_medians(fns, repeats: int) -> list[float]:

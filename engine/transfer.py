@@ -144,6 +144,8 @@ def _check_alpha(alpha):
 class _TransferQuilter(Quilter):
     """One transfer pass: the quilting engine with the α-weighted three-term cost."""
 
+    worker_processes = False  # threads only (not measured with worker processes)
+
     def __init__(self, *, corr_sample, corr_target, previous, alpha, corr_floor, shared, **kw):
         super().__init__(**kw)
         self.corr_sample = corr_sample

@@ -67,6 +67,11 @@ class Quilter:
     and :meth:`search` (its α-weighted cost).
     """
 
+    worker_processes = True
+    """Whether its blocks may be placed in worker processes on more than one thread
+    (:func:`engine.quilting.scheduler.uses_processes`): everything a task writes is the canvas
+    and ``filled``."""
+
     def __init__(self, *, seed: int, cancel, threads: int, plan: Plan, **options):
         # options: the validated keywords of iter_quilt, as returned by check_options (sample,
         # out_shape, block, overlap, select, tolerance, candidates, seam (a SeamSpec), excluded,

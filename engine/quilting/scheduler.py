@@ -5,12 +5,15 @@ earlier blocks (in raster order) whose footprints it touches; its *level* is one
 theirs, and blocks are placed in (level, raster) order, which gives exactly the raster result
 (blocks of one level neither read nor write each other's pixels). A block's search needs only
 its predecessors placed, so with ``threads > 1`` the searches (FFTs and numba kernels, which
-release the GIL) run ahead on a pool while blocks are placed. Each block is searched alone on
+release the GIL) run ahead on a pool while blocks are placed — in worker processes sharing the
+canvas where the per-block Python glue would hold the GIL too long for threads
+(:func:`uses_processes`, :mod:`engine.quilting.workers`). Each block is searched alone on
 exactly the canvas its predecessors left: the output is identical for any number of threads.
 """
 
 from __future__ import annotations
 
+import itertools
 import threading
 from concurrent.futures import Future, ThreadPoolExecutor
 
@@ -19,11 +22,12 @@ import numpy as np
 from engine import _jit as jit
 from engine.cancel import check
 from engine.events import Progress
+from engine.quilting import workers
 from engine.quilting.block_rng import BlockRng
 from engine.quilting.core import BlockWork, Quilter
 from engine.quilting.records import BlockPlaced, BlockRecord
 
-__all__ = ["POOL_MIN_SAMPLE_AREA", "dependencies", "run_levels"]
+__all__ = ["POOL_MIN_SAMPLE_AREA", "dependencies", "run_levels", "uses_processes"]
 
 
 def dependencies(rects, shape, torus: bool):
@@ -114,11 +118,12 @@ def run_levels(q: Quilter, rects, total_label: str):
     order = sorted(range(len(rects)), key=lambda k: (levels[k], k))
     area = q.sample.shape[0] * q.sample.shape[1]
     size = BATCH if area >= POOL_MIN_SAMPLE_AREA else BATCH_ONE_THREAD
+    processes = q.threads > 1 and uses_processes(q)
     if area >= POOL_MIN_SAMPLE_AREA:
         # each block's search a query of its own: ducc0's batched transforms differ in the last
         # bits with the batch, so only then may the batches depend on the threads
         q.alone = True
-        if q.threads == 1:
+        if q.threads == 1 or processes:
             size = 1
     if area > BATCH_MAX_SAMPLE_AREA:
         size = 1
@@ -136,7 +141,31 @@ def run_levels(q: Quilter, rects, total_label: str):
         works = [BlockWork(k, *rects[k], rng=rng(q.seed, k)) for k in batches[b]]
         return q.run_batch(works)
 
-    if q.threads > 1 and area >= POOL_MIN_SAMPLE_AREA:
+    if processes:
+        q.canvas, q.filled = workers.share(q.canvas), workers.share(q.filled)
+        # the first blocks run here until one with a top and a left arm is placed: the numba
+        # kernels of every common block are then loaded before the fork (else every worker
+        # would load them again, in every run)
+        head = []
+        while len(head) < len(batches) and not any(
+            rec.arms[0] and rec.arms[1] for out in head for rec, _ in out
+        ):
+            head.append(run(len(head)))
+
+        def pixels_of(rec):
+            return q.canvas[q.idx(*rec.position, *rec.size)].copy()
+
+        placed = workers.WorkerPool(
+            run,
+            lambda b: [rec for rec, _ in run(b)],  # this process reads the pixels (shared)
+            lambda recs: workers.records_in(recs, pixels_of),
+            needs,
+            q.threads,
+            q.cancel,
+            done=len(head),
+        )
+        outcomes = itertools.chain(head, (placed.result(b) for b in range(len(head), len(batches))))
+    elif q.threads > 1 and area >= POOL_MIN_SAMPLE_AREA:
         placed = _DependencyPool(run, needs, q.threads)
         outcomes = (placed.result(b) for b in range(len(batches)))
     else:
@@ -161,6 +190,24 @@ def run_levels(q: Quilter, rects, total_label: str):
         if placed is not None:
             placed.shutdown()
     return records
+
+
+def uses_processes(q: Quilter) -> bool:
+    """Whether a run on more than one thread places its blocks in worker processes
+    (:mod:`engine.quilting.workers`) rather than threads: the whole-sample exact search of
+    quilting (not transfer) on samples between :data:`POOL_MIN_SAMPLE_AREA` and
+    :data:`BATCH_MAX_SAMPLE_AREA`, where a block's Python glue holds the GIL for about a third
+    of its time (larger samples' transforms release the GIL long enough for threads), on a
+    system with ``fork``. Same records and image either way."""
+    area = q.sample.shape[0] * q.sample.shape[1]
+    return (
+        q.worker_processes
+        and q.select == "best"
+        and q.plan.search == "fft"
+        and q.origin is None
+        and POOL_MIN_SAMPLE_AREA <= area <= BATCH_MAX_SAMPLE_AREA
+        and workers.available()
+    )
 
 
 def _default_rng(seed: int, index: int) -> np.random.Generator:

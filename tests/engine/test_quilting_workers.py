@@ -1,0 +1,145 @@
+"""Exact quilting on worker processes (engine.quilting.workers) gives exactly one thread's result,
+stops its workers when cancelled or failing, and threads stay available."""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import pytest
+
+from engine import _jit
+from engine.cancel import Cancelled, CancelToken
+from engine.quilting import iter_quilt, quilt, workers
+from engine.quilting.core import Quilter
+from engine.quilting.records import BlockPlaced
+
+pytestmark = pytest.mark.skipif(not hasattr(os, "fork"), reason="worker processes need fork")
+
+SAMPLE = np.random.default_rng(6).random((210, 200, 3), dtype=np.float32)  # >= 200² pixels
+
+
+def _records(result):
+    return [
+        (
+            b.position,
+            b.size,
+            b.source,
+            b.arms,
+            b.criterion,
+            b.peak,
+            b.match_error,
+            b.best_error,
+            b.candidates,
+            b.depth,
+            None if b.error is None else b.error.tobytes(),
+            None if b.keep_old is None else b.keep_old.tobytes(),
+            np.asarray(b.path).tobytes(),
+        )
+        for b in result.blocks
+    ]
+
+
+@pytest.fixture
+def pools(monkeypatch):
+    """Counts the worker pools made."""
+    made = []
+    real = workers.WorkerPool
+
+    class Counted(real):
+        def __init__(self, *args, **kwargs):
+            made.append(self)
+            super().__init__(*args, **kwargs)
+
+    monkeypatch.setattr(workers, "WorkerPool", Counted)
+    return made
+
+
+@pytest.mark.parametrize(
+    "options",
+    [
+        {},
+        dict(tileable=True),  # wrap-around blocks with bottom / right arms
+        dict(adaptive_threshold=0.02),  # split blocks: children searched inside a task
+    ],
+)
+def test_worker_processes_give_one_threads_records_and_image(options, pools, monkeypatch):
+    _jit.load()
+    kw = dict(block=28, overlap=6, rng=3, mode="exact", **options)
+    one = quilt(SAMPLE, (150, 170), threads=1, **kw)
+    assert not pools
+    runs = [quilt(SAMPLE, (150, 170), threads=t, **kw) for t in (2, 3)]
+    assert len(pools) == 2
+    monkeypatch.setenv(workers.ENV, "threads")
+    runs.append(quilt(SAMPLE, (150, 170), threads=2, **kw))
+    assert len(pools) == 2  # threads, no processes
+    for run in runs:
+        assert np.array_equal(run.image, one.image)
+        assert _records(run) == _records(one)
+        assert not run.image.flags.writeable
+        for b in run.blocks:
+            for a in (b.error, b.keep_old, b.path):
+                assert a is None or not a.flags.writeable
+
+
+def test_streamed_pixels_are_the_placed_blocks(pools):
+    """The events of a run on worker processes carry each block's pixels as pasted (read from
+    the shared canvas before any later block may overwrite them), in level order."""
+    _jit.load()
+    kw = dict(block=28, overlap=6, rng=5, mode="exact")
+    mine, ref = (
+        [e for e in iter_quilt(SAMPLE, (150, 170), threads=t, **kw) if isinstance(e, BlockPlaced)]
+        for t in (2, 1)
+    )
+    assert pools
+    assert len(mine) == len(ref)
+    for a, b in zip(mine, ref, strict=True):
+        assert a.position == b.position
+        assert np.array_equal(a.pixels, b.pixels)
+
+
+def test_cancel_stops_the_workers(pools):
+    _jit.load()
+    token = CancelToken()
+    it = iter_quilt(SAMPLE, (300, 300), block=28, overlap=6, rng=1, threads=2, cancel=token)
+    with pytest.raises(Cancelled):
+        for n, _ in enumerate(it):
+            if n == 40:
+                token.cancel()
+    assert pools and not pools[0].pids  # the workers were stopped
+
+
+class Boom(Exception):
+    pass
+
+
+def test_an_error_in_a_worker_reaches_the_caller(pools, monkeypatch):
+    """A block failing in a worker process (or here) raises the same exception from quilt."""
+    _jit.load()
+    real = Quilter.place
+
+    def place(self, wk):
+        if wk.index == 30:
+            raise Boom(f"block {wk.index}")
+        return real(self, wk)
+
+    monkeypatch.setattr(Quilter, "place", place)
+    with pytest.raises(Boom):
+        quilt(SAMPLE, (200, 200), block=28, overlap=6, rng=1, mode="exact", threads=2)
+    assert pools and not pools[0].pids
+
+
+def test_closing_the_stream_early_stops_the_workers(pools):
+    _jit.load()
+    it = iter_quilt(SAMPLE, (300, 300), block=28, overlap=6, rng=1, threads=2)
+    for n, _ in enumerate(it):
+        if n == 30:
+            break
+    it.close()
+    assert pools and not pools[0].pids
+
+
+def test_small_samples_stay_on_threads(pools):
+    _jit.load()
+    quilt(SAMPLE[:150, :150], (150, 170), block=28, overlap=6, rng=3, threads=2)
+    assert not pools
