@@ -152,17 +152,8 @@ def run_levels(q: Quilter, rects, total_label: str):
         ):
             head.append(run(len(head)))
 
-        def pixels_of(rec):
-            return q.canvas[q.idx(*rec.position, *rec.size)].copy()
-
         placed = workers.WorkerPool(
-            run,
-            lambda b: [rec for rec, _ in run(b)],  # this process reads the pixels (shared)
-            lambda recs: workers.records_in(recs, pixels_of),
-            needs,
-            q.threads,
-            q.cancel,
-            done=len(head),
+            run, workers.records_in, needs, q.threads, q.cancel, done=len(head)
         )
         outcomes = itertools.chain(head, (placed.result(b) for b in range(len(head), len(batches))))
     elif q.threads > 1 and area >= POOL_MIN_SAMPLE_AREA:

@@ -1,32 +1,31 @@
 """Worker processes for exact quilting on two or more cores (fork + a shared canvas).
 
-Measured in session 7 (job B exact, 256² sample, 676 blocks): a block's search and placement
-holds the GIL about a third of its time (numpy glue between ducc0's transforms and the numba
-kernels), and two threads of one process handed the GIL back and forth ~10 times per block:
-~45 000 context switches per 7 runs against ~160 on one thread, each block's thread CPU time up
-by 40-60 % and about 0.5 ms per block spent waiting for the GIL, so two threads were no faster
-than one. Two *processes* running the same loop lost only 10-25 % each. So on POSIX, where
-``fork`` exists, :func:`engine.quilting.scheduler.run_levels` hands the blocks of an exact
-search to worker processes instead of threads:
+Measured in session 7 (job B exact, 256² sample, 676 blocks, numba loaded): a block's search
+and placement holds the GIL about a third of its time (py-spy --gil: numpy glue between ducc0's
+transforms and the numba kernels), and two threads of one process handed the GIL back and forth
+~10 times per block (perf: ~45 000 context switches per 7 runs against ~160 on one thread),
+their CPU time per block up 40-60 % and ~0.5 ms per block spent waiting for the GIL: two
+threads were no faster than one. So where ``fork`` exists,
+:func:`engine.quilting.scheduler.run_levels` places such blocks in worker processes instead:
 
 * the canvas and its ``filled`` mask move to shared memory (an anonymous ``MAP_SHARED``
   mapping) before the fork; the workers inherit everything else (the sample's spectra, the
-  options) copy-on-write, so nothing is sent but task numbers and the records;
-* each worker runs exactly the task a thread would run (:meth:`Quilter.run_batch` of one batch
-  whose predecessors are placed) and sends back the records and pixels; the parent dispatches a
-  task as soon as the tasks it needs have come back (their pixels are then on the shared canvas);
+  options) copy-on-write;
+* the calling process and ``threads - 1`` forked workers each take the lowest ready task (the
+  ready set, a lock and a semaphore live in shared memory), run exactly the task a thread would
+  run (:meth:`Quilter.run_batch` of one block whose predecessors are placed) and release its
+  dependents; the workers send their records and pixels back through a pipe;
 * every block is searched and placed by the same code on exactly the canvas its predecessors
   left: the records and the image are bit-identical to one thread's
   (``tests/engine/test_quilting_workers.py``).
 
-The parent only dispatches and collects (a few tens of microseconds per block); cancelling,
-an error in a worker or closing the generator kills the workers at once.
+Cancelling, an error in a worker or closing the generator kills the workers at once.
+``QUILT_STUDIO_WORKERS=threads`` keeps threads.
 """
 
 from __future__ import annotations
 
 import contextlib
-import heapq
 import mmap
 import os
 import signal
@@ -60,44 +59,53 @@ def share(a: np.ndarray) -> np.ndarray:
 
 
 class WorkerPool:
-    """Runs every task once, each as soon as the tasks it ``needs`` have run: in this process
-    (``run(task)``, while waiting for a result) and in ``workers - 1`` forked processes
-    (``remote(task)``, whose result comes back through a pipe and goes through
-    ``receive(result)`` before any task that depended on it is sent out: ``receive`` may read the
-    shared memory the task wrote). :meth:`result` returns one task's result. Tasks before
-    ``done`` count as run.
+    """Runs every task once, each as soon as the tasks it ``needs`` have run, in this process
+    and ``workers - 1`` forked ones; :meth:`result` returns one task's result (``run(task)``'s,
+    through ``receive`` when it ran in a worker; it must pickle). Tasks before ``done`` count
+    as run.
 
     The tasks must write their effects only to memory shared before the pool was made (see
-    :func:`share`); ``remote``'s results must pickle. This process is one of the workers (a
-    third process on two cores would wait for a core to hand out every task), and each forked
-    worker gets up to :data:`QUEUE` tasks ahead, so it does not idle while this one runs a
-    task."""
+    :func:`share`). Which tasks are ready lives in shared memory too (a lock, a semaphore
+    counting the ready tasks, each task's count of unfinished needs): whoever finishes a task
+    releases its dependents at once and any idle process takes the lowest ready one, so no
+    task waits for this process to hand it out. This process is one of the workers (a third
+    process on two cores would wait for a core: measured 1.27x one thread against 1.30x, 15
+    interleaved rounds); it collects the workers' results between its own tasks."""
 
-    QUEUE = 2
+    def __init__(self, run, receive, needs, workers: int, cancel=None, *, done=0):
+        from multiprocessing import get_context
 
-    def __init__(self, run, remote, receive, needs, workers: int, cancel=None, *, done=0):
+        ctx = get_context("fork")
         self.run, self.receive, self.cancel = run, receive, cancel
         self.results: dict[int, object] = {}
-        self.waiting = [sum(j >= done for j in p) for p in needs]
+        n = len(needs)
         self.dependents: list[list[int]] = [[] for _ in needs]
         for k, p in enumerate(needs):
             for j in p:
                 self.dependents[j].append(k)
-        self.ready = [k for k, n in enumerate(self.waiting) if not n and k >= done]
-        heapq.heapify(self.ready)
-        self.conns, self.pids, self.sent = [], [], []
+        self.lock, self.ready = ctx.Lock(), ctx.Semaphore(0)
+        self.waiting = np.frombuffer(ctx.RawArray("i", max(1, n)), np.int32)[:n]
+        self.waiting[:] = [sum(j >= done for j in p) for p in needs]
+        self.state = np.frombuffer(ctx.RawArray("b", max(1, n) + 1), np.int8)  # last: stop
+        self.state[:done] = TAKEN
+        first = [k for k in range(done, n) if not self.waiting[k]]
+        self.state[first] = READY
+        for _ in first:
+            self.ready.release()
+        self.left = n - done  # tasks whose results are not in yet
+        self.conns, self.pids = [], []
         owner = os.getpid()
         try:
             for _ in range(workers - 1):
                 parent, child = Pipe()
                 pid = os.fork()
-                if pid == 0:  # the worker: serve tasks until told to stop, never return
+                if pid == 0:  # the worker: take tasks until told to stop, never return
                     code = 0
                     try:
                         parent.close()
                         for other in self.conns:  # the other workers' pipes
                             other.close()
-                        _serve(child, remote, owner)
+                        self._serve(child, owner)
                     except BaseException:
                         code = 1
                     finally:
@@ -105,52 +113,76 @@ class WorkerPool:
                 child.close()
                 self.conns.append(parent)
                 self.pids.append(pid)
-                self.sent.append(0)
         except BaseException:
             self.shutdown(kill=True)
             raise
 
-    def _done(self, k: int, value) -> None:
-        self.results[k] = value
-        for d in self.dependents[k]:
-            self.waiting[d] -= 1
-            if not self.waiting[d]:
-                heapq.heappush(self.ready, d)
+    def _take(self) -> int:
+        """The lowest ready task, marked taken (the caller holds one count of ``ready``)."""
+        with self.lock:
+            k = int(np.flatnonzero(self.state[:-1] == READY)[0])
+            self.state[k] = TAKEN
+        return k
 
-    def _dispatch(self) -> None:
-        for i, conn in enumerate(self.conns):
-            while self.sent[i] < self.QUEUE and self.ready:
-                conn.send(heapq.heappop(self.ready))
-                self.sent[i] += 1
+    def _finish(self, k: int) -> None:
+        released = 0
+        with self.lock:
+            for d in self.dependents[k]:
+                self.waiting[d] -= 1
+                if not self.waiting[d]:
+                    self.state[d] = READY
+                    released += 1
+        for _ in range(released):
+            self.ready.release()
+
+    def _serve(self, conn, owner: int) -> None:
+        with contextlib.suppress(ValueError):  # a Ctrl+C is the parent's (it kills its workers)
+            signal.signal(signal.SIGINT, signal.SIG_IGN)
+        while True:
+            if not self.ready.acquire(timeout=1.0):
+                if os.getppid() != owner:  # the parent is gone (killed): no one will collect
+                    return
+                continue
+            if self.state[-1]:  # stop
+                return
+            k = self._take()
+            try:
+                out = self.run(k)
+            except BaseException as exc:
+                try:
+                    conn.send(("error", k, exc))
+                except Exception:  # an exception that does not pickle
+                    conn.send(("error", k, RuntimeError(repr(exc))))
+                return
+            self._finish(k)
+            conn.send(("ok", k, out))
 
     def _collect(self, timeout: float) -> None:
-        busy = [c for c, n in zip(self.conns, self.sent, strict=True) if n]
-        if timeout:
-            busy = wait(busy, timeout) if busy else ()
-        for conn in busy:  # Connection.poll: far cheaper than wait()'s selector per call
-            i = self.conns.index(conn)
+        conns = wait(self.conns, timeout) if timeout else self.conns
+        for conn in conns:  # Connection.poll: far cheaper than wait()'s selector per call
             while conn.poll():
                 try:
                     kind, k, value = conn.recv()
                 except EOFError:
                     raise RuntimeError("a quilting worker process died") from None
-                self.sent[i] -= 1
                 if kind == "error":
                     raise value
-                self._done(k, self.receive(value))
+                self.results[k] = self.receive(value)
+                self.left -= 1
 
     def result(self, k: int):
-        """Task ``k``'s result (running, handing out and collecting tasks until it is in)."""
+        """Task ``k``'s result (running tasks here and collecting the workers' until it is in)."""
         while k not in self.results:
             check(self.cancel)
             self._collect(0)
-            self._dispatch()
             if k in self.results:
                 break
-            if self.ready:
-                j = heapq.heappop(self.ready)
-                self._done(j, self.run(j))
-            elif any(self.sent):
+            if self.ready.acquire(block=False):
+                j = self._take()
+                self.results[j] = self.run(j)
+                self.left -= 1
+                self._finish(j)
+            elif self.conns:
                 self._collect(0.05)
             else:  # pragma: no cover - a task whose needs never run
                 raise RuntimeError(f"quilting task {k} can never run")
@@ -158,20 +190,22 @@ class WorkerPool:
 
     def shutdown(self, kill: bool = False) -> None:
         """Stop the workers (at once with ``kill``, or when tasks are still out)."""
-        kill = kill or any(self.sent)
-        for conn, pid in zip(self.conns, self.pids, strict=True):
-            try:
-                if kill:
+        kill = kill or self.left > 0
+        self.state[-1] = 1
+        for pid in self.pids:
+            if kill:
+                with contextlib.suppress(OSError):
                     os.kill(pid, signal.SIGKILL)
-                else:
-                    conn.send(None)
-            except OSError:
-                pass
+            else:
+                self.ready.release()
         for conn, pid in zip(self.conns, self.pids, strict=True):
             conn.close()
             # reaped on a thread of its own: a worker's exit takes milliseconds
             threading.Thread(target=_reap, args=(pid,), daemon=True).start()
-        self.conns, self.pids, self.sent = [], [], []
+        self.conns, self.pids = [], []
+
+
+READY, TAKEN = 1, 2
 
 
 def _reap(pid: int) -> None:
@@ -179,34 +213,13 @@ def _reap(pid: int) -> None:
         os.waitpid(pid, 0)
 
 
-def _serve(conn, run, owner: int) -> None:
-    with contextlib.suppress(ValueError):  # a Ctrl+C is the parent's (it kills its workers)
-        signal.signal(signal.SIGINT, signal.SIG_IGN)
-    while True:
-        while not conn.poll(1.0):
-            if os.getppid() != owner:  # the parent is gone (killed): no one will ask
-                return
-        k = conn.recv()
-        if k is None:
-            return
-        try:
-            conn.send(("ok", k, run(k)))
-        except BaseException as exc:
-            try:
-                conn.send(("error", k, exc))
-            except Exception:  # an exception that does not pickle
-                conn.send(("error", k, RuntimeError(repr(exc))))
-
-
-def records_in(recs, pixels_of):
-    """A task's records as received, with their arrays read-only again (pickling drops the
-    flag), paired with their pixels (``pixels_of(record)``, read from the shared canvas: the
-    workers do not send them)."""
-    out = []
-    for rec in recs:
+def records_in(out):
+    """A task's (record, pixels) pairs as received from a worker, their arrays read-only again
+    (pickling drops the flag)."""
+    for rec, pixels in out:
         for name in ("error", "keep_old", "path", "territory"):
             a = getattr(rec, name)
             if a is not None:
                 read_only(a)
-        out.append((rec, read_only(pixels_of(rec))))
+        read_only(pixels)
     return out
