@@ -44,9 +44,16 @@ ENV = "QUILT_STUDIO_WORKERS"
 
 
 def available() -> bool:
-    """Whether worker processes can be used here (``os.fork`` exists; not turned off by
-    :data:`ENV`)."""
-    return hasattr(os, "fork") and os.environ.get(ENV, "").strip().lower() != "threads"
+    """Whether worker processes can be used here: ``fork`` exists, this is not a daemonic
+    process of :mod:`multiprocessing` (which may not have children) and :data:`ENV` does not
+    say ``threads``."""
+    from multiprocessing import current_process
+
+    return (
+        hasattr(os, "fork")
+        and not current_process().daemon
+        and os.environ.get(ENV, "").strip().lower() != "threads"
+    )
 
 
 def share(a: np.ndarray) -> np.ndarray:
@@ -93,26 +100,18 @@ class WorkerPool:
         for _ in first:
             self.ready.release()
         self.left = n - done  # tasks whose results are not in yet
-        self.conns, self.pids = [], []
+        self.conns, self.procs = [], []
         owner = os.getpid()
         try:
             for _ in range(workers - 1):
                 parent, child = Pipe()
-                pid = os.fork()
-                if pid == 0:  # the worker: take tasks until told to stop, never return
-                    code = 0
-                    try:
-                        parent.close()
-                        for other in self.conns:  # the other workers' pipes
-                            other.close()
-                        self._serve(child, owner)
-                    except BaseException:
-                        code = 1
-                    finally:
-                        os._exit(code)
+                proc = ctx.Process(
+                    target=self._serve, args=(child, owner, list(self.conns)), daemon=True
+                )
+                proc.start()
                 child.close()
                 self.conns.append(parent)
-                self.pids.append(pid)
+                self.procs.append(proc)
         except BaseException:
             self.shutdown(kill=True)
             raise
@@ -135,7 +134,10 @@ class WorkerPool:
         for _ in range(released):
             self.ready.release()
 
-    def _serve(self, conn, owner: int) -> None:
+    def _serve(self, conn, owner: int, others) -> None:
+        """A worker's loop: take tasks until told to stop (or the caller is gone)."""
+        for other in others:  # the other workers' pipes
+            other.close()
         with contextlib.suppress(ValueError):  # a Ctrl+C is the parent's (it kills its workers)
             signal.signal(signal.SIGINT, signal.SIG_IGN)
         while True:
@@ -192,25 +194,19 @@ class WorkerPool:
         """Stop the workers (at once with ``kill``, or when tasks are still out)."""
         kill = kill or self.left > 0
         self.state[-1] = 1
-        for pid in self.pids:
+        for proc in self.procs:
             if kill:
-                with contextlib.suppress(OSError):
-                    os.kill(pid, signal.SIGKILL)
+                proc.kill()
             else:
                 self.ready.release()
-        for conn, pid in zip(self.conns, self.pids, strict=True):
+        for conn, proc in zip(self.conns, self.procs, strict=True):
             conn.close()
-            # reaped on a thread of its own: a worker's exit takes milliseconds
-            threading.Thread(target=_reap, args=(pid,), daemon=True).start()
-        self.conns, self.pids = [], []
+            # joined on a thread of its own: a worker's exit takes milliseconds
+            threading.Thread(target=proc.join, daemon=True).start()
+        self.conns, self.procs = [], []
 
 
 READY, TAKEN = 1, 2
-
-
-def _reap(pid: int) -> None:
-    with contextlib.suppress(ChildProcessError):
-        os.waitpid(pid, 0)
 
 
 def records_in(out):

@@ -106,7 +106,7 @@ def test_cancel_stops_the_workers(pools):
         for n, _ in enumerate(it):
             if n == 40:
                 token.cancel()
-    assert pools and not pools[0].pids  # the workers were stopped
+    assert pools and not pools[0].procs  # the workers were stopped
 
 
 class Boom(Exception):
@@ -126,7 +126,7 @@ def test_an_error_in_a_worker_reaches_the_caller(pools, monkeypatch):
     monkeypatch.setattr(Quilter, "place", place)
     with pytest.raises(Boom):
         quilt(SAMPLE, (200, 200), block=28, overlap=6, rng=1, mode="exact", threads=2)
-    assert pools and not pools[0].pids
+    assert pools and not pools[0].procs
 
 
 def test_closing_the_stream_early_stops_the_workers(pools):
@@ -136,7 +136,7 @@ def test_closing_the_stream_early_stops_the_workers(pools):
         if n == 30:
             break
     it.close()
-    assert pools and not pools[0].pids
+    assert pools and not pools[0].procs
 
 
 def test_small_samples_stay_on_threads(pools):
