@@ -16,6 +16,15 @@ frame / ring tone / lattice above floor / template share of:
 * **hard cuts**: the candidates re-made without the gradient re-blend of showing cuts
   (``seam_shows=0``).
 
+Each lattice figure is also split by the kind of harmonic that carries it (``--parts``,
+:func:`lattice_parts`): *along y* (bins with no horizontal frequency: row structure such as a
+tone step or a joint at every tile row), *along x* (column structure), *mixed* (both: structure
+local in both directions, e.g. a blob at the tile's corners) — each the mean power on those
+harmonics over the same between-harmonic power, minus the floor's; the ``all`` figure is the
+metric's. Next to it the tiles' *tone spread*: the standard deviation of the tiles' mean
+luminance over the floor crops' (below 1: tiles more alike in tone than crops of the source,
+which raises the lattice ratio by itself — less power between the harmonics).
+
 Prints a table and writes it to ``benchmarks/results/lattice_causes.txt``.
 """
 
@@ -35,6 +44,60 @@ def _with_margin(q: np.ndarray, T: np.ndarray, m: int) -> np.ndarray:
     q = q.copy()
     q[:m], q[-m:], q[:, :m], q[:, -m:] = T[:m], T[-m:], T[:, :m], T[:, -m:]
     return q
+
+
+def lattice_parts(tiles, source, *, template, margin: int, layouts=None, rng=0) -> dict:
+    """:func:`engine.metrics.lattice` (same crops, same layouts, same random draws: ``all`` is
+    its ``above``) split by harmonic kind, in dB above the floor: ``along y`` (bins (i, 0)),
+    ``along x`` ((0, j)), ``mixed`` ((i, j), i, j > 0), ``all``; and ``tone spread`` (module
+    docstring)."""
+    from engine.metrics import LATTICE_LAYOUTS, edge_distance, luminance
+    from engine.reference_crops import ReferenceCrops
+
+    stack = np.stack([luminance(getattr(t, "tile", t)) for t in tiles]).astype(np.float64)
+    n, h, w = stack.shape
+    ring = edge_distance((h, w)) < margin
+    T = luminance(getattr(template, "tile", template))
+    g = np.random.default_rng(rng)
+    S = luminance(source)
+    where = ReferenceCrops.build(S, (h, w), T)
+    R = C = 8
+    ty, tx = np.arange(R)[:, None], np.arange(C)[None, :]
+    r, c = np.arange(h)[:, None], np.arange(w)[None, :]
+    kinds = {
+        "along y": (slice(1, None), slice(0, 1)),
+        "along x": (slice(0, 1), slice(1, None)),
+        "mixed": (slice(1, None), slice(1, None)),
+        "all": (slice(None), slice(None)),
+    }
+
+    def spectra(st, idx) -> dict:
+        power = {}
+        for a in (0, 1):
+            for b in (0, 1):
+                wts = np.zeros(st.shape[0])
+                np.add.at(wts, idx.ravel(), ((-1.0) ** (ty * a + tx * b)).ravel())
+                mod = np.exp(-1j * np.pi * (a * r / h + b * c / w))
+                power[a, b] = np.abs(np.fft.fft2(np.tensordot(wts, st, 1) * mod)) ** 2
+        harm = power[0, 0].copy()
+        harm[0, 0] = np.nan  # the DC bin is no harmonic
+        mid = np.concatenate([power[1, 0].ravel(), power[0, 1].ravel(), power[1, 1].ravel()])
+        return {k: 10 * np.log10(np.nanmean(harm[s]) / mid.mean()) for k, s in kinds.items()}
+
+    above = {k: [] for k in kinds}
+    means = []
+    for _ in range(LATTICE_LAYOUTS if layouts is None else layouts):
+        org = where.origins(n, g)
+        ref = np.stack([S[y : y + h, x : x + w] for y, x in org]).astype(np.float64)
+        ref[:, ring] = T[ring]
+        idx = g.integers(0, n, (R, C))
+        v, f = spectra(stack, idx), spectra(ref, idx)
+        for k in kinds:
+            above[k].append(v[k] - f[k])
+        means.append(ref[:, ~ring].mean(axis=1).std())
+    out = {k: float(np.mean(x)) for k, x in above.items()}
+    out["tone spread"] = float(stack[:, ~ring].mean(axis=1).std() / max(np.mean(means), 1e-12))
+    return out
 
 
 def stand_ins(res, S, seed: int = 5) -> dict:
@@ -80,8 +143,11 @@ def causes(name: str) -> list[list[str]]:
         fr = frame(tiles, S, limit=2 * wp, template=st.tile).value
         tone = ring_tone(tiles, S, width=wp, template=st.tile)
         lat = lattice(tiles, S, template=st.tile, margin=m).above
+        parts = lattice_parts(tiles, S, template=st.tile, margin=m)
         share = float(template_share(tiles, st.tile).mean())
-        figures = [f"{fr:.2f}", f"{tone:.2f}", f"{lat:+.2f}", f"{share:.0%}"]
+        split = [f"{parts[k]:+.2f}" for k in ("along y", "along x", "mixed")]
+        figures = [f"{fr:.2f}", f"{tone:.2f}", f"{lat:+.2f}", *split]
+        figures += [f"{parts['tone spread']:.2f}", f"{share:.0%}"]
         rows.append([name, label, f"{len(tiles)}", *figures])
     return rows
 
@@ -102,7 +168,8 @@ def main(argv=None) -> int:
         warnings.simplefilter("ignore")
         for name in names:
             rows += causes(name)
-    head = ["texture", "set", "tiles", "frame", "ring tone", "lattice dB above floor", "share"]
+    head = ["texture", "set", "tiles", "frame", "ring tone", "lattice dB above floor"]
+    head += ["along y", "along x", "mixed", "tone spread", "share"]
     text = format_table(head, rows)
     print(text)
     RESULTS.parent.mkdir(parents=True, exist_ok=True)
