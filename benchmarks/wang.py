@@ -245,21 +245,35 @@ def wang_frame(tiles, S, limit: int):
     return frame(tiles, S, limit=limit, wrap=False, template=tiles[0])
 
 
-#: sets of genuine crops whose median frame is :func:`crop_frame`
+#: draws of genuine crop sets whose median frame is :func:`crop_frame`
 FRAME_DRAWS = 12
 
 
-def crop_frame(S, T: int, limit: int, tiles: int = 16) -> float:
-    """Median :func:`wang_frame` of :data:`FRAME_DRAWS` sets of ``tiles`` genuine T x T source
-    crops (seeds 0..): what a set without any construction flaw scores with this yardstick
-    (its floor; a reference column, not a correction).
+def pooled_frame(ratios) -> float:
+    """The frame of several sets of one construction on one texture (the benchmark's seeds):
+    the maximum over distances of their *mean* ratio profile (:attr:`Frame.ratio` of each
+    set, each against its own reference crops).
+
+    The oracle behind it: the median of the sets' own maxima (the figure before session 7)
+    is biased upward by each 16-tile profile's noise, which the maximum over 16 distances
+    picks: triples of genuine 16-crop sets read 1.157 (1.123-1.284, 8 of 8 draws above 1.12)
+    on brick and 1.177 on page that way, 1.101 and 1.138 pooled."""
+    return float(np.mean(np.asarray(ratios, dtype=float), axis=0).max())
+
+
+def crop_frame(S, T: int, limit: int, tiles: int = 16, sets: int = 1) -> float:
+    """Median over :data:`FRAME_DRAWS` draws of the frame of ``sets`` sets of ``tiles``
+    genuine T x T source crops (:func:`wang_frame`; with ``sets`` > 1 pooled as
+    :func:`pooled_frame`): what sets without any construction flaw score with this yardstick
+    (its floor on this texture).
 
     Each set's first crop is random and the others lie in its phase along the axes where the
     texture is periodic and the tile holds whole periods (:mod:`engine.reference_crops`;
     elsewhere plain random crops), as an aligned Wang set's tiles would. The frame is a
     maximum over distances of a ratio estimated from 16 tiles, so the floor is above 1 where
-    windows of the source differ much from each other: measured 1.02-1.03 on the stochastic
-    samples but 1.11-1.19 on brick (perspective), page (lighting, margins) and planks."""
+    windows of the source differ much from each other: measured 1.01-1.05 on the stochastic
+    samples and text but 1.12-1.18 on brick (perspective), page (lighting, margins), planks,
+    for one set of 16; 1.01-1.02 and 1.12-1.13 for three sets pooled."""
     from engine.metrics import luminance
     from engine.reference_crops import ReferenceCrops, random_origins
 
@@ -267,10 +281,14 @@ def crop_frame(S, T: int, limit: int, tiles: int = 16) -> float:
     values = []
     for k in range(FRAME_DRAWS):
         g = np.random.default_rng(k)
-        (y0, x0), *_ = random_origins(L.shape, (T, T), 1, g)
-        ref = ReferenceCrops.build(L, (T, T), L[y0 : y0 + T, x0 : x0 + T])
-        org = [(y0, x0), *ref.origins(tiles - 1, g)]
-        values.append(wang_frame([S[y : y + T, x : x + T] for y, x in org], S, limit).value)
+        ratios = []
+        for _ in range(sets):
+            (y0, x0), *_ = random_origins(L.shape, (T, T), 1, g)
+            ref = ReferenceCrops.build(L, (T, T), L[y0 : y0 + T, x0 : x0 + T])
+            org = [(y0, x0), *ref.origins(tiles - 1, g)]
+            crops = [S[y : y + T, x : x + T] for y, x in org]
+            ratios.append(wang_frame(crops, S, limit).ratio)
+        values.append(pooled_frame(ratios))
     return float(np.median(values))
 
 
@@ -278,7 +296,8 @@ def wang_figures(S, T: int, seed: int, options: dict, docs_file: Path | None = N
     """One Wang set's figures: joint ratios (list), lattice dB above its floor, frame over
     2 w_P of the default ring, frame over half the tile, detail (the tiles' median detail
     ratio over random crops', :func:`crop_detail`), corners, joints, and the tiles' median
-    detail ratio itself."""
+    detail ratio itself, the lattice above the continued floor, and the frame's ratio profile
+    (:attr:`engine.metrics.Frame.ratio`)."""
     ws = wang_set(S, tile_size=T, rng=seed, **options)
     sigs = ws.signatures
 
@@ -306,19 +325,22 @@ def wang_figures(S, T: int, seed: int, options: dict, docs_file: Path | None = N
         from engine.io import save_image
 
         save_image(docs_file, img)
-    return pairs, lat.above, fr.value, half.value, det, corner, joints, raw, cont
+    return pairs, lat.above, fr.value, half.value, det, corner, joints, raw, cont, fr.ratio
 
 
 def wang_row(S, T: int, docs: Path | None, name: str, seeds: int = 1):
     """Wang figures of ``seeds`` sets (seeds 0 ..): medians over them; the joints' max is the
-    largest of any set. Layouts as the CLI's and the editor's previews (no equal neighbours)."""
-    figures = []
+    largest of any set; last, the frame pooled over the sets (:func:`pooled_frame`; the
+    median of the sets' own frames is among the medians). Layouts as the CLI's and the
+    editor's previews (no equal neighbours)."""
+    figures, ratios = [], []
     for seed in range(seeds):
         out = None if docs is None or seed else docs / f"{name}_wang.png"
-        pairs, lat, fr, _, det, corner, joints, raw, cont = wang_figures(S, T, seed, {}, out)
+        pairs, lat, fr, _, det, corner, joints, raw, cont, ratio = wang_figures(S, T, seed, {}, out)
         figures.append((np.median(pairs), max(pairs), lat, fr, det, corner, joints, raw, cont))
+        ratios.append(ratio)
     med = np.median(np.array(figures), axis=0)
-    return (med[0], max(f[1] for f in figures), *med[2:])
+    return (med[0], max(f[1] for f in figures), *med[2:], pooled_frame(ratios))
 
 
 def somol_row(S, T: int, docs: Path | None, name: str):
@@ -345,8 +367,8 @@ def quality(which: str, tile: int, docs: Path | None, seeds: int = 3) -> str:
         T = _fit(S, tile)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            wmed, wmax, wl, wf, wd, wc, wj, wraw, wcont = wang_row(S, T, docs, name, seeds)
-            floor = crop_frame(S, T, 2 * _default_ring(T))
+            wmed, wmax, wl, wf, wd, wc, wj, wraw, wcont, wpool = wang_row(S, T, docs, name, seeds)
+            floor = crop_frame(S, T, 2 * _default_ring(T), sets=seeds)
             try:
                 sp, sl, sf, sd = somol_row(S, T, docs, name)
                 somol = [f"{np.median(sp):.2f} / {max(sp):.2f}", f"{sl:+.2f}", f"{sf:.2f}"]
@@ -358,7 +380,7 @@ def quality(which: str, tile: int, docs: Path | None, seeds: int = 3) -> str:
                 T,
                 f"{wmed:.2f} / {wmax:.2f}",
                 f"{wcont:+.2f} ({wl:+.2f})",
-                f"{wf:.3f} ({floor:.3f})",
+                f"{wpool / floor:.3f} ({wpool:.3f} / {floor:.3f}; {wf:.3f})",
                 f"{wd:.2f} ({wraw:.2f})",
                 f"{wc:.2f} ({wj:.2f})",
                 *somol,
@@ -366,7 +388,7 @@ def quality(which: str, tile: int, docs: Path | None, seeds: int = 3) -> str:
         )
         print(" | ".join(str(c) for c in rows[-1]), file=sys.stderr, flush=True)
     heads = ["texture", "tile", "Wang joints med / max", "Wang lattice dB (pasted)"]
-    heads += ["Wang frame (crops)"]
+    heads += ["Wang frame (pooled / crops; median)"]
     heads += ["Wang detail (raw)", "corners (joints)", "Somol joints med / max", "Somol lattice dB"]
     heads += ["Somol frame"]
     return (
@@ -380,8 +402,10 @@ def quality(which: str, tile: int, docs: Path | None, seeds: int = 3) -> str:
         "(benchmarks/wang_lattice.py; the ideal set of a Gaussian field scores ~0 there), in "
         "brackets above the floor of crops with the ring pasted (engine.metrics.lattice). "
         "Wang frame: tiles reflected, reference crops in the set's phase on periodic textures "
-        "(wang_frame); in brackets what 16 genuine source crops score (crop_frame, median of "
-        f"{FRAME_DRAWS} sets: the yardstick's floor on this texture)\n\n"
+        "(wang_frame); the sets' ratio profiles pooled (max of their mean, pooled_frame) over "
+        f"what {seeds} sets of 16 genuine source crops score pooled alike (crop_frame, median "
+        f"of {FRAME_DRAWS} draws: the yardstick's floor on this texture); in brackets both, "
+        "then the median of the sets' own frames (the figure before session 7)\n\n"
         + format_table(heads, rows)
         + "\n"
     )

@@ -1,9 +1,10 @@
 """Oracles behind the Wang benchmark's detail and lattice figures (benchmarks/wang*.py)."""
 
 import numpy as np
+import pytest
 from scipy import ndimage
 
-from benchmarks.wang import crop_detail, crop_frame, wang_frame
+from benchmarks.wang import crop_detail, crop_frame, pooled_frame, wang_frame
 from benchmarks.wang_lattice import continued_lattice
 from benchmarks.wang_oracle import Field, ideal_set
 from engine.metrics import detail_ratio, frame, lattice
@@ -93,6 +94,33 @@ def test_crop_frame_is_about_one_on_a_stationary_texture_and_counts_genuine_crop
     # on running bonds the crops lie in one phase: an aligned set, no frame either
     bricks = _running_bond(rng, (384, 384), 32, 64)
     assert crop_frame(bricks, 64, 16) < 1.1
+
+
+def test_pooled_frame_keeps_a_frame_every_set_shows_and_averages_out_chance_peaks():
+    # three flawless sets whose profiles each peak by chance at another distance: the median
+    # of their maxima reads the chance peak as a frame, their mean profile does not
+    flat = np.ones(16)
+    chance = [flat.copy() for _ in range(3)]
+    for i, d in enumerate((2, 7, 12)):
+        chance[i][d] = 1.2
+    assert np.median([r.max() for r in chance]) == 1.2
+    assert pooled_frame(chance) < 1.1
+    # a frame every set has at the same distance (a cut 3 px from the edge) stays in full
+    framed = [flat.copy() for _ in range(3)]
+    for r in framed:
+        r[3] = 1.4
+    assert pooled_frame(framed) == pytest.approx(1.4)
+    assert pooled_frame([framed[0]]) == framed[0].max()
+
+
+def test_pooled_crop_frame_is_the_pooled_statistic_of_genuine_sets():
+    # one set: the frame of 16 genuine crops (as before); three sets pooled: not above it by
+    # more than the draws' noise, and about one on a stationary texture
+    rng = np.random.default_rng(5)
+    noise = ndimage.gaussian_filter(rng.standard_normal((192, 192)), 2)[..., None]
+    one, three = crop_frame(noise, 32, 8), crop_frame(noise, 32, 8, sets=3)
+    assert 0.95 < three < 1.08
+    assert three <= one + 0.02
 
 
 def test_continued_floor_in_the_sets_phase_reads_an_aligned_set_lower():
