@@ -43,8 +43,10 @@ DETAIL_QUANTILE = 0.25
 CORNER_STEPS = 2.0
 CORNER_QUANTILE = 0.05
 #: on a periodic texture whose period the tile holds k times, samples and interiors keep to
-#: the first sample's phase modulo T / k within this many px (see WangSetup.keep_phase)
-PHASE_SLACK = 1.0
+#: the first sample's phase modulo T / k within this many px (see WangSetup.keep_phase): 0.5 =
+#: the whole pixel nearest to the phase. 1.0 (until session 7) let two windows lie 2 px apart,
+#: so shelves' boards stepped by 1-2 px at the tile lines (frame 1.215 -> 1.085, seeds 0-2)
+PHASE_SLACK = 0.5
 
 #: How the interior patch is blended (``interior_blend``): "auto" = gradient domain unless the
 #: seam's blend is "none" (hard cuts asked for: every pixel stays a source copy), or one of
