@@ -21,9 +21,11 @@ Run ``python -m benchmarks.wang`` (``--help`` for options). Tables:
      tile's own outer margin; Somol over 16 random 8x8 layouts against crops carrying the
      template's margin;
    * frame (:func:`engine.metrics.frame`, limit 2 w_P; Wang tiles reflected at their border,
-     Somol tiles wrapped), detail (Wang: the tiles' median detail ratio over the median of
-     random source crops, :func:`crop_detail`, with the raw median in brackets; Somol: the
-     median detail ratio of the tiles);
+     Somol tiles wrapped; Wang: the seeds' ratio profiles pooled, :func:`pooled_frame`, over
+     what as many sets of genuine source crops score pooled alike, :func:`crop_frame` — the
+     oracle is :mod:`benchmarks.wang_frame_oracle`), detail (Wang: the tiles' median detail
+     ratio over the median of random source crops, :func:`crop_detail`, with the raw median
+     in brackets; Somol: the median detail ratio of the tiles);
    * corners (Wang): :func:`engine.metrics.corner_border_ratio` within 2 px of the points where
      four tiles meet, in an 8x8 valid layout (the joints elsewhere for comparison).
 
