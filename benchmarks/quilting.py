@@ -130,7 +130,9 @@ scipy's libraries each start theirs; FFT worker pools start later, on first use)
 
 
 def blas_cpu_seconds() -> float | None:
-    """CPU seconds used so far by :data:`BLAS_THREADS` (None without /proc)."""
+    """CPU seconds used so far by :data:`BLAS_THREADS` (None without /proc, or once one of
+    them is gone: OpenBLAS ends its threads before a ``fork``, as exact quilting's worker
+    processes do, and starts new ones when next needed)."""
     if not BLAS_THREADS:
         return None
     total = 0
@@ -139,7 +141,7 @@ def blas_cpu_seconds() -> float | None:
             with open(f"/proc/self/task/{tid}/stat") as f:
                 fields = f.read().rsplit(")", 1)[1].split()
         except OSError:
-            continue
+            return None
         total += int(fields[11]) + int(fields[12])  # utime + stime, in clock ticks
     return total / os.sysconf("SC_CLK_TCK")
 
@@ -315,11 +317,14 @@ def speed(args) -> None:
             rows,
         )
     )
-    if blas_before is not None:
+    blas_after = blas_cpu_seconds()
+    if blas_before is not None and blas_after is not None:
         print(
             "\nCPU time of OpenBLAS's helper threads during these runs: "
-            f"{blas_cpu_seconds() - blas_before:.2f} s (the engine's products stay on one thread)"
+            f"{blas_after - blas_before:.2f} s (the engine's products stay on one thread)"
         )
+    elif blas_before is not None:
+        print("\nOpenBLAS's helper threads ended at a fork (worker processes): CPU not measured")
     print()
 
 
