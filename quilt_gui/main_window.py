@@ -485,6 +485,7 @@ class MainWindow(QMainWindow):
     @Slot(str, str)
     def show_message(self, level: str, text: str, actions=()) -> None:
         """Tell the user something without blocking (banner + status bar + log)."""
+        text = params.editor_words(text)
         self.messages.append((level, text))
         getattr(log, {"error": "error", "warning": "warning"}.get(level, "info"))(text)
         if actions or level != "info" or not self.message_bar.waiting_for_answer():

@@ -301,6 +301,25 @@ def ui_words(text: str) -> str:
     return re.sub(pattern, lambda m: f"“{_UI_NAMES[m.group(1)]}”", text)
 
 
+#: the command line's hints in the engine's notes -> the editor's words (the notes name both)
+_CLI_HINTS = (
+    # "(a larger tile size: --tile-max, or Tile size in the editor)" -> "(Tile size)"
+    (re.compile(r"\([^()]*?--[\w-]+(?: N)?, or ([^()]+?) in the editor\)"), r"(\1)"),
+    # "--no-flatten, or Flatten lighting: Off in the editor, keeps" -> "Flatten lighting: Off keeps"
+    (re.compile(r"--[\w-]+, or ([^()]+?) in the editor,?"), r"\1"),
+    # "try Flatten lighting (tileset --flatten)" -> "... (Parameters ▸ Advanced ▸ Tile)"
+    (re.compile(r"\(tileset --flatten\)"), "(Parameters ▸ Advanced ▸ Tile)"),
+)
+
+
+def editor_words(text: str) -> str:
+    """``text`` (an engine note) without the command line's flags where the note also names
+    the editor's control, so the banner speaks of what is on screen."""
+    for pattern, repl in _CLI_HINTS:
+        text = pattern.sub(repl, text)
+    return text
+
+
 def _option_key(option: str, method: str) -> str:
     """The parameter of seam ``option`` of ``method`` (each method's variant has its own)."""
     if option == "variant":

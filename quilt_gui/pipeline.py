@@ -73,6 +73,8 @@ class Pipeline(QObject):
         self._gen_old = ([], [])
         self._gen_wanted, self._gen_next = 0, 0  # candidates asked for / shown in index order
         self._gen_waiting: dict[int, CandidateTile] = {}  # finished before their turn
+        self._gen_notice = ""  # the engine's reason when it makes fewer candidates than asked
+        self._gen_job: jobs.Job | None = None
         self._quilt_mode = "quilt"  # what a parameter change restarts: "quilt" or "transfer"
         self.sweep_samples = SWEEP_SAMPLES  # 0: the template search streams no sweep
 
@@ -213,7 +215,7 @@ class Pipeline(QObject):
         doc = self.doc
         if doc.source is None or doc.tileset.template_rect is None:
             return None
-        wps = {k: list(v) for k, v in doc.tileset.waypoints.items() if v}
+        wps = {k: v for k, v in doc.tileset.waypoints_in_use().items() if v}
         kwargs = dict(
             overlap=doc.tileset.overlap(),
             waypoints=wps or None,
@@ -372,10 +374,12 @@ class Pipeline(QObject):
         s = self.settings()
         n = s.candidates - len(keep)
         self._gen_wanted, self._gen_next, self._gen_waiting = max(0, n), 0, {}
+        self._gen_notice = ""
+        self._gen_job = None
         if n <= 0:
             self._on_candidates_done([])
             return None
-        return self.jobs.start(
+        self._gen_job = self.jobs.start(
             "candidates",
             excluding(iter_candidates),
             doc.source.main,
@@ -390,12 +394,17 @@ class Pipeline(QObject):
             on_error=self._on_candidates_error,
             **self._tile_options(),
         )
+        return self._gen_job
 
     def _on_candidate_event(self, event) -> None:
         """Candidates finish in any order; they are shown in the order of their index, so
         candidate #k is the same tile for the same seed (each waits for the ones before it,
         at most a worker's head start)."""
-        if isinstance(event, CandidateTile):
+        from engine.tiles.candidates import CandidatesNotice
+
+        if isinstance(event, CandidatesNotice):  # fewer than asked, and why: said at the end
+            self._gen_notice = event.message
+        elif isinstance(event, CandidateTile):
             self._gen_waiting[int(event.index)] = self.kept(event)
             while self._gen_next in self._gen_waiting:
                 self.doc.tileset.append_candidate(self._gen_waiting.pop(self._gen_next))
@@ -415,10 +424,14 @@ class Pipeline(QObject):
             already_applied=True,
         )
         what = f"{len(doc.tileset.candidates)} candidates"
-        if made < self._gen_wanted:
+        level, notice = "info", self._gen_notice
+        stopped = self._gen_job is not None and self._gen_job.token.cancelled
+        if notice and not stopped:  # the source gave no more: the engine's reason, kept
+            level, what = "warning", f"{notice[0].upper()}{notice[1:]}. {what}"
+        elif made < self._gen_wanted:
             what = f"Generation stopped: {made} of {self._gen_wanted} new candidates made, {what}"
         self.message.emit(
-            "info", f"{what}. Click to pick the tiles to keep; double-click to open one."
+            level, f"{what}. Click to pick the tiles to keep; double-click to open one."
         )
 
     def _on_candidates_error(self, exc) -> None:

@@ -177,6 +177,20 @@ class TileSetDocument(QObject):
                 )
             )
 
+    def waypoints_in_use(self) -> dict[str, list[tuple[int, int]]]:
+        """The waypoints inside the error maps of the current rectangle and Seam search width:
+        a smaller rectangle leaves some outside (kept, for an undo or a larger one; the engine
+        refuses them, so the seams and the views use these)."""
+        if self.template_rect is None:
+            return {k: [] for k in WAYPOINT_KEYS}
+        _, _, a, b = self.template_rect
+        ov = self.overlap()
+        shape = {"horizontal": (b + ov, ov), "vertical": (ov, a)}  # error map (rows, cols)
+        return {
+            k: [(r, c) for r, c in self.waypoints[k] if r < shape[k][0] and c < shape[k][1]]
+            for k in WAYPOINT_KEYS
+        }
+
     def add_waypoint(self, key: str, point: tuple[int, int]) -> None:
         pt = (int(point[0]), int(point[1]))
         if pt in self.waypoints[key]:

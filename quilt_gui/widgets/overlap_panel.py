@@ -237,7 +237,7 @@ class OverlapPanel(QWidget):
         view = self.views[which]
         r1, r2 = (update.regions[k] for k in LIVE_REGIONS[which])
         view.show_overlap(r1, r2, update.error, stacked=which == "vertical")
-        view.set_waypoints(self.doc.tileset.waypoints[which])
+        view.set_waypoints(self.doc.tileset.waypoints_in_use()[which])
         self.frames[which] = frame
         self._shown[which] = update.error
         other = "vertical"
@@ -268,4 +268,4 @@ class OverlapPanel(QWidget):
     @Slot()
     def _on_waypoints_changed(self) -> None:
         for which, v in self.views.items():
-            v.set_waypoints(self.doc.tileset.waypoints[which])
+            v.set_waypoints(self.doc.tileset.waypoints_in_use()[which])

@@ -210,7 +210,7 @@ class SourceView(ImageCanvas):
         if rect is None:
             return
         x, y = rect[0], rect[1]
-        for pts in self.doc.tileset.waypoints.values():
+        for pts in self.doc.tileset.waypoints_in_use().values():
             for r, c in pts:
                 it = WaypointItem(y + r, x + c)
                 self.scene().addItem(it)

@@ -20,6 +20,7 @@ def test_uneven_lighting_is_flattened_said_on_the_banner_and_can_be_switched_off
     wait_idle(qtbot, w)
     banner = w.message_bar.label.text()
     assert "lighting varies" in banner and "automatic" in banner
+    assert "Flatten lighting: Off keeps" in banner and "--no-flatten" not in banner  # UI words
     panel, hint = w.params_panel, w.params_panel.tone_hint
     assert panel.value("blend") == "adaptive"  # the choice is kept; the hint says what Auto uses
     assert hint.isVisibleTo(panel) and "Gradient domain" in hint.text()

@@ -52,3 +52,26 @@ def test_a_plain_drag_draws_the_tile_rectangle_and_space_or_middle_drag_pans(qtb
     start = scroll(v)
     drag(qtbot, v, QPoint(100, 100), QPoint(140, 130), Qt.MouseButton.MiddleButton)
     assert scroll(v) == (start[0] - 40, start[1] - 30) and ts.template_rect == rect
+
+
+def test_a_smaller_rectangle_leaves_waypoints_outside_it_unused_and_kept(qtbot):
+    """A waypoint below a shrunk rectangle's overlap is not sent (the engine refuses it: no
+    seamless tile and an error, as before) nor drawn; it is kept for an undo."""
+    w = make_window(qtbot)
+    open_sample(qtbot, w)
+    t = w.doc.tileset
+    t.set_template_rect((150, 120, 128, 112))
+    t.add_waypoint("horizontal", (100, 4))
+    wait_idle(qtbot, w)
+    assert t.waypoints_in_use()["horizontal"] == [(100, 4)]
+    t.set_template_rect((150, 120, 64, 64))
+    wait_idle(qtbot, w)
+    assert t.seamless is not None and t.seamless.tile.shape[:2] == (64, 64)
+    assert w.message_bar.level != "error"
+    assert t.waypoints["horizontal"] == [(100, 4)] and t.waypoints_in_use()["horizontal"] == []
+    assert w.source_view._waypoint_items == []
+    assert w.overlap_panel.views["horizontal"].waypoints == []
+    t.undo_stack.undo()  # the larger rectangle again: the waypoint is used again
+    wait_idle(qtbot, w)
+    assert t.waypoints_in_use()["horizontal"] == [(100, 4)]
+    assert len(w.source_view._waypoint_items) == 1

@@ -122,3 +122,31 @@ def test_candidates_from_an_earlier_template_are_marked_until_regenerated(qtbot)
     )  # kept (they still connect to each other), not dropped
     generate(qtbot, w, 4)
     assert not w.doc.tileset.candidates_outdated and "earlier template" not in title()
+
+
+def test_fewer_candidates_than_asked_says_why_on_the_banner(qtbot, tmp_path):
+    """The engine makes fewer candidates when a small source has no more distinct patch
+    positions; the banner gives its reason as a warning (not "Generation stopped")."""
+    from PIL import Image
+
+    from resources import sample_path
+
+    small = np.asarray(Image.open(sample_path("cobblestones")))[:180, :180]
+    path = tmp_path / "small.png"
+    Image.fromarray(small).save(path)
+    w = make_window(qtbot)
+    with qtbot.waitSignal(w.doc.source_changed, timeout=10_000):
+        w.files.open_path(str(path), confirm=False)
+    wait_idle(qtbot, w)
+    template_rect = (20, 24, 96, 96)
+    w.doc.tileset.set_template_rect(template_rect)
+    wait_idle(qtbot, w)
+    w.doc.set_param("n_candidates", 100)
+    w.act_generate.trigger()
+    wait_idle(qtbot, w)
+    n = len(w.doc.tileset.candidates)
+    assert 1 <= n < 100
+    assert w.message_bar.level == "warning"
+    text = w.message_bar.label.text()
+    assert text.startswith(f"Made {n} of 100 candidates: the source has no more patch positions")
+    assert "Generation stopped" not in text

@@ -47,3 +47,19 @@ def test_help_is_a_shortcut_sheet_and_a_getting_started_that_stay(qtbot):
     assert guide.isVisible() and "Export seamless tile" in guide.text.text()
     qtbot.wait(50)
     assert sheet.isVisible() and guide.isVisible()  # dialogs, not a banner that fades
+
+
+def test_engine_notes_name_the_editors_controls_not_the_command_line(qtbot):
+    import numpy as np
+
+    from engine.tiles.stationarity import stationarity_of
+
+    rng = np.random.default_rng(0)
+    light = np.linspace(0.4, 1.0, 128, dtype=np.float32)[None, :, None]
+    note = stationarity_of(rng.random((128, 128, 3), dtype=np.float32) * light).warnings[0]
+    assert "(tileset --flatten)" in note  # the command line's hint, in the engine's note
+    w = make_window(qtbot)
+    w.show_message("warning", note)
+    text = w.message_bar.label.text()
+    assert "--flatten" not in text and "try Flatten lighting (Parameters ▸ Advanced ▸ Tile)" in text
+    assert w.last_message() == text

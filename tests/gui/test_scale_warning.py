@@ -19,3 +19,4 @@ def test_a_tile_smaller_than_three_periods_is_warned_about_on_the_banner(qtbot, 
     banner = w.message_bar.label.text()
     assert w.message_bar.level == "warning" and "repeats about every 64 px tall" in banner
     assert "Wang set" in banner and any("Best tile" in text for _, text in w.messages)
+    assert "(Tile size)" in banner and "--tile-max" not in banner  # the editor's words
