@@ -312,6 +312,11 @@ _CLI_HINTS = (
 )
 
 
+def sentence(note: str) -> str:
+    """An engine note (lower case: it also ends up inside other sentences) as a sentence."""
+    return note[:1].upper() + note[1:]
+
+
 def editor_words(text: str) -> str:
     """``text`` (an engine note) without the command line's flags where the note also names
     the editor's control, so the banner speaks of what is on screen."""

@@ -189,7 +189,7 @@ class Pipeline(QObject):
         self.settings()  # the source's Auto tone note, said with the search's warnings
         notes = [self.doc.tileset.tone_note, *template.warnings]
         if any(notes):  # after the info line, so the banner keeps them, all at once
-            self.message.emit("warning", "\n".join(n for n in notes if n))
+            self.message.emit("warning", "\n".join(params.sentence(n) for n in notes if n))
         self.template_searching.emit(False)
 
     def _on_template_error(self, exc) -> None:
@@ -276,7 +276,7 @@ class Pipeline(QObject):
         self.seamless_inputs = self._seamless_pending
         self.doc.tileset.apply_seamless(result)
         for note in result.warnings:
-            self.message.emit("warning", note)
+            self.message.emit("warning", params.sentence(note))
 
     def _on_seamless_error(self, exc) -> None:
         self.seamless_inputs = None
@@ -427,7 +427,7 @@ class Pipeline(QObject):
         level, notice = "info", self._gen_notice
         stopped = self._gen_job is not None and self._gen_job.token.cancelled
         if notice and not stopped:  # the source gave no more: the engine's reason, kept
-            level, what = "warning", f"{notice[0].upper()}{notice[1:]}. {what}"
+            level, what = "warning", f"{params.sentence(notice)}. {what}"
         elif made < self._gen_wanted:
             what = f"Generation stopped: {made} of {self._gen_wanted} new candidates made, {what}"
         self.message.emit(

@@ -93,8 +93,11 @@ class MessageBar(QWidget):
             return
         m = self.MARGIN
         width = max(100, parent.width() - 2 * m)
-        height = self.heightForWidth(width) if self.hasHeightForWidth() else -1
-        height = max(height, self.sizeHint().height())
+        # the wrapped text's height at this width (sizeHint wraps it narrower: 2-3x too tall)
+        if self.hasHeightForWidth():
+            height = max(self.heightForWidth(width), self.minimumSizeHint().height())
+        else:
+            height = self.sizeHint().height()
         self.setGeometry(m, max(0, parent.height() - height - m), width, height)
         self.raise_()
 

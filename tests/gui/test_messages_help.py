@@ -63,3 +63,13 @@ def test_engine_notes_name_the_editors_controls_not_the_command_line(qtbot):
     text = w.message_bar.label.text()
     assert "--flatten" not in text and "try Flatten lighting (Parameters ▸ Advanced ▸ Tile)" in text
     assert w.last_message() == text
+
+
+def test_a_long_message_is_as_tall_as_its_wrapped_text(qtbot):
+    w = make_window(qtbot)
+    w.show_message("warning", "The lighting varies across the photo, try something. " * 10)
+    qtbot.wait(10)
+    bar = w.message_bar
+    lines = bar.label.heightForWidth(bar.label.width())
+    assert lines > 2 * bar.label.fontMetrics().height()  # it wraps
+    assert bar.height() <= lines + 16  # the margins (5 + 5 px), not a sizeHint's narrow wrap

@@ -17,6 +17,7 @@ def test_a_tile_smaller_than_three_periods_is_warned_about_on_the_banner(qtbot, 
     wait_idle(qtbot, w)
     assert w.doc.tileset.template_rect[2:] == (64, 64)
     banner = w.message_bar.label.text()
-    assert w.message_bar.level == "warning" and "repeats about every 64 px tall" in banner
+    assert w.message_bar.level == "warning"
+    assert "The texture repeats about every 64 px tall" in banner  # a sentence
     assert "Wang set" in banner and any("Best tile" in text for _, text in w.messages)
     assert "(Tile size)" in banner and "--tile-max" not in banner  # the editor's words
