@@ -30,6 +30,8 @@ SCORE_LABELS = {
     "changed": ("Pixels that differ from the template", True),
     "coverage": ("Share of the tile inside the seam (patch pixels)", True),
 }
+#: yes/no scores (1.0 / 0.0 in the engine)
+FLAG_LABELS = {"gradient_blend": "Cut re-blended in the gradient domain (its step showed)"}
 
 
 def score_lines(entry: CandidateTile) -> list[str]:
@@ -39,6 +41,9 @@ def score_lines(entry: CandidateTile) -> list[str]:
         lines.append(f"Mean error along the closed seam: <b>{entry.score:.4f}</b>")
     for key, value in entry.scores.items():
         if not isinstance(value, float):
+            continue
+        if key in FLAG_LABELS:
+            lines.append(f"{FLAG_LABELS[key]}: {'yes' if value else 'no'}")
             continue
         label, percent = SCORE_LABELS.get(key, (key, False))
         lines.append(f"{label}: {value:.0%}" if percent else f"{label}: {value:.4g}")

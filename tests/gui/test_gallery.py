@@ -95,6 +95,8 @@ def test_candidate_dialog_shows_seam_on_tile_and_patch_source_and_keeps_it_in_pr
     assert inside.min() >= 0 and (inside[:, 0] < ph).all() and (inside[:, 1] < pw).all()
     np.testing.assert_array_equal(inside, e.loop - (ty, tx))
     assert "Pixels that differ from the template" in dlg.info.text()
+    assert "re-blended in the gradient domain (its step showed): " in dlg.info.text()
+    assert "gradient_blend" not in dlg.info.text()  # words, not the engine's key
     dlg.close()
     path = str(tmp_path / "p.quiltproj")
     assert w.files.save_to(path, wait=True)
