@@ -19,6 +19,39 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+#: docs/ stays small: a screenshot PNG larger than this is saved in 256 colours (no
+#: dithering, so the interface's text stays sharp), then also scaled down until it fits
+MAX_BYTES = 300_000
+
+
+def save_png(image, path) -> Path:
+    """Save ``image`` (a QPixmap or QImage: a grab) as the PNG ``path``, at most
+    :data:`MAX_BYTES` (also tools/screenshots_*.py)."""
+    import io
+
+    from PIL import Image
+    from PySide6.QtCore import QBuffer, QIODevice
+
+    buf = QBuffer()
+    buf.open(QIODevice.OpenModeFlag.WriteOnly)
+    image.save(buf, "PNG")
+    full = Image.open(io.BytesIO(bytes(buf.data()))).convert("RGB")
+    data = bytes(buf.data())
+    for scale in (1.0, 0.9, 0.8, 0.7, 0.6):
+        if len(data) <= MAX_BYTES:
+            break
+        im = full
+        if scale < 1:
+            size = (round(full.width * scale), round(full.height * scale))
+            im = full.resize(size, Image.Resampling.LANCZOS)
+        im = im.quantize(256, method=Image.Quantize.FASTOCTREE, dither=Image.Dither.NONE)
+        out = io.BytesIO()
+        im.save(out, "PNG", optimize=True)
+        data = out.getvalue()
+    path = Path(path)
+    path.write_bytes(data)
+    return path
+
 
 def open_editor():
     """(app, window, idle) with the bundled sample open in a 1600x1000 dark window, settings
@@ -58,7 +91,7 @@ def main() -> int:
 
     def shot(widget, name: str) -> None:
         app.processEvents()
-        widget.grab().save(str(out / name))
+        save_png(widget.grab(), out / name)
         print("wrote", out / name)
 
     # -- template step: rectangle, shaded overlaps, heat overlays, seams, a waypoint
@@ -148,7 +181,7 @@ def main() -> int:
     w.message_bar.dismiss()
     w.source_view.show_patch(None)
     w.source_view.fit()
-    w.params_panel.ensureWidgetVisible(w.params_panel.groups["Exclusion"])
+    w.params_panel.scroll.ensureWidgetVisible(w.params_panel.groups["Exclusion"])
     shot(w, "exclusion.png")
     w.close()
     return 0

@@ -52,6 +52,7 @@ def main() -> int:
     QSettings.setPath(QSettings.Format.IniFormat, QSettings.Scope.UserScope, str(tmp))
     from quilt_gui.main_window import MainWindow
     from quilt_gui.responsiveness import wait_until
+    from tools.screenshots import save_png
 
     screen = QGuiApplication.primaryScreen().geometry()
     suffix = "" if screen.width() >= 1600 else f"_{screen.width()}"
@@ -72,14 +73,14 @@ def main() -> int:
         for _ in range(5):
             app.processEvents()
         path = out / name.replace(".png", f"{suffix}.png")
-        widget.grab().save(str(path))
+        save_png(widget.grab(), path)
         print("wrote", path)
 
     def screen_shot(name: str) -> None:
         for _ in range(5):
             app.processEvents()
         path = out / name.replace(".png", f"{suffix}.png")
-        QGuiApplication.primaryScreen().grabWindow(0).save(str(path))
+        save_png(QGuiApplication.primaryScreen().grabWindow(0), path)
         print("wrote", path)
 
     # -- Heal: the painted region over the logo, then healed

@@ -28,6 +28,7 @@ def main(library: str) -> int:
     QSettings.setPath(QSettings.Format.IniFormat, QSettings.Scope.UserScope, str(tmp))
     from quilt_gui.main_window import MainWindow
     from quilt_gui.responsiveness import wait_until
+    from tools.screenshots import save_png
 
     w = MainWindow()
     w.files.ask_save_changes = lambda: "discard"
@@ -43,7 +44,7 @@ def main(library: str) -> int:
     for _ in range(10):
         app.processEvents()
     path = ROOT / "docs" / "library.png"
-    w.grab().save(str(path))
+    save_png(w.grab(), path)
     print("wrote", path)
     w.close()
     return 0

@@ -18,7 +18,7 @@ sys.path[:0] = [str(ROOT), str(ROOT / "tools")]
 
 
 def main() -> int:
-    from screenshots import open_editor
+    from screenshots import open_editor, save_png
 
     from quilt_gui import params
     from quilt_gui.responsiveness import wait_until
@@ -37,7 +37,7 @@ def main() -> int:
         if not caught and event.phase == "horizontal" and len(sweep.recent) >= 60:
             sweep._rebuild()
             app.processEvents()
-            w.grab().save(str(out / "template_sweep.png"))
+            save_png(w.grab(), out / "template_sweep.png")
             caught.append(event)
 
     w.pipeline.template_swept.connect(catch)
@@ -54,7 +54,7 @@ def main() -> int:
     wait_until(lambda: watch.drawn >= 150 or watch.state == "finished", 120)
     w.message_bar.dismiss()
     app.processEvents()
-    w.grab().save(str(out / "watch_search.png"))
+    save_png(w.grab(), out / "watch_search.png")
     print("wrote", out / "watch_search.png", f"({watch.drawn} improvements drawn)")
     watch.back()
     wait_until(idle)
