@@ -26,6 +26,7 @@ Cancelling, an error in a worker or closing the generator kills the workers at o
 from __future__ import annotations
 
 import contextlib
+import functools
 import mmap
 import os
 import signal
@@ -45,15 +46,28 @@ ENV = "QUILT_STUDIO_WORKERS"
 
 def available() -> bool:
     """Whether worker processes can be used here: ``fork`` exists, this is not a daemonic
-    process of :mod:`multiprocessing` (which may not have children) and :data:`ENV` does not
-    say ``threads``."""
+    process of :mod:`multiprocessing` (which may not have children), :data:`ENV` does not
+    say ``threads`` and the pool's shared lock can be made (containers without ``/dev/shm``
+    have no POSIX semaphores: quilting then keeps threads instead of failing)."""
     from multiprocessing import current_process
 
     return (
         hasattr(os, "fork")
         and not current_process().daemon
         and os.environ.get(ENV, "").strip().lower() != "threads"
+        and _shared_locks_work()
     )
+
+
+@functools.cache
+def _shared_locks_work() -> bool:
+    from multiprocessing import get_context
+
+    try:
+        get_context("fork").Lock()
+    except OSError:
+        return False
+    return True
 
 
 def share(a: np.ndarray) -> np.ndarray:

@@ -143,3 +143,26 @@ def test_small_samples_stay_on_threads(pools):
     _jit.load()
     quilt(SAMPLE[:150, :150], (150, 170), block=28, overlap=6, rng=3, threads=2)
     assert not pools
+
+
+def test_without_shared_semaphores_quilting_keeps_threads(pools, monkeypatch):
+    """Where the pool's lock cannot be made (no /dev/shm), a 2-thread run uses threads and
+    gives one thread's result rather than failing."""
+    import multiprocessing.synchronize
+
+    _jit.load()
+    kw = dict(block=28, overlap=6, rng=3, mode="exact")
+    one = quilt(SAMPLE, (150, 170), threads=1, **kw)
+
+    def no_semaphores(*args, **kwargs):
+        raise OSError(38, "Function not implemented")
+
+    monkeypatch.setattr(multiprocessing.synchronize.SemLock, "__init__", no_semaphores)
+    workers._shared_locks_work.cache_clear()
+    try:
+        two = quilt(SAMPLE, (150, 170), threads=2, **kw)
+    finally:
+        workers._shared_locks_work.cache_clear()
+    assert not pools
+    assert np.array_equal(two.image, one.image)
+    assert _records(two) == _records(one)
