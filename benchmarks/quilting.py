@@ -338,28 +338,32 @@ def interleaved_threads(s, j, kw, mode, repeats, images):
     untimed run of each: ({threads: median seconds}, (median of the rounds' 1-thread /
     2-thread ratios, rounds)); the outputs go into ``images[mode, threads]``."""
     rounds = max(repeats, INTERLEAVED_ROUNDS)
-    times = {1: [], 2: []}
-    for r in range(rounds + 1):
-        for threads in (1, 2):
-            t0 = time.perf_counter()
-            res = quilt(s, j["out"], rng=0, mode=mode, threads=threads, **kw)
-            if r:  # the first round warms up
-                times[threads].append(time.perf_counter() - t0)
-            images[mode, threads] = res.image
-    ratio = float(np.median(np.divide(times[1], times[2])))
-    return {t: float(np.median(v)) for t, v in times.items()}, (ratio, rounds)
+
+    def run(threads):
+        images[mode, threads] = quilt(s, j["out"], rng=0, mode=mode, threads=threads, **kw).image
+
+    one, two = alternating_times([lambda: run(1), lambda: run(2)], rounds, warmup=1)
+    ratio = float(np.median(np.divide(one, two)))
+    return {1: float(np.median(one)), 2: float(np.median(two))}, (ratio, rounds)
 
 
-def alternating_medians(fns, repeats: int) -> list[float]:
-    """Median wall time of each function, the functions run in turn ``repeats`` times (a change
-    of the machine's load hits all of them alike, unlike timing one after the other)."""
+def alternating_times(fns, repeats: int, warmup: int = 0) -> list[list[float]]:
+    """Wall times of each function, the functions run in turn ``repeats`` times after
+    ``warmup`` untimed rounds (a change of the machine's load hits all of them alike, unlike
+    timing one after the other)."""
     times = [[] for _ in fns]
-    for _ in range(repeats):
+    for r in range(warmup + repeats):
         for fn, ts in zip(fns, times, strict=True):
             t0 = time.perf_counter()
             fn()
-            ts.append(time.perf_counter() - t0)
-    return [float(np.median(ts)) for ts in times]
+            if r >= warmup:
+                ts.append(time.perf_counter() - t0)
+    return times
+
+
+def alternating_medians(fns, repeats: int) -> list[float]:
+    """Median wall time of each function, run in turn (:func:`alternating_times`)."""
+    return [float(np.median(ts)) for ts in alternating_times(fns, repeats)]
 
 
 def streaming(args) -> None:
