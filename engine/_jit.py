@@ -21,10 +21,12 @@ import functools
 import sys
 import threading
 
-__all__ = ["Kernel", "load", "loaded", "njit"]
+__all__ = ["LOADING_LOCK", "Kernel", "load", "loaded", "njit"]
 
 _KERNELS: list[Kernel] = []
-_LOCK = threading.RLock()
+LOADING_LOCK = threading.RLock()
+"""Held while kernels are registered or loaded (a process forked meanwhile must not inherit it
+held: :mod:`engine.quilting.workers` takes it around its forks)."""
 _LOADED = False
 
 
@@ -56,7 +58,7 @@ def njit(*args, **options):
 
 
 def _register(fn, options: dict):
-    with _LOCK:
+    with LOADING_LOCK:
         if _LOADED:
             import numba
 
@@ -76,7 +78,7 @@ def load() -> None:
     global _LOADED
     if _LOADED:
         return
-    with _LOCK:
+    with LOADING_LOCK:
         if _LOADED:
             return
         import numba

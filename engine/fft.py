@@ -20,6 +20,7 @@ __all__ = [
     "BACKENDS",
     "BUFFER_BYTES",
     "ENV",
+    "LOADING_LOCK",
     "default_backend",
     "inverse",
     "next_fast_len",
@@ -102,7 +103,7 @@ _DUCC: list = []  # ducc0.fft once imported (None: not installed or not working)
 
 
 def _ducc0():
-    with _LOCK:
+    with LOADING_LOCK:
         if not _DUCC:
             try:
                 import ducc0.fft as module
@@ -114,7 +115,8 @@ def _ducc0():
 
 
 _POCKETFFT: list = []  # the extension, once loaded (None: not loadable here)
-_LOCK = threading.Lock()
+LOADING_LOCK = threading.Lock()
+"""Held while a backend is imported and checked (taken around forks, as ``engine._jit``'s)."""
 
 
 def _scipy():
@@ -125,7 +127,7 @@ def _scipy():
     imported, and a later ``import scipy.fft`` loads its own). :class:`_Pocketfft` prepares the
     arguments as ``scipy.fft`` does: the same results, and less time per call than scipy.fft's
     dispatch (its backends) takes."""
-    with _LOCK:
+    with LOADING_LOCK:
         if not _POCKETFFT:
             module = _load_pocketfft()
             ok = module is not None and _works(_Pocketfft(module))

@@ -19,7 +19,9 @@ threads were no faster than one. So where ``fork`` exists,
   left: the records and the image are bit-identical to one thread's
   (``tests/engine/test_quilting_workers.py``).
 
-Cancelling, an error in a worker or closing the generator kills the workers at once.
+No worker is forked while another thread loads the numba kernels, an FFT backend or compiles
+(a child would inherit that lock held and wait for it forever): this process then runs every
+task itself. Cancelling, an error in a worker or closing the generator kills the workers at once.
 ``QUILT_STUDIO_WORKERS=threads`` keeps threads.
 """
 
@@ -30,6 +32,7 @@ import functools
 import mmap
 import os
 import signal
+import sys
 import threading
 from multiprocessing.connection import Pipe, wait
 
@@ -116,11 +119,15 @@ class WorkerPool:
         self.left = n - done  # tasks whose results are not in yet
         self.conns, self.procs = [], []
         owner = os.getpid()
+        held = _take_loading_locks()
         try:
-            for _ in range(workers - 1):
+            # with a loading lock held by another thread (the editor's kernel warm-up), a forked
+            # worker would inherit it held by no one and wait for it forever: no fork then, this
+            # process runs every task (the same results)
+            for _ in range(workers - 1 if held is not None else 0):
                 parent, child = Pipe()
                 proc = ctx.Process(
-                    target=self._serve, args=(child, owner, list(self.conns)), daemon=True
+                    target=self._serve, args=(child, owner, list(self.conns), held), daemon=True
                 )
                 proc.start()
                 child.close()
@@ -129,6 +136,8 @@ class WorkerPool:
         except BaseException:
             self.shutdown(kill=True)
             raise
+        finally:
+            _release(held)
 
     def _take(self) -> int:
         """The lowest ready task, marked taken (the caller holds one count of ``ready``)."""
@@ -148,8 +157,9 @@ class WorkerPool:
         for _ in range(released):
             self.ready.release()
 
-    def _serve(self, conn, owner: int, others) -> None:
+    def _serve(self, conn, owner: int, others, held) -> None:
         """A worker's loop: take tasks until told to stop (or the caller is gone)."""
+        _release(held)  # this process's copies, taken by the parent around the fork
         for other in others:  # the other workers' pipes
             other.close()
         with contextlib.suppress(ValueError):  # a Ctrl+C is the parent's (it kills its workers)
@@ -221,6 +231,36 @@ class WorkerPool:
 
 
 READY, TAKEN = 1, 2
+
+
+def _loading_locks() -> list:
+    """The locks a worker may need that another thread may hold at the fork: loading the
+    numba kernels (``engine._jit``), the FFT backends (``engine.fft``) and numba's compiler
+    (it compiles or reads a kernel from its cache under one lock)."""
+    from engine import _jit, fft
+
+    locks = [_jit.LOADING_LOCK, fft.LOADING_LOCK]
+    numba_lock = sys.modules.get("numba.core.compiler_lock")
+    if numba_lock is not None:  # its lock object wraps an RLock (numba 0.59-0.6x)
+        locks.append(getattr(numba_lock.global_compiler_lock, "_lock", None))
+    return [lock for lock in locks if lock is not None]
+
+
+def _take_loading_locks() -> list | None:
+    """Every lock of :func:`_loading_locks`, taken without waiting; None (and none held) when
+    another thread holds one."""
+    held = []
+    for lock in _loading_locks():
+        if not lock.acquire(blocking=False):
+            _release(held)
+            return None
+        held.append(lock)
+    return held
+
+
+def _release(held: list | None) -> None:
+    for lock in reversed(held or []):
+        lock.release()
 
 
 def records_in(out):

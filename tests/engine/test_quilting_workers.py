@@ -166,3 +166,48 @@ def test_without_shared_semaphores_quilting_keeps_threads(pools, monkeypatch):
     assert not pools
     assert np.array_equal(two.image, one.image)
     assert _records(two) == _records(one)
+
+
+LOCK_SCENARIO = """
+import os, sys, threading, time
+from engine import _jit
+from engine.quilting.workers import WorkerPool
+
+def run(k):  # a task that loads the kernels' lock, as a worker's first kernel call does
+    with _jit.LOADING_LOCK:
+        time.sleep(0.02)  # long enough for both processes to take tasks
+        return os.getpid()
+
+def pids():
+    pool = WorkerPool(run, lambda pid: pid, [[] for _ in range(40)], 2)
+    try:
+        return {pool.result(k) for k in range(40)}
+    finally:
+        pool.shutdown()
+
+started, stop = threading.Event(), threading.Event()
+def warm_up():  # another thread holding the lock while the pool forks (the editor's warm-up)
+    with _jit.LOADING_LOCK:
+        started.set()
+        stop.wait()
+threading.Thread(target=warm_up, daemon=True).start()
+started.wait()
+threading.Timer(0.5, stop.set).start()
+busy = pids()
+free = pids()
+print(busy == {os.getpid()}, len(free))
+"""
+
+
+def test_no_worker_is_forked_while_another_thread_loads_the_kernels():
+    """A worker forked while another thread holds a loading lock would wait for it forever (the
+    run never ended: the editor's quilting during its kernel warm-up, and CI once). Then this
+    process runs every task; with the locks free the workers are forked and may take them."""
+    import subprocess
+    import sys
+
+    out = subprocess.run(
+        [sys.executable, "-c", LOCK_SCENARIO], capture_output=True, text=True, timeout=120
+    )
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["True", "2"]
