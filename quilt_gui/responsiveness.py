@@ -13,6 +13,8 @@ from collections.abc import Callable
 import numpy as np
 from PySide6.QtCore import QEventLoop, QObject, Qt, QTimer, Slot
 
+from quilt_gui import params
+
 TICK_MS = 5
 
 
@@ -100,16 +102,82 @@ def measure_quilting(window) -> dict:
     return gap_stats(gaps_during(window, window.run_quilt))
 
 
-def cancel_latency(
-    window, start: Callable[[], object], started: Callable[[], bool], timeout_s: float = 60.0
-) -> float:
-    """Milliseconds from Cancel until every job has ended, once ``started()`` is true."""
+def cancel_running(
+    window,
+    key: str,
+    start: Callable[[], object],
+    started: Callable[[], bool],
+    timeout_s: float = 300.0,
+) -> dict:
+    """Start the job ``key`` with ``start()``, wait until ``started()`` and the status bar shows
+    it, click Cancel and wait until every job has ended.
+
+    Returns ``ms`` (from the click until every job ended), ``job`` and ``running``: whether the
+    job was still running when Cancel was clicked (a cancel of a job already over measures
+    nothing). Raises TimeoutError when a wait takes longer than ``timeout_s`` (a margin)."""
     start()
-    wait_until(started, timeout_s)
+    job = window.jobs.get(key)
+    if job is None:
+        raise RuntimeError(f"no {key} job started")
+    if not wait_until(lambda: started() and window.job_status.isVisible(), timeout_s):
+        raise TimeoutError(f"the job did not show progress within {timeout_s} s")
+    running = job.running
     t0 = time.perf_counter()
-    window.job_status.cancel()
-    wait_until(lambda: not window.jobs.busy(), timeout_s)
-    return (time.perf_counter() - t0) * 1000.0
+    window.job_status.cancel_button.click()
+    if not wait_until(lambda: not window.jobs.busy(), timeout_s):
+        raise TimeoutError(f"the jobs did not end within {timeout_s} s of Cancel")
+    return {"ms": (time.perf_counter() - t0) * 1000.0, "job": job, "running": running}
+
+
+#: the long jobs :func:`measure_cancel` cancels: candidates (the local patch search makes as
+#: many as asked, whatever the source) and a quilt (about 2 000 blocks, 20 s on a quiet machine)
+CANCEL_CANDIDATES, CANCEL_QUILT_SIDE = 500, 2048
+
+
+def cancel_candidates(window, timeout_s: float = 300.0) -> dict:
+    """:func:`cancel_running` on the generation of :data:`CANCEL_CANDIDATES` candidates (the
+    template must be found), cancelled once 3 of them are shown. Adds ``made`` (new candidates
+    kept) and ``asked``; the parameters are restored afterwards."""
+    doc = window.doc
+    kept = doc.params.get(params.KEPT)
+    n = doc.params["n_candidates"]
+    doc.apply_params({params.KEPT: {**(kept or {}), "patch_search": "local"}})
+    doc.set_param("n_candidates", CANCEL_CANDIDATES)
+    wait_until(lambda: not window.pipeline.busy(), timeout_s)
+    try:
+        out = cancel_running(
+            window,
+            "candidates",
+            window.act_generate.trigger,
+            lambda: len(doc.tileset.candidates) >= 3,
+            timeout_s,
+        )
+    finally:
+        doc.apply_params({params.KEPT: kept})
+        doc.set_param("n_candidates", n)
+    out.update(made=len(doc.tileset.candidates), asked=CANCEL_CANDIDATES)
+    return out
+
+
+def cancel_quilting(window, timeout_s: float = 300.0) -> dict:
+    """:func:`cancel_running` on a :data:`CANCEL_QUILT_SIDE` px square quilt, cancelled once 3
+    blocks are placed; the output size is restored afterwards. No quilt may be shown (the
+    size change would re-run it)."""
+    doc = window.doc
+    if doc.quilting.result is not None or window.jobs.get("quilt") is not None:
+        raise RuntimeError("cancel_quilting needs a window without a quilt shown or running")
+    size = {k: doc.params[k] for k in ("out_width", "out_height")}
+    doc.set_params({"out_width": CANCEL_QUILT_SIDE, "out_height": CANCEL_QUILT_SIDE})
+    try:
+        return cancel_running(
+            window,
+            "quilt",
+            window.act_quilt.trigger,
+            lambda: len(doc.quilting.blocks) >= 3,
+            timeout_s,
+        )
+    finally:
+        doc.set_params(size)
 
 
 def recompute_latency(window, method: str, repeats: int = 3) -> float:
@@ -153,17 +221,21 @@ def measure_watch(window, improvements: int = 240) -> dict:
 
 
 def measure_all(
-    window, *, repeats: int = 3, heavy: bool = False, watch: bool = False
+    window, *, repeats: int = 3, heavy: bool = False, watch: bool = False, cancel: bool = True
 ) -> dict[str, dict]:
     """The figures of the benchmark table (the window must have the sample open).
 
     ``heavy`` adds runs of several seconds (300 candidates; a 1536x1536 quilt), so the
     percentiles rest on thousands of ticks rather than a few dozen; ``watch`` the animation of
-    *Watch the search* (:func:`measure_watch`, about 8 s)."""
+    *Watch the search* (:func:`measure_watch`, about 8 s); ``cancel`` the latency of Cancel on
+    two long jobs (:func:`cancel_candidates`, :func:`cancel_quilting`)."""
     doc = window.doc
     window.pipeline.find_template()
     wait_until(lambda: not window.pipeline.busy())
     rows = {f"{doc.params['n_candidates']} candidates": measure_candidates(window, repeats)}
+    if cancel:  # before any quilt is shown (a size change would re-run a shown one)
+        rows["cancel candidates"] = {"ms": cancel_candidates(window)["ms"]}
+        rows["cancel quilting"] = {"ms": cancel_quilting(window)["ms"]}
     rows["quilting (best match)"] = measure_quilting(window)
     if watch:
         rows["watch the search (paced)"] = measure_watch(window)
@@ -174,17 +246,6 @@ def measure_all(
         doc.set_params({"n_candidates": n, "out_width": 1536, "out_height": 1536})
         rows["quilting 1536x1536 (best match)"] = measure_quilting(window)
         doc.set_params({"out_width": size[0], "out_height": size[1]})
-    n = doc.params["n_candidates"]
-    doc.set_param("n_candidates", 400)
-    rows["cancel candidates"] = {
-        "ms": cancel_latency(
-            window, window.pipeline.generate_candidates, lambda: len(doc.tileset.candidates) >= 3
-        )
-    }
-    doc.set_param("n_candidates", n)
-    rows["cancel quilting"] = {
-        "ms": cancel_latency(window, window.run_quilt, lambda: len(doc.quilting.blocks) >= 3)
-    }
     method = doc.params["method"]
     for m in ("dp", "oscillating", "oscillating-optimal"):  # the methods with a cyclic seam
         rows[f"seamless tile, {m}"] = {"recompute_ms": recompute_latency(window, m)}
