@@ -6,12 +6,15 @@ stored argmin pointers. Exact and O(3 w h). Every row may be restricted to a col
 makes rows 0 and h-1 neighbours (``|c_0 - c_{h-1}| <= 1``), solved exactly by fixing c_0 to
 each allowed column in turn, cheapest open-path bound first, until the bound exceeds the best
 closed cost: O(3 w h) per start tried, O(3 w² h) at worst, a few starts on real overlaps.
+While numba is not loaded a small map (:data:`SMALL_DP_PIXELS`) takes the kernels' numpy twins
+(row by row over the columns: the same sums, the same ties), so a small job starts no numba.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from engine import _jit as jit
 from engine._jit import njit
 from engine.seams._result import Seam, make_seam, mask_from_columns
 
@@ -118,11 +121,87 @@ def _dp_kernel(error, lo, hi, cyclic, cols):
     return _dp_pass(error, lo, hi, best_s, back, cols)
 
 
+SMALL_DP_PIXELS = 1 << 16
+"""Largest map solved by the numpy twins while numba is not loaded (~10 µs a row and pass here;
+numba's start-up costs ~0.3-0.6 s)."""
+
+
+def _down(table, error, lo, hi, rows) -> None:
+    """``table[j]`` (w + 2 wide, inf at both ends) from ``table[j ∓ 1]`` for j in ``rows``: the
+    least of the three costs next to each column of ``lo..hi`` plus the error (the kernels'
+    values: the least of three is the same whichever wins a tie)."""
+    for j, p in rows:
+        a, b = lo[j], hi[j] + 1
+        prev = table[p]
+        row = table[j, a + 1 : b + 1]
+        np.minimum(prev[a:b], prev[a + 1 : b + 1], out=row)
+        np.minimum(row, prev[a + 2 : b + 2], out=row)
+        row += error[j, a:b]
+
+
+def _dp_pass_numpy(error, lo, hi, s, cols) -> float:
+    """:func:`_dp_pass` in numpy: the costs row by row, then the path traced back through them
+    with the kernel's ties (straight, then left, then right)."""
+    h, w = error.shape
+    table = np.full((h, w + 2), np.inf)
+    a0, b0 = (s, s) if s >= 0 else (lo[0], hi[0])
+    table[0, a0 + 1 : b0 + 2] = error[0, a0 : b0 + 1]
+    _down(table, error, lo, hi, ((j, j - 1) for j in range(1, h)))
+    a, b = lo[h - 1], hi[h - 1]
+    if s >= 0:
+        a, b = max(a, s - 1), min(b, s + 1)
+    last = table[h - 1, a + 1 : b + 2]
+    if last.size == 0 or not last.min() < np.inf:
+        return np.inf
+    i = a + int(np.argmin(last))
+    cols[h - 1] = i
+    rows = table.tolist()
+    for j in range(h - 1, 0, -1):
+        prev = rows[j - 1]
+        best, k = prev[i + 1], 0
+        if prev[i] < best:
+            best, k = prev[i], -1
+        if prev[i + 2] < best:
+            k = 1
+        i += k
+        cols[j - 1] = i
+    return float(last.min())
+
+
+def _open_costs_numpy(error, lo, hi):
+    """:func:`_open_costs` in numpy."""
+    h, w = error.shape
+    table = np.full((h, w + 2), np.inf)
+    table[h - 1, lo[h - 1] + 1 : hi[h - 1] + 2] = error[h - 1, lo[h - 1] : hi[h - 1] + 1]
+    _down(table, error, lo, hi, ((j, j + 1) for j in range(h - 2, -1, -1)))
+    return table[0, 1:-1]
+
+
+def _dp_numpy(error, lo, hi, cyclic, cols) -> float:
+    """:func:`_dp_kernel` in numpy: the same starts in the same order, the same path."""
+    if not cyclic or error.shape[0] == 1:
+        return _dp_pass_numpy(error, lo, hi, -1, cols)
+    bound = _open_costs_numpy(error, lo, hi)
+    starts = np.arange(lo[0], hi[0] + 1)
+    starts = starts[np.argsort(bound[lo[0] : hi[0] + 1], kind="mergesort")]
+    best, best_s = np.inf, -1
+    for s in starts.tolist():
+        if bound[s] > best + 1e-9 * abs(best) + 1e-300 or bound[s] == np.inf:
+            break
+        c = _dp_pass_numpy(error, lo, hi, s, cols)
+        if c < best or (c == best and s < best_s):
+            best, best_s = c, s
+    if best_s < 0:
+        return np.inf
+    return _dp_pass_numpy(error, lo, hi, best_s, cols)
+
+
 def dp_columns(error: np.ndarray, lo: np.ndarray, hi: np.ndarray, *, cyclic: bool = False):
     """Column of the optimal path in every row, or None when the constraints admit no path."""
     h = error.shape[0]
     cols = np.zeros(h, dtype=np.int64)
-    cost = _dp_kernel(error, lo, hi, bool(cyclic), cols)
+    small = error.size <= SMALL_DP_PIXELS and not jit.loaded()
+    cost = (_dp_numpy if small else _dp_kernel)(error, lo, hi, bool(cyclic), cols)
     return None if not np.isfinite(cost) else cols
 
 

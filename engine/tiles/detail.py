@@ -54,11 +54,11 @@ REFERENCE_GRID = 64
 SMALL_PIXELS = 1 << 20
 
 
-def kernel_pays(pixels: int) -> bool:
+def kernel_pays(pixels: int, small: int = SMALL_PIXELS) -> bool:
     """Whether the compiled kernels (the numpy paths' bit-for-bit twins) are worth it for
-    ``pixels``: always once numba is loaded, else only above :data:`SMALL_PIXELS` (small
-    sources do not pay numba's start-up)."""
-    return pixels >= SMALL_PIXELS or jit.loaded()
+    ``pixels`` (or another measure of the work): always once numba is loaded, else only from
+    ``small`` on (small jobs do not pay numba's start-up)."""
+    return pixels >= small or jit.loaded()
 
 
 def check_detail_weight(value) -> float:

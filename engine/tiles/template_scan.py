@@ -1,6 +1,8 @@
 """The template search's scans (ALGORITHMS.md §1.6): for every position and shift of one
 phase at once, the strip mismatch D, the natural wrap joint's step G and the detail term
 (:mod:`engine.tiles.detail`) — numba kernels over the shifts, cumulative sums over positions.
+A small scan while numba is not loaded takes the kernel's numpy twin (the same sums in the same
+order: identical values) and so does not start numba (:func:`engine.tiles.detail.kernel_pays`).
 """
 
 from __future__ import annotations
@@ -9,7 +11,9 @@ import math
 
 import numpy as np
 
+from engine import _jit as jit
 from engine._jit import njit
+from engine.tiles.detail import kernel_pays
 
 __all__ = [
     "CHUNK",
@@ -22,6 +26,10 @@ __all__ = [
 ]
 
 CHUNK = 8  # shifts per kernel call between cancel checks / progress events
+#: A scan of fewer pixel pairs (rows x columns x shifts) than this, while numba is not loaded,
+#: takes :func:`_shift_sums_numpy` (~10 ns a pair here against the kernel's ~3 ns: numba's
+#: start-up, ~0.3-0.6 s, buys ~50-100 M pairs).
+SMALL_SCAN_PAIRS = 1 << 24
 
 
 @njit(cache=True, nogil=True)
@@ -56,14 +64,58 @@ def runs_right(free):  # pragma: no cover
     return out
 
 
+def _shift_sums_numpy(S, valid, use_valid, r0, r1, shifts, out_sum, out_cnt) -> None:
+    """:func:`_shift_sums` in numpy: the same float32 differences and squares, float64 channel
+    sums, square roots and row-by-row sums (down the rows, from ``out_sum``)."""
+    W, C = S.shape[1], S.shape[2]
+    if r1 <= r0:
+        return
+    rows = S[r0:r1]
+    for k in range(shifts.shape[0]):
+        a = int(shifts[k])
+        n = W - a
+        if n <= 0:
+            continue
+        sq = rows[:, :n] - rows[:, a:]
+        sq *= sq
+        s = sq[..., 0].astype(np.float64)
+        for c in range(1, C):
+            s += sq[..., c]
+        seq = np.empty((r1 - r0 + 1, n))
+        seq[0] = out_sum[k, :n]
+        np.sqrt(s, out=seq[1:])
+        ok = valid[r0:r1, :n] & valid[r0:r1, a:] if use_valid else None
+        if ok is not None:
+            seq[1:][~ok] = 0.0  # x + 0.0 == x: a skipped pair
+        cnt = out_cnt[k, :n]
+        if np.array_equal(cnt, np.trunc(cnt)):  # whole counts (always here): any order is exact
+            cnt += float(r1 - r0) if ok is None else ok.sum(axis=0)
+        else:
+            ones = np.ones((r1 - r0, n)) if ok is None else ok
+            out_cnt[k, :n] = _down_rows(np.concatenate([cnt[None], ones]))
+        out_sum[k, :n] = _down_rows(seq)
+
+
+def _down_rows(a: np.ndarray) -> np.ndarray:
+    """The sum of each column of ``a`` (rows, n), added row by row from the first."""
+    # down the rows of a C-ordered (rows, n >= 2) array numpy adds row by row (pairwise
+    # summation is only along the contiguous axis: a single column would take it)
+    return np.add.reduce(a, axis=0) if a.shape[1] > 1 else np.cumsum(a, axis=0)[-1]
+
+
 def runs_1d(free: np.ndarray) -> np.ndarray:
     return runs_right(np.ascontiguousarray(free[None, :]))[0]
 
 
 # --------------------------------------------------------------------------- phases
-def _sums(S, valid, rows, shifts, out_sum, out_cnt) -> None:
+def scan_kernel_pays(S, rows, shifts: int) -> bool:
+    """Whether a scan of ``shifts`` shifts over ``rows`` of ``S`` takes the numba kernel."""
+    return kernel_pays((rows[1] - rows[0]) * S.shape[1] * shifts, SMALL_SCAN_PAIRS)
+
+
+def _sums(S, valid, rows, shifts, out_sum, out_cnt, kernel=True) -> None:
     use_valid = valid is not None
-    _shift_sums(
+    (_shift_sums if kernel or jit.loaded() else _shift_sums_numpy)(
         S,
         valid if use_valid else np.ones((1, 1), dtype=np.bool_),
         use_valid,
@@ -80,7 +132,7 @@ def _joint_steps(S, valid, rows) -> np.ndarray:
     W = S.shape[1]
     s = np.zeros((1, W))
     c = np.zeros((1, W))
-    _sums(S, valid, rows, np.ones(1, dtype=np.int64), s, c)
+    _sums(S, valid, rows, np.ones(1, dtype=np.int64), s, c, scan_kernel_pays(S, rows, 1))
     G = np.zeros(W)
     G[1:] = s[0, : W - 1] / np.maximum(c[0, : W - 1], 1.0)
     return G
@@ -106,13 +158,15 @@ class Scan:
         self.sum = np.zeros((self.shifts.size, W), dtype=np.float64)
         self.cnt = np.zeros((self.shifts.size, W), dtype=np.float64)
         self._G = None
+        self.kernel = scan_kernel_pays(S, rows, self.shifts.size)
 
     def chunks(self):
         """Run the kernel chunk by chunk; yields the (start, end) shifts done."""
         for k0 in range(0, self.shifts.size, CHUNK):
             k1 = min(k0 + CHUNK, self.shifts.size)
             _sums(
-                self.S, self.valid, self.rows, self.shifts[k0:k1], self.sum[k0:k1], self.cnt[k0:k1]
+                *(self.S, self.valid, self.rows, self.shifts[k0:k1]),
+                *(self.sum[k0:k1], self.cnt[k0:k1], self.kernel),
             )
             yield k0, k1
 
