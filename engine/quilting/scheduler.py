@@ -153,7 +153,13 @@ def run_levels(q: Quilter, rects, total_label: str):
             head.append(run(len(head)))
 
         placed = workers.WorkerPool(
-            run, workers.records_in, needs, q.threads, q.cancel, done=len(head)
+            run,
+            workers.unpack_records,
+            needs,
+            q.threads,
+            q.cancel,
+            done=len(head),
+            pack=workers.pack_records,
         )
         outcomes = itertools.chain(head, (placed.result(b) for b in range(len(head), len(batches))))
     elif q.threads > 1 and area >= POOL_MIN_SAMPLE_AREA:

@@ -98,6 +98,43 @@ def test_streamed_pixels_are_the_placed_blocks(pools):
         assert np.array_equal(a.pixels, b.pixels)
 
 
+@pytest.mark.parametrize("ring", [4096, 1 << 16])
+def test_messages_through_a_small_ring_and_the_pipe(ring, pools, monkeypatch):
+    """The workers' records and pixels arrive whole whichever way they come: with a 4 kB ring
+    every message (~9 kB) goes through the pipe; with 64 kB they wrap around the ring (and go
+    through the pipe when the caller is behind); adaptive runs send several records a task."""
+    _jit.load()
+    monkeypatch.setattr(workers, "RING_BYTES", ring)
+    kw = dict(block=28, overlap=6, rng=4, mode="exact", adaptive_threshold=0.02)
+    mine, ref = (list(iter_quilt(SAMPLE, (200, 220), threads=t, **kw)) for t in (2, 1))
+    assert pools
+    placed = [[e for e in run if isinstance(e, BlockPlaced)] for run in (mine, ref)]
+    assert len(placed[0]) == len(placed[1])
+    for a, b in zip(*placed, strict=True):
+        assert np.array_equal(a.pixels, b.pixels)
+        assert not a.pixels.flags.writeable
+    done = [quilt(SAMPLE, (200, 220), threads=t, **kw) for t in (2, 1)]
+    assert _records(done[0]) == _records(done[1])
+
+
+def test_a_worker_that_dies_stops_the_run(pools, monkeypatch):
+    """A worker process killed mid-run (no message, no error sent) ends the run with an error
+    instead of waiting for its blocks forever."""
+    _jit.load()
+    real = Quilter.place
+    parent = os.getpid()
+
+    def place(self, wk):
+        if os.getpid() != parent:
+            os._exit(3)
+        return real(self, wk)
+
+    monkeypatch.setattr(Quilter, "place", place)
+    with pytest.raises(RuntimeError, match="died"):
+        quilt(SAMPLE, (200, 200), block=28, overlap=6, rng=1, mode="exact", threads=2)
+    assert pools and not pools[0].procs
+
+
 def test_cancel_stops_the_workers(pools):
     _jit.load()
     token = CancelToken()
