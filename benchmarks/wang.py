@@ -330,7 +330,7 @@ def wang_figures(S, T: int, seed: int, options: dict, docs_file: Path | None = N
     return pairs, lat.above, fr.value, half.value, det, corner, joints, raw, cont, fr.ratio
 
 
-def wang_row(S, T: int, docs: Path | None, name: str, seeds: int = 1):
+def wang_row(S, T: int, docs: Path | None, name: str, seeds: int = 1, options=None):
     """Wang figures of ``seeds`` sets (seeds 0 ..): medians over them; the joints' max is the
     largest of any set; last, the frame pooled over the sets (:func:`pooled_frame`; the
     median of the sets' own frames is among the medians). Layouts as the CLI's and the
@@ -338,7 +338,9 @@ def wang_row(S, T: int, docs: Path | None, name: str, seeds: int = 1):
     figures, ratios = [], []
     for seed in range(seeds):
         out = None if docs is None or seed else docs / f"{name}_wang.png"
-        pairs, lat, fr, _, det, corner, joints, raw, cont, ratio = wang_figures(S, T, seed, {}, out)
+        pairs, lat, fr, _, det, corner, joints, raw, cont, ratio = wang_figures(
+            S, T, seed, dict(options or {}), out
+        )
         figures.append((np.median(pairs), max(pairs), lat, fr, det, corner, joints, raw, cont))
         ratios.append(ratio)
     med = np.median(np.array(figures), axis=0)
@@ -363,13 +365,15 @@ def somol_row(S, T: int, docs: Path | None, name: str):
     return pairs, lat.above, fr.value, det
 
 
-def quality(which: str, tile: int, docs: Path | None, seeds: int = 3) -> str:
+def quality(which: str, tile: int, docs: Path | None, seeds: int = 3, options=None) -> str:
     rows = []
     for name, S in _textures(which):
         T = _fit(S, tile)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            wmed, wmax, wl, wf, wd, wc, wj, wraw, wcont, wpool = wang_row(S, T, docs, name, seeds)
+            wmed, wmax, wl, wf, wd, wc, wj, wraw, wcont, wpool = wang_row(
+                S, T, docs, name, seeds, options
+            )
             floor = crop_frame(S, T, 2 * _default_ring(T), sets=seeds)
             try:
                 sp, sl, sf, sd = somol_row(S, T, docs, name)
@@ -489,6 +493,11 @@ def main(argv=None) -> int:
         default=None,
         help="Wang sets per texture (medians; default 3, 2 for --interiors)",
     )
+    ap.add_argument(
+        "--corner-match",
+        action="store_true",
+        help="--quality with Wang sets of corner_match=True (wang_quality_SET_corner_match.txt)",
+    )
     args = ap.parse_args(argv)
     RESULTS.mkdir(exist_ok=True)
     if args.docs is not None:
@@ -499,9 +508,12 @@ def main(argv=None) -> int:
         (RESULTS / "wang.txt").write_text(text)
     if args.quality:
         seeds = 3 if args.seeds is None else args.seeds
-        text = f"{_stamp()}\n\n{quality(args.quality, args.tile, args.docs, seeds)}"
+        options = {"corner_match": True} if args.corner_match else None
+        table = quality(args.quality, args.tile, args.docs, seeds, options)
+        text = f"{_stamp()}{' (corner_match=True)' if options else ''}\n\n{table}"
         print(text)
-        (RESULTS / f"wang_quality_{args.quality}.txt").write_text(text)
+        suffix = "_corner_match" if options else ""
+        (RESULTS / f"wang_quality_{args.quality}{suffix}.txt").write_text(text)
     if args.interiors:
         seeds = 2 if args.seeds is None else args.seeds
         load = _load_avg()

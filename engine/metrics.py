@@ -10,6 +10,8 @@ channel); absolute differences are averaged over channels.
 * :func:`grid_border_ratio` — the same ratio along the lines of a block grid.
 * :func:`block_grid_border_ratio` — the same along a quilted image's grid, where its cuts run.
 * :func:`corner_border_ratio` — the same near the grid's crossings, where four tiles meet.
+* :func:`corner_energy` — all steps (across, along and off the lines) in windows around the
+  crossings over the image's mean step, with its profile by distance from the crossing.
 * :func:`detail_ratio` — variance of the Laplacian of a tile over that of the source
   (:func:`laplacian_variance`).
 * :func:`grid_score` — normalised autocorrelation at a lag of one tile period minus the
@@ -28,6 +30,8 @@ also zero and ``inf`` otherwise.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -50,8 +54,12 @@ __all__ = [
     "Duplicates",
     "Frame",
     "Lattice",
+    "CornerEnergy",
     "block_grid_border_ratio",
     "corner_border_ratio",
+    "corner_energy",
+    "mean_step",
+    "step_windows",
     "border_ratio",
     "duplicates",
     "edge_distance",
@@ -188,6 +196,89 @@ def corner_border_ratio(image, period, *, radius: int = 2) -> float:
             f"{x.shape[1]}x{x.shape[0]} image"
         )
     return float(np.mean(ratios))
+
+
+def step_windows(image, points, radius: int) -> tuple[np.ndarray, np.ndarray]:
+    """The steps of ``image`` in square windows around pixel-corner ``points``.
+
+    ``points`` is an (n, 2) array of (row, col) corners: (y, x) lies between pixels y − 1 and
+    y and x − 1 and x, so a tile crossing at (m·T, n·T) is a point. Every column step
+    (|x[i, j+1] − x[i, j]|, averaged over channels; at row centre i + ½, on the line j + 1)
+    and every row step whose Chebyshev distance to the point is below ``radius`` is read.
+    Returns the steps (n, m) and each step's ring, floor(distance), 0 .. radius − 1 (m,).
+    Every point must satisfy radius <= y <= H − radius and radius <= x <= W − radius.
+    """
+    x = _colour(image, "image")
+    r = positive_int(radius, "radius")
+    p = np.asarray(points, dtype=np.intp).reshape(-1, 2)
+    H, W = x.shape[:2]
+    if p.size and not (
+        (p[:, 0] >= r).all()
+        and (p[:, 0] <= H - r).all()
+        and (p[:, 1] >= r).all()
+        and (p[:, 1] <= W - r).all()
+    ):
+        raise ValueError(f"every point needs {r} px around it inside the {W}x{H} image")
+    a = np.arange(-r, r)  # across the point's row: row centres y + a + 1/2
+    b = np.arange(-(r - 1), r)  # the line j + 1 = x + b
+    aa, bb = np.meshgrid(a, b, indexing="ij")
+    ring = np.maximum(np.where(aa >= 0, aa, -aa - 1), np.abs(bb)).ravel()
+    cols = _col_steps(x)  # (H, W - 1)
+    rows = _col_steps(x.transpose(1, 0, 2))  # (W, H - 1): row steps, transposed
+    vc = cols[p[:, 0, None] + aa.ravel(), p[:, 1, None] - 1 + bb.ravel()]
+    vr = rows[p[:, 1, None] + aa.ravel(), p[:, 0, None] - 1 + bb.ravel()]
+    return np.concatenate([vc, vr], axis=1), np.concatenate([ring, ring])
+
+
+def mean_step(image) -> float:
+    """The image's mean step (column and row steps pooled): what :func:`step_windows` reads
+    on average at uniformly random points."""
+    x = _colour(image, "image")
+    c, r = _col_steps(x), _col_steps(x.transpose(1, 0, 2))
+    return float((c.sum() + r.sum()) / (c.size + r.size))
+
+
+@dataclass(frozen=True)
+class CornerEnergy:
+    """:func:`corner_energy`'s result: means over ``level``, the image's mean step."""
+
+    value: float  #: the steps within ``radius`` of the crossings
+    lines: float  #: the same around the midpoints of the tile edges (a joint, no crossing)
+    profile: np.ndarray  #: the crossings' steps by ring (floor of the distance), 0 .. r − 1
+    level: float  #: the image's mean step (random points)
+    count: int  #: crossings read
+
+
+def corner_energy(image, period, *, radius: int = 4) -> CornerEnergy:
+    """Step energy where four tiles meet: the mean step (all column and row steps, across,
+    along and off the tile lines: :func:`step_windows`) within ``radius`` px of the interior
+    crossings of the grid of ``period`` (offset 0), over the image's mean step (what random
+    points read). 1.0: the crossings are as smooth as anywhere; a tile construction whose
+    corners break (unrelated pixels meeting, cuts converging, blend blobs) reads above, a
+    blurred corner below. ``lines``: the same at the midpoints of the tile edges, to tell a
+    corner's own excess from the joints'. A layout of crops of one continuous image (the
+    image itself) reads about 1.
+    """
+    x = _colour(image, "image")
+    ph, pw = _period(period)
+    r = positive_int(radius, "radius")
+    H, W = x.shape[:2]
+    ys, xs = np.arange(ph, H - r + 1, ph), np.arange(pw, W - r + 1, pw)
+    ys, xs = ys[ys >= r], xs[xs >= r]
+    if not (len(ys) and len(xs)):
+        raise ValueError(
+            f"no crossing of grid lines of period {(ph, pw)} lies {r} px inside the {W}x{H} image"
+        )
+    level = mean_step(x)
+    cross = np.stack(np.meshgrid(ys, xs, indexing="ij"), -1).reshape(-1, 2)
+    steps, ring = step_windows(x, cross, r)
+    profile = np.array([_ratio(steps[:, ring == k].mean(), level) for k in range(r)])
+    mids = [(y, m) for y in ys for m in xs - pw // 2 if m >= r]
+    mids += [(m, xx) for m in ys - ph // 2 for xx in xs if m >= r]
+    line = step_windows(x, mids, r)[0].mean() if mids else np.nan
+    return CornerEnergy(
+        _ratio(steps.mean(), level), _ratio(line, level), profile, level, len(cross)
+    )
 
 
 def block_grid_border_ratio(result, *, reduce: str = "max") -> float:

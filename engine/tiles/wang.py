@@ -185,6 +185,11 @@ def iter_wang_set(
     tolerance : float
         Samples and interiors are drawn among the positions within ``(1 + tolerance)`` of
         the best match.
+    corner_match : bool
+        Draw the h samples also where their corner pixels meet the v samples' end pixels
+        (columns 0 and T-1 at rows 1 and T-2, which sit between two pixels of the h layer
+        where four tiles meet: :meth:`WangSetup.hv_corner_errors`), under the same bound as
+        the h samples' own corner steps (default False; README "Session 8").
     seam : SeamSpec
         Seam method and options, error metric and blending of every cut (default
         :data:`engine.stitch.PATCH_SEAM`: dp, adaptive blending).

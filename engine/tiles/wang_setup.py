@@ -57,7 +57,7 @@ class WangSetup:
         interior_blend = opts.pop("interior_blend")
         margin, outward = opts.pop("margin"), opts.pop("outward")
         min_distance, tolerance = opts.pop("min_distance"), opts.pop("tolerance")
-        seam = opts.pop("seam")
+        seam, corner_match = opts.pop("seam"), opts.pop("corner_match")
         excluded, maps, weights = opts.pop("excluded"), opts.pop("maps"), opts.pop("weights")
         if opts:
             raise TypeError(f"unexpected option(s): {', '.join(sorted(opts))}")
@@ -103,6 +103,7 @@ class WangSetup:
             T / 2 if min_distance is None else min_distance, "min_distance"
         )
         self.tolerance = _nonneg_float(tolerance, "tolerance")
+        self.corner_match = bool(corner_match)
         extra = as_maps(maps, (H, W))
         self.weights = check_weights(weights, extra)
         self.stack = {MAIN: self.S, **extra}
@@ -347,6 +348,36 @@ class WangSetup:
                     e += norm[part] - 2 * (mine[part] @ theirs[r]) + float(theirs[r] @ theirs[r])
         return e
 
+    def hv_corner_errors(self, vs: list[WangSample]) -> np.ndarray:
+        """Squared colour steps of the v samples' end pixels at the tile corners, for an ``h``
+        sample at every window anchor (as :meth:`corner_errors`), summed over ``vs``.
+
+        A tile's rows 0 and T-1 are its N and S samples' and its columns 0 and T-1 its W and
+        E samples' in rows 1..T-2; the corner cuts start below the corner, so at every corner
+        the edge column's end pixel (row 1 or T-2) sits between two pixels of the h layer: the
+        edge row's corner pixel beside it along the edge and the layer's pixel diagonally
+        inward beside it across the cut (the dots where four tiles meet). Each v sample's four
+        end pixels (W and E roles, top and bottom) against this h sample's two neighbours."""
+        T, h = self.T, self.reach
+        S = colour_channels(self.S)
+        ny, nx = S.shape[0] - 2 * h + 1, S.shape[1] - T + 1
+        e = np.zeros((ny, nx))
+        # (v pixel offset from the v origin, [h layer pixels' offsets from the h origin])
+        corners = (
+            ((1, 0), ((0, 0), (1, 1))),  # NW: W(1, 0) below N(0, 0), left of N(1, 1)
+            ((1, -1), ((0, T - 1), (1, T - 2))),  # NE: E(1, T-1)
+            ((T - 2, 0), ((-1, 0), (-2, 1))),  # SW: W(T-2, 0) above S(T-1, 0)
+            ((T - 2, -1), ((-1, T - 1), (-2, T - 2))),  # SE: E(T-2, T-1)
+        )
+        for v in vs:
+            vy, vx = v.origin
+            for (py, px), nbrs in corners:
+                p = S[vy + py, vx + px]
+                for dy, dx in nbrs:  # the h origin of anchor (y, x) is (y + h, x)
+                    d = S[h + dy : h + dy + ny, dx : dx + nx] - p
+                    e += np.einsum("yxc,yxc->yx", d, d)
+        return e
+
     def choose(self, axis, colour, others, placed, rng, same=()) -> WangSample:
         """Sample ``colour`` of ``axis``: best matching ``others`` within tolerance, away from
         ``placed`` (role anchors) by ``min_distance``; an ``h`` sample also with corner steps
@@ -385,7 +416,11 @@ class WangSetup:
             )
         if axis == "h":
             c = self.corner_errors(list(same))
-            natural = 2 * (1 + 2 * len(same)) * self.natural_step  # that many steps
+            n_steps = 2 * (1 + 2 * len(same))
+            if self.corner_match and others:
+                c = c + self.hv_corner_errors(list(others))
+                n_steps += 8 * len(others)
+            natural = n_steps * self.natural_step  # that many steps
             ok &= c <= max(CORNER_STEPS * natural, np.quantile(c[ok], CORNER_QUANTILE))
         n_px = sum(len(r) for r, _ in self.bands.values()) * max(1, len(others))
         k, _, _ = _select(

@@ -311,6 +311,123 @@ def test_corner_border_ratio_sees_steps_where_four_tiles_meet():
         corner_border_ratio(S[:20, :20], 32)
 
 
+def test_corner_energy_sees_defects_where_four_tiles_meet():
+    """Oracle: a layout of crops of one continuous image (the image itself) reads about 1 at
+    its crossings; a 6x6 patch of elsewhere pasted on every crossing reads high there and
+    not at the edges' midpoints (which corner_border_ratio, 2 px across the lines, misses)."""
+    from engine.metrics import corner_border_ratio, corner_energy
+
+    S = smooth_texture((256, 256), 3, seed=1)
+    e = corner_energy(S, 32)
+    assert 0.9 < e.value < 1.1 and 0.9 < e.lines < 1.1 and e.count == 49
+    assert np.all(np.abs(e.profile - 1) < 0.15)
+    P, g = S.copy(), np.random.default_rng(0)
+    for y in range(32, 256, 32):
+        for x in range(32, 256, 32):
+            sy, sx = g.integers(0, 250, 2)
+            P[y - 3 : y + 3, x - 3 : x + 3] = S[sy : sy + 6, sx : sx + 6]
+    e = corner_energy(P, 32)
+    assert e.value > 1.4 and e.lines < 1.1 and e.profile[3] > 2
+    assert corner_border_ratio(P, 32) < 1.1
+    with pytest.raises(ValueError, match="no crossing"):
+        corner_energy(S[:34, :34], 32)
+
+
+def test_step_windows_read_every_step_within_the_radius_by_brute_force():
+    from engine.metrics import step_windows
+
+    x = smooth_texture((40, 50), 1, seed=2)
+    vals, ring = step_windows(x, [(20, 25)], 3)
+    want = {}  # (kind, row, col) -> (step, ring)
+    for i in range(40):
+        for j in range(49):  # column step: row centre i + 1/2, on the line j + 1
+            d = max(abs(i + 0.5 - 20), abs(j + 1 - 25))
+            if d < 3:
+                want["c", i, j] = (abs(x[i, j + 1, 0] - x[i, j, 0]), int(d))
+    for i in range(39):
+        for j in range(50):
+            d = max(abs(i + 1 - 20), abs(j + 0.5 - 25))
+            if d < 3:
+                want["r", i, j] = (abs(x[i + 1, j, 0] - x[i, j, 0]), int(d))
+    got = sorted(zip(vals[0].tolist(), ring.tolist(), strict=True))
+    np.testing.assert_allclose(got, sorted(want.values()))
+    with pytest.raises(ValueError, match="3 px around it"):
+        step_windows(x, [(2, 25)], 3)
+
+
+def test_hv_corner_errors_are_the_v_end_pixels_steps_by_brute_force(source):
+    """The pixels the errors read are a diamonds tile's own (the oracle: which layer shows
+    where at each corner), and the errors are their squared steps summed (brute force)."""
+    from engine.tiles.wang import WangSetup
+
+    dia = wang_set(source, tile_size=T, rng=5, interior="diamonds", corner_match=True)
+    t = dia.tiles[9]
+    n, e, s, w = (dia.sample(ax, c) for ax, c in zip("hvhv", t.signature, strict=True))
+    (ny, nx), (sy, sx), (ey, ex), (wy, wx) = n.origin, s.origin, e.origin, w.origin
+    x = source
+    corners = [  # (v end pixel, tile pixel), [(h layer pixel, tile pixel) beside it]
+        (
+            (x[wy + 1, wx], t.tile[1, 0]),
+            [(x[ny, nx], t.tile[0, 0]), (x[ny + 1, nx + 1], t.tile[1, 1])],
+        ),
+        (
+            (x[ey + 1, ex - 1], t.tile[1, T - 1]),
+            [(x[ny, nx + T - 1], t.tile[0, T - 1]), (x[ny + 1, nx + T - 2], t.tile[1, T - 2])],
+        ),
+        (
+            (x[wy + T - 2, wx], t.tile[T - 2, 0]),
+            [(x[sy - 1, sx], t.tile[T - 1, 0]), (x[sy - 2, sx + 1], t.tile[T - 2, 1])],
+        ),
+        (
+            (x[ey + T - 2, ex - 1], t.tile[T - 2, T - 1]),
+            [
+                (x[sy - 1, sx + T - 1], t.tile[T - 1, T - 1]),
+                (x[sy - 2, sx + T - 2], t.tile[T - 2, T - 2]),
+            ],
+        ),
+    ]
+    for (p, tp), nbrs in corners:
+        np.testing.assert_array_equal(p, tp)
+        for q, tq in nbrs:
+            np.testing.assert_array_equal(q, tq)
+    setup = WangSetup(source, tile_size=T)
+    vs = [dia.sample("v", 0), dia.sample("v", 1)]
+    err = setup.hv_corner_errors(vs)
+    S, h = source.astype(np.float64), setup.reach
+    g = np.random.default_rng(1)
+    for y, xx in zip(g.integers(0, err.shape[0], 20), g.integers(0, err.shape[1], 20), strict=True):
+        oy, ox = y + h, xx  # the h origin of anchor (y, x)
+        want = 0.0
+        for v in vs:
+            vy, vx = v.origin
+            for (py, px), nb in (
+                ((vy + 1, vx), [(oy, ox), (oy + 1, ox + 1)]),
+                ((vy + 1, vx - 1), [(oy, ox + T - 1), (oy + 1, ox + T - 2)]),
+                ((vy + T - 2, vx), [(oy - 1, ox), (oy - 2, ox + 1)]),
+                ((vy + T - 2, vx - 1), [(oy - 1, ox + T - 1), (oy - 2, ox + T - 2)]),
+            ):
+                want += sum(np.sum((S[py, px] - S[qy, qx]) ** 2) for qy, qx in nb)
+        assert err[y, xx] == pytest.approx(want, rel=1e-4, abs=1e-6)
+
+
+def test_corner_match_draws_h_samples_whose_corners_meet_the_v_ends(source, k2):
+    """With ``corner_match`` the last h sample's steps to the v samples' end pixels lie in the
+    low tail of the source's positions; without it, anywhere."""
+    from engine.tiles.wang import WangSetup
+
+    setup = WangSetup(source, tile_size=T)
+
+    def tail(ws):
+        e = setup.hv_corner_errors([ws.sample("v", 0), ws.sample("v", 1)])
+        e = e + setup.corner_errors([ws.sample("h", 0)])
+        s = ws.sample("h", 1)
+        return np.mean(e < e[s.origin[0] - setup.reach, s.origin[1]])
+
+    matched = wang_set(source, tile_size=T, rng=5, workers=2, corner_match=True)
+    assert tail(matched) < 0.08 < tail(k2)
+    assert matched.samples[:2] != k2.samples[:2]
+
+
 def test_a_tile_survives_the_projects_candidate_type(k2):
     from engine.tiles.wang import from_candidate
 
