@@ -61,11 +61,12 @@ def pools(monkeypatch):
         {},
         dict(tileable=True),  # wrap-around blocks with bottom / right arms
         dict(adaptive_threshold=0.02),  # split blocks: children searched inside a task
+        dict(mode="fast"),  # principal components + exact re-ranking
     ],
 )
 def test_worker_processes_give_one_threads_records_and_image(options, pools, monkeypatch):
     _jit.load()
-    kw = dict(block=28, overlap=6, rng=3, mode="exact", **options)
+    kw = {"block": 28, "overlap": 6, "rng": 3, "mode": "exact", **options}
     one = quilt(SAMPLE, (150, 170), threads=1, **kw)
     assert not pools
     runs = [quilt(SAMPLE, (150, 170), threads=t, **kw) for t in (2, 3)]
