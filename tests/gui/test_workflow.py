@@ -8,7 +8,7 @@ import numpy as np
 from PySide6.QtCore import Qt
 
 from engine.project import load_project
-from tests.gui.helpers import click_candidate, make_window, open_sample, wait_idle
+from tests.gui.helpers import WAIT_MS, click_candidate, make_window, open_sample, wait_idle
 
 
 def test_tile_set_workflow_open_to_reopen(qtbot, tmp_path):
@@ -42,7 +42,7 @@ def test_tile_set_workflow_open_to_reopen(qtbot, tmp_path):
     assert w.overlap_panel.views["vertical"].frame_shape == s.errors["vertical"].shape
     assert "seam criterion" in w.overlap_panel.labels["horizontal"].text()
     assert w.tile_view.shown_image().shape[:2] == (3 * th, 3 * tw)
-    qtbot.waitUntil(lambda: w.tile_view.metrics is not None, timeout=10_000)
+    qtbot.waitUntil(lambda: w.tile_view.metrics is not None, timeout=WAIT_MS)
     assert "wrap border ratio" in w.tile_view.info.text()
     assert w.tile_view.metrics["wrap"] < 2.0  # naive crops of this sample score far higher
     assert "seam H" in w.criterion_label.text()
@@ -90,7 +90,7 @@ def test_tile_set_workflow_open_to_reopen(qtbot, tmp_path):
     assert w.preview_view.canvas.array is doc.tileset.preview
     assert "grid score" in w.preview_view.info.text() and doc.tileset.grid_score is not None
     # the picked set's interior figures (issue 10), measured in the background, and warnings
-    qtbot.waitUntil(lambda: w.preview_view.quality is not None, timeout=20_000)
+    qtbot.waitUntil(lambda: w.preview_view.quality is not None, timeout=WAIT_MS)
     q = w.preview_view.quality
     assert {"frame", "ring_tone", "duplicates", "lattice", "template_share"} <= set(q)
     assert f"frame {q['frame']:.2f}" in w.preview_view.info.text()
@@ -108,7 +108,7 @@ def test_tile_set_workflow_open_to_reopen(qtbot, tmp_path):
     out = tmp_path / "bundle"
     dlg.folder.setText(str(out))
     dlg.spacing.setValue(2)
-    with qtbot.waitSignal(dlg.exported, timeout=20_000) as sig:
+    with qtbot.waitSignal(dlg.exported, timeout=WAIT_MS) as sig:
         dlg.export_button.click()
     manifest = sig.args[0]
     assert len(manifest["tiles"]) == 5
@@ -123,14 +123,14 @@ def test_tile_set_workflow_open_to_reopen(qtbot, tmp_path):
     # -- save the project, then reopen it in a fresh window
     path = tmp_path / "session.quiltproj"
     w.files.ask_save_path = lambda: str(path)
-    with qtbot.waitSignal(doc.path_changed, timeout=20_000):
+    with qtbot.waitSignal(doc.path_changed, timeout=WAIT_MS):
         w.act_save.trigger()
     assert not doc.modified and not w.isWindowModified()
     saved = load_project(path)
     assert saved.picks == [2, 7, 10, 11, 12] and len(saved.candidates) == 30
 
     w2 = make_window(qtbot)
-    with qtbot.waitSignal(w2.doc.path_changed, timeout=20_000):
+    with qtbot.waitSignal(w2.doc.path_changed, timeout=WAIT_MS):
         w2.files.open_path(str(path), confirm=False)
     wait_idle(qtbot, w2)
     d2 = w2.doc.tileset
