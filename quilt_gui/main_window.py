@@ -38,7 +38,7 @@ from quilt_gui.widgets.gallery import CandidateView
 from quilt_gui.widgets.help import GettingStarted, ShortcutSheet
 from quilt_gui.widgets.library import LibraryView
 from quilt_gui.widgets.overlap_panel import OverlapPanel
-from quilt_gui.widgets.params_panel import QUILT_GROUPS, TILESET_GROUPS, ParamsPanel
+from quilt_gui.widgets.params_panel import QUILT_GROUPS, TILESET_GROUPS, WANG_GROUPS, ParamsPanel
 from quilt_gui.widgets.preview import PreviewView
 from quilt_gui.widgets.quilt_view import QuiltView
 from quilt_gui.widgets.source_view import SourceView
@@ -617,7 +617,9 @@ class MainWindow(QMainWindow):
         save_as = QKeySequence(QKeySequence.StandardKey.SaveAs)  # on the Quilting tab: Save output
         self.act_save_as.setShortcut(QKeySequence() if quilting else save_as)
         self.act_save_output.setShortcut(save_as if quilting else QKeySequence())
-        self.params_panel.show_groups(QUILT_GROUPS if quilting else TILESET_GROUPS)
+        self.params_panel.show_groups(
+            QUILT_GROUPS if quilting else WANG_GROUPS if wang else TILESET_GROUPS
+        )
         for key in ("overlaps", "tile", "gallery"):
             self.docks[key].setVisible(not quilting and not wang)
         self._show_criteria()

@@ -88,6 +88,7 @@ class MaskBrush(QObject):
             return self._press(event)
         if kind == QEvent.Type.MouseMove and self._stroke is not None:
             px = self.canvas.pixel_at(event.position())
+            self.canvas.hovered.emit(px)  # the canvas does not see this move: the status bar
             if px is not None:
                 self._paint(self._last or px, px)
                 self._last = px
@@ -104,6 +105,7 @@ class MaskBrush(QObject):
         px = self.canvas.pixel_at(event.position())
         if px is None:
             return False
+        self.canvas.hovered.emit(px)
         current = self.current_mask()
         self._stroke = np.zeros(self.doc.source.shape, bool) if current is None else current.copy()
         self._value = event.button() != Qt.MouseButton.RightButton

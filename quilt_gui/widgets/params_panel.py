@@ -60,6 +60,9 @@ TILESET_GROUPS = (
     "Exclusion",
     "Heal",
 )
+#: the groups the Wang set uses: its cuts (seams, their options, the material maps' weights) and
+#: the pixels never to use; its own options are on the Wang tab
+WANG_GROUPS = ("Seams", MATERIALS, "Seam options", "Exclusion")
 #: group titles on screen, where they differ from the group's name
 GROUP_TITLES = {"Exclusion": "Pixels never to use", "Heal": "Heal the source"}
 QUILT_GROUPS = ("Quilting", "Exclusion", "Seam options", "Transfer")

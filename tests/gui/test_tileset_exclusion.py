@@ -26,6 +26,20 @@ def footprint(rect, overlap):
     return slice(y, y + h + overlap), slice(x, x + w + overlap)
 
 
+def test_the_status_bar_follows_the_brush_and_keeps_no_stale_pixel(qtbot, win):
+    v = win.source_view
+    v.set_zoom(1.0)
+    v.center_on_pixel(256, 256)
+    a = v.view_pos_of_pixel(220, 200).toPoint()
+    b = v.view_pos_of_pixel(240, 300).toPoint()
+    (ra, ca), (rb, cb) = v.pixel_at(QPointF(a)), v.pixel_at(QPointF(b))
+    qtbot.mouseMove(v.viewport(), a)
+    assert win.pixel_label.text().startswith(f"x {ca}, y {ra} =")
+    drag(qtbot, v, a, b, modifier=Qt.KeyboardModifier.ShiftModifier)
+    assert win.doc.exclude_painted[rb, cb]
+    assert win.pixel_label.text().startswith(f"x {cb}, y {rb} =")  # where the brush is, not was
+
+
 def test_shift_drag_on_the_source_paints_one_undoable_exclusion(qtbot, win):
     v = win.source_view
     assert win.params_panel.groups["Exclusion"].isVisible()  # shown in the tile-set mode

@@ -9,10 +9,10 @@ import numpy as np
 from PySide6.QtCore import QPoint, Qt
 
 from engine.tiles.wang_layout import layout_mismatches
-from tests.gui.helpers import make_window, open_sample
+from tests.gui.helpers import WAIT_MS, make_window, open_sample
 
 
-def wait_wang(qtbot, win, timeout=30_000):
+def wait_wang(qtbot, win, timeout=WAIT_MS):
     qtbot.waitUntil(lambda: not win.jobs.busy(), timeout=timeout)
 
 
@@ -119,3 +119,15 @@ def test_reroll_a_sample_save_reopen_and_export(qtbot, tmp_path):
     man = json.loads((tmp_path / "bundle" / f"{name}.json").read_text())
     assert man["wang"]["colours"] == 2 and len(man["tiles"]) == 16
     assert "<wangset" in (tmp_path / "bundle" / f"{name}.tsx").read_text()
+
+
+def test_the_wang_tab_shows_only_the_parameters_the_wang_set_uses(qtbot):
+    win = make_window(qtbot)
+    groups = win.params_panel.groups
+    somol = ("Tile", "Candidates", "Preview", "Heal")  # the Somol set's: no say in a Wang set
+    assert all(groups[g].isVisible() for g in somol)  # the tile-set tabs
+    win.tabs.setCurrentWidget(win.wang_view)
+    assert not any(groups[g].isVisible() for g in somol)
+    assert groups["Seams"].isVisible() and groups["Exclusion"].isVisible()  # its cuts use them
+    win.tabs.setCurrentWidget(win.source_view)
+    assert all(groups[g].isVisible() for g in somol)
