@@ -312,6 +312,16 @@ _CLI_HINTS = (
 )
 
 
+#: the engine's advice naming options the editor has no control for (the command line's
+#: --min-distance) -> what to do in the editor
+_ENGINE_ONLY = (
+    (
+        re.compile(r"a larger source, smaller tiles or a smaller minimum distance give more"),
+        f"a larger source or a smaller “{BY_KEY['tile_size'].label}” gives more",
+    ),
+)
+
+
 def sentence(note: str) -> str:
     """An engine note (lower case: it also ends up inside other sentences) as a sentence."""
     return note[:1].upper() + note[1:]
@@ -319,8 +329,9 @@ def sentence(note: str) -> str:
 
 def editor_words(text: str) -> str:
     """``text`` (an engine note) without the command line's flags where the note also names
-    the editor's control, so the banner speaks of what is on screen."""
-    for pattern, repl in _CLI_HINTS:
+    the editor's control, and without advice the editor has no control for, so the banner
+    speaks of what is on screen."""
+    for pattern, repl in (*_CLI_HINTS, *_ENGINE_ONLY):
         text = pattern.sub(repl, text)
     return text
 

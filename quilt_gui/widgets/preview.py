@@ -17,19 +17,64 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from quilt_gui import jobs, settings
+from quilt_gui import jobs, params, settings
 from quilt_gui.document import Document
 from quilt_gui.widgets.canvas import ImageCanvas, cosmetic_pen
 
 WARN_STYLE = "color: #e8a33d;"  # the warnings' colour (readable on the light and dark themes)
 
 
+#: where the controls the advice names are (the Advanced view shows every parameter)
+_WHERE = {
+    "flatten": "Parameters ▸ Advanced ▸ Tile",
+    "patch_overlap": "Parameters ▸ Advanced ▸ Candidates",
+}
+
+
+def _control(key: str) -> str:
+    """A parameter's label as on screen, and where it is when the Basic view hides it."""
+    where = f" ({_WHERE[key]})" if key in _WHERE else ""
+    return f"“{params.BY_KEY[key].label}”{where}"
+
+
+def editor_advice(flattened: bool) -> dict[str, str]:
+    """What exceeding each of issue 10's limits means and what to try, in the editor's words
+    (the controls it has: the engine's advice also names the command line's patch search and
+    minimum distance); Flatten lighting is suggested only while it is off, else said to be on."""
+    ring, size = _control("patch_overlap"), _control("tile_size")
+    if flattened:
+        tone = " although Flatten lighting is on"
+        frame_try, ring_try = f"a narrower {ring}", "another tile position"
+    else:
+        tone, flatten = "", f"“{params.BY_KEY['flatten'].label}”: On ({_WHERE['flatten']})"
+        frame_try = f"{flatten} or a narrower {ring}"
+        ring_try = f"{flatten} or another tile position"
+    return {
+        "frame": f"the tiles show a frame (frame {{v:.2f}} > {{lim}}){tone}: try {frame_try}",
+        "ring_tone": "the shared ring differs in tone from the patches (ring tone {v:.2f} > "
+        f"{{lim}}){tone}: try {ring_try}",
+        "duplicates": "{v} candidate(s) repeat the template or each other: use a larger source, "
+        f"a smaller {size} or fewer candidates ({_control('n_candidates')})",
+        "lattice": "a layout shows a lattice at the tile period ({v:+.1f} dB above the floor of "
+        f"a shared border): structured textures may need a narrower {ring}, a larger {size} "
+        "or a Wang set (the Wang tiles tab)",
+    }
+
+
+def editor_warnings(q: dict, flattened: bool) -> list[str]:
+    """:func:`engine.metrics.quality_warnings` of the figures ``q`` in the editor's words."""
+    from engine.metrics import QUALITY_LIMITS
+
+    advice = editor_advice(flattened)
+    return [advice[k].format(v=q[k], lim=lim) for k, lim in QUALITY_LIMITS.items() if q[k] > lim]
+
+
 def set_quality(tiles, source, template, settings, *, cancel=None) -> dict:
-    """:func:`engine.metrics.tileset_quality` of the picked tiles and its ``warnings`` in words
-    (worker thread); ``settings`` are the resolved TilesetSettings (ring w_P, margin, and
-    flatten: tiles of a flattened source are compared with it). ``{"error": text}`` when the
-    source has nothing to measure (flat)."""
-    from engine.metrics import quality_warnings, tileset_quality
+    """:func:`engine.metrics.tileset_quality` of the picked tiles and its ``warnings`` in the
+    editor's words (worker thread); ``settings`` are the resolved TilesetSettings (ring w_P,
+    margin, and flatten: tiles of a flattened source are compared with it, and the warnings
+    know it is on). ``{"error": text}`` when the source has nothing to measure (flat)."""
+    from engine.metrics import tileset_quality
     from engine.tiles.pipeline import working_source
 
     source = working_source(source, settings)
@@ -38,7 +83,7 @@ def set_quality(tiles, source, template, settings, *, cancel=None) -> dict:
         q = tileset_quality(tiles, source, template=template, ring=ring, margin=margin)
     except ValueError as exc:
         return {"error": str(exc)}
-    q["warnings"] = quality_warnings(q)
+    q["warnings"] = editor_warnings(q, bool(settings.flatten))
     return q
 
 
