@@ -88,6 +88,14 @@ def share(a: np.ndarray) -> np.ndarray:
     return out
 
 
+def _shared(n: int, dtype) -> np.ndarray:
+    """``n`` zeros in anonymous shared memory of their own. Not multiprocessing's RawArray: its
+    heap hands a freed block to the next array, and a worker of a finished pool that had not
+    yet seen its stop flag then read the next pool's memory as its own (a test failed once:
+    the next pool's message counts overwritten)."""
+    return np.frombuffer(mmap.mmap(-1, max(1, n * np.dtype(dtype).itemsize)), dtype, n)
+
+
 class WorkerPool:
     """Runs every task once, each as soon as the tasks it ``needs`` have run, in this process
     and ``workers - 1`` forked ones; :meth:`result` returns one task's result (``run(task)``'s,
@@ -116,9 +124,9 @@ class WorkerPool:
             for j in p:
                 self.dependents[j].append(k)
         self.lock, self.ready = ctx.Lock(), ctx.Semaphore(0)
-        self.waiting = np.frombuffer(ctx.RawArray("i", max(1, n)), np.int32)[:n]
+        self.waiting = _shared(n, np.int32)
         self.waiting[:] = [sum(j >= done for j in p) for p in needs]
-        self.state = np.frombuffer(ctx.RawArray("b", max(1, n) + 1), np.int8)  # last: stop
+        self.state = _shared(n + 1, np.int8)  # last: stop
         self.state[:done] = TAKEN
         first = [k for k in range(done, n) if not self.waiting[k]]
         self.state[first] = READY
@@ -291,7 +299,7 @@ class _Mailbox:
 
     def __init__(self, ctx, conn):
         self.ring = np.frombuffer(mmap.mmap(-1, RING_BYTES), np.uint8)
-        self.counts = np.frombuffer(ctx.RawArray("q", 3), np.int64)  # written, read, piped
+        self.counts = _shared(3, np.int64)  # written, read, piped
         self.lock = ctx.Lock()
         self.conn = conn
         self.read, self.piped = 0, 0  # the caller's own counts
