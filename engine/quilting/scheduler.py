@@ -27,7 +27,7 @@ from engine.quilting.block_rng import BlockRng
 from engine.quilting.core import BlockWork, Quilter
 from engine.quilting.records import BlockPlaced, BlockRecord
 
-__all__ = ["POOL_MIN_SAMPLE_AREA", "dependencies", "run_levels", "uses_processes"]
+__all__ = ["POOL_MIN_SAMPLE_AREA", "PROCESS_BATCH", "dependencies", "run_levels", "uses_processes"]
 
 
 def dependencies(rects, shape, torus: bool):
@@ -94,6 +94,15 @@ with 3, 1.83x with 4, 1.65x with 6). Job B on one thread, measured in session 6 
 blocks one by one 1.15x faster than batches of 3 searched together; on two threads batches of 3
 searched block by block 1.05x faster than searched together."""
 
+PROCESS_BATCH = 2
+"""Blocks per task in worker processes (:func:`uses_processes`; each block searched alone, so
+the same records as one thread's one block per task). Job B exact, 2 workers, 12 interleaved
+rounds under load 10-11 (other engineers' runs at nice 15, this at nice -10): 1 block a task
+0.399 s, 2 blocks 0.341 s, 3 blocks 0.346 s, 4 blocks 0.349 s (one thread 0.572 s): a task's
+bookkeeping (taking it, releasing its dependents, its message) costs each process ~70 us, and
+a process that places two neighbours in a row finds the canvas between them in its cache;
+larger tasks lengthen the chain of levels."""
+
 BATCH_ONE_THREAD = 8
 """Batch size below :data:`POOL_MIN_SAMPLE_AREA` (one thread whatever ``threads`` says): fewer,
 larger FFT calls (job A: ~5 % faster than batches of 4; the same result)."""
@@ -103,8 +112,9 @@ def run_levels(q: Quilter, rects, total_label: str):
     """Place ``rects`` (top-level blocks, raster order); yields events, returns the records.
 
     Blocks go in level order (level, then raster index), in fixed batches of consecutive blocks
-    of one level (:data:`BATCH`, one on one thread; :data:`BATCH_ONE_THREAD` on small samples,
-    one on large ones; where the batches depend on the threads, each block is searched alone). A
+    of one level (:data:`BATCH`, one on one thread, :data:`PROCESS_BATCH` in worker processes;
+    :data:`BATCH_ONE_THREAD` on small samples, one on large ones; where the batches depend on
+    the threads, each block is searched alone). A
     batch is loaded (the canvas under it read), searched and placed as one task as soon as its
     blocks' predecessors are placed; with ``threads > 1`` the tasks run on a pool (FFTs and numba
     kernels release the GIL), and blocks of one level are placed side by side (their footprints
@@ -123,8 +133,10 @@ def run_levels(q: Quilter, rects, total_label: str):
         # each block's search a query of its own: ducc0's batched transforms differ in the last
         # bits with the batch, so only then may the batches depend on the threads
         q.alone = True
-        if q.threads == 1 or processes:
+        if q.threads == 1:
             size = 1
+        elif processes:
+            size = PROCESS_BATCH
     if area > BATCH_MAX_SAMPLE_AREA:
         size = 1
     batches: list[list[int]] = []
