@@ -311,6 +311,7 @@ class MainWindow(QMainWindow):
         lay.setContentsMargins(0, 0, 0, 0)
         lay.addWidget(self.tabs, 1)
         self.message_bar = MessageBar(central)  # floats over the canvas, outside the layout
+        self.message_bar.covered.connect(self.wang_view.keep_clear_of)  # but not the Wang tab's
         self.setCentralWidget(central)
         self.params_panel = ParamsPanel(
             doc,

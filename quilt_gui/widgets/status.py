@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import time
 
-from PySide6.QtCore import QEvent, Qt, QTimer, Slot
+from PySide6.QtCore import QEvent, Qt, QTimer, Signal, Slot
 from PySide6.QtWidgets import (
     QHBoxLayout,
     QLabel,
@@ -32,6 +32,9 @@ class MessageBar(QWidget):
     mouse when it comes and goes."""
 
     MARGIN = 8
+    #: the height the banner covers at the bottom of its parent (0: hidden), for a view that
+    #: must not be covered (the Wang tab's layout ends above it)
+    covered = Signal(int)
 
     def __init__(self, parent=None) -> None:
         super().__init__(parent)
@@ -100,6 +103,7 @@ class MessageBar(QWidget):
             height = self.sizeHint().height()
         self.setGeometry(m, max(0, parent.height() - height - m), width, height)
         self.raise_()
+        self.covered.emit(height + 2 * m)
 
     def eventFilter(self, obj, event) -> bool:  # noqa: N802 - Qt API
         if obj is self.parentWidget() and event.type() == QEvent.Type.Resize and self.isVisible():
@@ -114,6 +118,7 @@ class MessageBar(QWidget):
     def dismiss(self) -> None:
         self._timer.stop()
         self.hide()
+        self.covered.emit(0)
 
 
 #: Jobs that run beside a long one without taking the status bar from it.

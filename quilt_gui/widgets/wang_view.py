@@ -173,6 +173,12 @@ class WangView(QWidget):
         self.sample_dropped.connect(runner.move_sample)
         self._on_source_changed()
 
+    @Slot(int)
+    def keep_clear_of(self, height: int) -> None:
+        """End the canvases ``height`` px above the bottom (the window's banner floats there:
+        it must not cover the layout's last rows); 0 when it is gone."""
+        self.layout().setContentsMargins(0, 0, 0, max(0, int(height)))
+
     # ------------------------------------------------------------------ construction
     @staticmethod
     def _titled(title: str, canvas: ImageCanvas) -> QWidget:

@@ -131,3 +131,20 @@ def test_the_wang_tab_shows_only_the_parameters_the_wang_set_uses(qtbot):
     assert groups["Seams"].isVisible() and groups["Exclusion"].isVisible()  # its cuts use them
     win.tabs.setCurrentWidget(win.source_view)
     assert all(groups[g].isVisible() for g in somol)
+
+
+def test_the_banner_does_not_cover_the_wang_layout(qtbot):
+    win = make_window(qtbot)
+    win.tabs.setCurrentWidget(win.wang_view)
+    preview, bar = win.wang_view.preview, win.message_bar
+    central = bar.parentWidget()
+
+    def bottom() -> int:  # below the layout canvas's last row, in the banner's parent
+        return preview.mapTo(central, QPoint(0, preview.height())).y()
+
+    win.show_message("warning", "Wang set: the texture repeats about every 48 px. " * 6)
+    assert bar.isVisible() and bar.label.text().count("48 px") == 6
+    top = bar.geometry().top()
+    qtbot.waitUntil(lambda: bottom() <= top, timeout=WAIT_MS)
+    bar.dismiss()  # gone: the canvases take the room back
+    qtbot.waitUntil(lambda: bottom() > top, timeout=WAIT_MS)
