@@ -177,6 +177,7 @@ class ParamsPanel(QWidget):
         self._quilting = "Quilting" in groups
         self._apply_view()
         self._enable_seam_options()
+        self._on_tone_changed()
 
     def set_view(self, view: str) -> None:
         """Basic (the parameters most photos need) or Advanced (every parameter)."""
@@ -244,8 +245,9 @@ class ParamsPanel(QWidget):
     @Slot()
     def _on_tone_changed(self) -> None:
         """Under Seam blending: the blend Flatten lighting's Auto uses for this photo instead of
-        the one chosen (the box keeps the choice, which applies again with Flatten lighting Off)."""
-        blend = self.doc.tileset.auto_blend
+        the one chosen (the box keeps the choice, which applies again with Flatten lighting Off);
+        not for a Wang set (Auto tone leaves it alone: the choice applies)."""
+        blend = self.doc.tileset.auto_blend if "Tile" in self._shown else None
         if blend is not None:
             name = params.BY_KEY["blend"].choice_label(blend)
             self.tone_hint.setText(

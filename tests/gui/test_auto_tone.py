@@ -3,14 +3,14 @@
 from PIL import Image
 
 from benchmarks.evalset import bricks
-from tests.gui.helpers import make_window, wait_idle
+from tests.gui.helpers import WAIT_MS, make_window, wait_idle
 
 
 def test_uneven_lighting_is_flattened_said_on_the_banner_and_can_be_switched_off(qtbot, tmp_path):
     path = tmp_path / "bricks.png"
     Image.fromarray(bricks(256, seed=3)).save(path)  # a lighting gradient of ±22 %
     w = make_window(qtbot)
-    with qtbot.waitSignal(w.doc.source_changed, timeout=5000):
+    with qtbot.waitSignal(w.doc.source_changed, timeout=WAIT_MS):
         w.files.open_path(str(path), confirm=False)
     w.doc.set_params({"tile_size": "64"})
     s = w.pipeline.settings()
@@ -24,6 +24,10 @@ def test_uneven_lighting_is_flattened_said_on_the_banner_and_can_be_switched_off
     panel, hint = w.params_panel, w.params_panel.tone_hint
     assert panel.value("blend") == "adaptive"  # the choice is kept; the hint says what Auto uses
     assert hint.isVisibleTo(panel) and "Gradient domain" in hint.text()
+    w.tabs.setCurrentWidget(w.wang_view)  # Auto tone leaves a Wang set alone: no hint there
+    assert not hint.isVisibleTo(panel)
+    w.tabs.setCurrentWidget(w.source_view)
+    assert hint.isVisibleTo(panel)
     w.doc.set_params({"flatten": "off"})
     s = w.pipeline.settings()
     assert s.flatten is False and s.seam.blend == "adaptive"
