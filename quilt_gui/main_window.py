@@ -702,7 +702,10 @@ class MainWindow(QMainWindow):
     @Slot()
     def _show_criteria(self) -> None:
         """The seam criterion of what is in front: the template's seams, or the inspected
-        quilting block's cut in the Quilting tab."""
+        quilting block's cut in the Quilting tab; none in the Wang tab (no template there)."""
+        if self.tabs.currentWidget() is self.wang_view:
+            self.criterion_label.setText("")
+            return
         if self.tabs.currentWidget() is self.quilt_view:
             rec = self.quilt_view.selected_block()
             has_cut = rec is not None and len(rec.path)

@@ -153,6 +153,7 @@ def main() -> int:
     wv.select_sample("h", 1)
     wv.grid_box.setChecked(True)
     w.message_bar.dismiss()
+    w.statusBar().clearMessage()  # the quilting's message is not the Wang tab's
     wv.tiles.fit()
     wv.preview.fit()
     shot(w, "wang.png")

@@ -123,14 +123,19 @@ def test_reroll_a_sample_save_reopen_and_export(qtbot, tmp_path):
 
 def test_the_wang_tab_shows_only_the_parameters_the_wang_set_uses(qtbot):
     win = make_window(qtbot)
+    open_sample(qtbot, win)
+    win.doc.tileset.set_template_rect((150, 120, 128, 112))
+    qtbot.waitUntil(lambda: "seam H" in win.criterion_label.text(), timeout=WAIT_MS)
     groups = win.params_panel.groups
     somol = ("Tile", "Candidates", "Preview", "Heal")  # the Somol set's: no say in a Wang set
     assert all(groups[g].isVisible() for g in somol)  # the tile-set tabs
     win.tabs.setCurrentWidget(win.wang_view)
     assert not any(groups[g].isVisible() for g in somol)
     assert groups["Seams"].isVisible() and groups["Exclusion"].isVisible()  # its cuts use them
+    assert win.criterion_label.text() == ""  # the template's seams are not the Wang set's
     win.tabs.setCurrentWidget(win.source_view)
     assert all(groups[g].isVisible() for g in somol)
+    assert "seam H" in win.criterion_label.text()
 
 
 def test_the_banner_does_not_cover_the_wang_layout(qtbot):
