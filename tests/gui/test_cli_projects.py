@@ -9,7 +9,7 @@ import numpy as np
 from engine.cli import main as cli_main
 from engine.project import load_project
 from resources import sample_path
-from tests.gui.helpers import generate, make_window, open_sample, wait_idle
+from tests.gui.helpers import WAIT_MS, generate, make_window, open_sample, wait_idle
 
 
 def test_cli_project_opens_in_the_editor(qtbot, tmp_path):
@@ -37,7 +37,7 @@ def test_cli_project_opens_in_the_editor(qtbot, tmp_path):
     assert rc == 0 and proj.is_file()
     cli = load_project(proj)
     w = make_window(qtbot)
-    with qtbot.waitSignal(w.doc.path_changed, timeout=20_000):
+    with qtbot.waitSignal(w.doc.path_changed, timeout=WAIT_MS):
         w.files.open_path(str(proj), confirm=False)
     wait_idle(qtbot, w)
     d = w.doc.tileset

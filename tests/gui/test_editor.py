@@ -13,7 +13,7 @@ from quilt_gui import settings
 from quilt_gui.imaging import to_uint8
 from quilt_gui.widgets.canvas import ImageCanvas
 from quilt_gui.widgets.gallery import CandidateModel
-from tests.gui.helpers import drop, make_window, open_sample, template, wait_idle
+from tests.gui.helpers import WAIT_MS, drop, make_window, open_sample, template, wait_idle
 
 
 @pytest.fixture
@@ -81,9 +81,9 @@ def test_a_view_fitted_while_hidden_fits_when_shown_and_on_resize(qtbot):
         r = hidden.mapFromScene(hidden.image_rect()).boundingRect()
         return hidden.viewport().rect().contains(r)
 
-    qtbot.waitUntil(whole_image_visible, timeout=2000)
+    qtbot.waitUntil(whole_image_visible, timeout=WAIT_MS)
     tabs.resize(500, 250)  # smaller: still fitted
-    qtbot.waitUntil(whole_image_visible, timeout=2000)
+    qtbot.waitUntil(whole_image_visible, timeout=WAIT_MS)
     hidden.set_zoom(2.0)  # the user's zoom sticks
     tabs.resize(520, 300)
     qtbot.wait(50)
@@ -250,7 +250,7 @@ def test_changing_a_parameter_supersedes_and_no_stale_result_is_drawn(qtbot, win
     superseded = []
     for method in ("oscillating", "dp", "oscillating-optimal", "oscillating"):
         with qtbot.waitSignal(
-            win.jobs.started, timeout=5000, check_params_cb=lambda j: j.key == "seamless"
+            win.jobs.started, timeout=WAIT_MS, check_params_cb=lambda j: j.key == "seamless"
         ) as sig:
             win.doc.set_param("method", method)
         old = sig.args[0]
@@ -260,7 +260,7 @@ def test_changing_a_parameter_supersedes_and_no_stale_result_is_drawn(qtbot, win
     win.doc.set_param("method", "dp")
     win.doc.set_param("rho", 5)
     wait_idle(qtbot, win)
-    qtbot.waitUntil(lambda: all(j.state == "aborted" for j in superseded), timeout=5000)
+    qtbot.waitUntil(lambda: all(j.state == "aborted" for j in superseded), timeout=WAIT_MS)
     assert applied and all(m is None or m == cur for m, cur in applied)
     assert all(m == cur for m, cur in live)
     assert win.doc.tileset.seamless.seam.method == "dp" and win.doc.tileset.seamless.seam.rho == 5
@@ -323,7 +323,7 @@ def test_corrupt_file_dropped_shows_message_and_keeps_editor_usable(qtbot, win, 
     bad.write_bytes(b"\x89PNG\r\n\x1a\n" + b"garbage" * 50)
     source = win.doc.source
     drop(win, bad)
-    qtbot.waitUntil(lambda: win.last_message("error") != "", timeout=5000)
+    qtbot.waitUntil(lambda: win.last_message("error") != "", timeout=WAIT_MS)
     text = win.last_message("error")
     assert "broken.png" in text and ("corrupt" in text or "not an image" in text)
     assert win.message_bar.isVisible() and win.message_bar.level == "error"
@@ -337,7 +337,7 @@ def test_drop_opens_an_image_and_remembers_it(qtbot, win, tmp_path):
     good = tmp_path / "small texture.png"
     pixels = np.random.default_rng(1).integers(0, 256, (90, 120, 3), dtype=np.uint8)
     Image.fromarray(pixels).save(good)
-    with qtbot.waitSignal(win.doc.source_changed, timeout=5000):
+    with qtbot.waitSignal(win.doc.source_changed, timeout=WAIT_MS):
         drop(win, good)
     assert win.doc.source.shape == (90, 120) and win.doc.name == "small_texture"
     assert settings.get("recent_files")[0] == str(good.resolve())
@@ -363,7 +363,7 @@ def test_opened_message_names_the_colour_model_in_words(qtbot, win, tmp_path, mo
     else:
         im = im.convert(mode)
     im.save(path)
-    with qtbot.waitSignal(win.doc.source_changed, timeout=5000):
+    with qtbot.waitSignal(win.doc.source_changed, timeout=WAIT_MS):
         win.files.open_path(str(path), confirm=False)
     assert f"50×40, {shown}." in win.last_message()
 
@@ -379,7 +379,7 @@ def test_files_dropped_on_any_image_view_reach_the_window(win):
 def test_image_too_small_for_the_tile(qtbot, win, tmp_path):
     tiny = tmp_path / "tiny.png"
     Image.fromarray(np.zeros((24, 24, 3), np.uint8) + 100).save(tiny)
-    with qtbot.waitSignal(win.doc.source_changed, timeout=5000):
+    with qtbot.waitSignal(win.doc.source_changed, timeout=WAIT_MS):
         win.files.open_path(str(tiny), confirm=False)
     win.doc.set_params({"tile_size": "any", "tile_min": 64, "tile_max": 64})
     win.act_find.trigger()
@@ -417,7 +417,7 @@ def test_unwritable_folder_for_export_and_save(qtbot, win, tmp_path):
     assert "The project was not saved" in win.last_message("error")
     assert win.doc.modified  # still unsaved, nothing lost
     dlg.folder.setText(str(tmp_path / "ok"))
-    with qtbot.waitSignal(dlg.exported, timeout=10_000):
+    with qtbot.waitSignal(dlg.exported, timeout=WAIT_MS):
         dlg.export()
     # again into the same folder: the dialog names its own check box, not an API keyword
     assert dlg.export() is None
@@ -427,7 +427,7 @@ def test_unwritable_folder_for_export_and_save(qtbot, win, tmp_path):
     assert dlg.export() is None and "is a file, not a folder" in dlg.status.text()
     dlg.overwrite.setChecked(True)
     dlg.folder.setText(str(tmp_path / "ok"))
-    with qtbot.waitSignal(dlg.exported, timeout=10_000):
+    with qtbot.waitSignal(dlg.exported, timeout=WAIT_MS):
         dlg.export()
 
 
@@ -437,7 +437,7 @@ def test_close_while_jobs_run_does_not_hang(qtbot, win):
     win.doc.set_param("n_candidates", 500)
     win.act_generate.trigger()
     win.doc.set_param("method", "oscillating")
-    qtbot.waitUntil(lambda: len(win.doc.tileset.candidates) > 0, timeout=10_000)
+    qtbot.waitUntil(lambda: len(win.doc.tileset.candidates) > 0, timeout=WAIT_MS)
     assert win.jobs.running()
     assert win.close()  # returns once every job stopped (500 candidates would take minutes)
     assert not win.isVisible()

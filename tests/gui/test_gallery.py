@@ -7,7 +7,7 @@ from PySide6.QtCore import QEvent, QPointF, Qt
 from PySide6.QtGui import QMouseEvent
 
 from engine.tiles.candidates import candidate_seed
-from tests.gui.helpers import generate, make_window, open_sample, wait_idle
+from tests.gui.helpers import WAIT_MS, generate, make_window, open_sample, wait_idle
 
 
 def _mouse(view, kind, row) -> None:
@@ -66,7 +66,7 @@ def test_candidates_are_numbered_by_their_seed_and_a_stop_says_so(qtbot):
     ]
     w.doc.set_param("n_candidates", 400)
     w.act_generate.trigger()
-    qtbot.waitUntil(lambda: len(w.doc.tileset.candidates) >= 4, timeout=20_000)
+    qtbot.waitUntil(lambda: len(w.doc.tileset.candidates) >= 4, timeout=WAIT_MS)
     w.act_cancel.trigger()
     wait_idle(qtbot, w)
     n = len(w.doc.tileset.candidates)
@@ -100,7 +100,7 @@ def test_candidate_dialog_shows_seam_on_tile_and_patch_source_and_keeps_it_in_pr
     dlg.close()
     path = str(tmp_path / "p.quiltproj")
     assert w.files.save_to(path, wait=True)
-    with qtbot.waitSignal(w.doc.path_changed, timeout=10_000):
+    with qtbot.waitSignal(w.doc.path_changed, timeout=WAIT_MS):
         w.files.open_path(path, confirm=False)
     wait_idle(qtbot, w)
     back = w.doc.tileset.candidates[1]
@@ -137,7 +137,7 @@ def test_fewer_candidates_than_asked_says_why_on_the_banner(qtbot, tmp_path):
     path = tmp_path / "small.png"
     Image.fromarray(small).save(path)
     w = make_window(qtbot)
-    with qtbot.waitSignal(w.doc.source_changed, timeout=10_000):
+    with qtbot.waitSignal(w.doc.source_changed, timeout=WAIT_MS):
         w.files.open_path(str(path), confirm=False)
     wait_idle(qtbot, w)
     template_rect = (20, 24, 96, 96)

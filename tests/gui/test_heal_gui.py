@@ -8,7 +8,7 @@ from PIL import Image
 from PySide6.QtCore import Qt
 
 from tests.engine.helpers import smooth_texture
-from tests.gui.helpers import drag, make_window, wait_idle
+from tests.gui.helpers import WAIT_MS, drag, make_window, wait_idle
 
 LOGO = (1.0, 0.0, 1.0)  # magenta: found nowhere in the texture
 
@@ -23,7 +23,7 @@ def test_paint_heal_undo_and_the_healed_source_feeds_the_template_search(qtbot, 
     path = tmp_path / "logo.png"
     Image.fromarray((tex * 255 + 0.5).astype(np.uint8)).save(path)
     w = make_window(qtbot)
-    with qtbot.waitSignal(w.doc.source_changed, timeout=10_000):
+    with qtbot.waitSignal(w.doc.source_changed, timeout=WAIT_MS):
         w.files.open_path(str(path), confirm=False)
     wait_idle(qtbot, w)
     doc, v = w.doc, w.source_view

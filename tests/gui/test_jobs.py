@@ -10,6 +10,7 @@ import pytest
 from engine.cancel import check
 from engine.events import Item, Progress, Snapshot
 from quilt_gui import jobs
+from tests.gui.helpers import WAIT_MS
 
 
 @dataclass(frozen=True)
@@ -70,7 +71,7 @@ def test_items_all_arrive_and_snapshots_are_coalesced(qtbot):
     seen = []
     done = []
     job = jobs.start("t", stream, 20_000, 50, on_event=seen.append, on_done=done.append)
-    qtbot.waitUntil(lambda: bool(done), timeout=20_000)
+    qtbot.waitUntil(lambda: bool(done), timeout=WAIT_MS)
     assert done == ["done"]
     items = [e.value for e in seen if isinstance(e, Thing)]
     assert items == list(range(50))
@@ -85,13 +86,15 @@ def test_supersede_drops_stale_results(qtbot):
     old = jobs.start(
         "k", stream, 10**9, 0, delay=0.0005, on_event=first.append, on_done=first.append
     )
-    qtbot.waitUntil(lambda: len(first) > 0, timeout=5000)
+    qtbot.waitUntil(lambda: len(first) > 0, timeout=WAIT_MS)
     new = jobs.start("k", stream, 5, 1, on_event=second.append, on_done=second.append)
     n_first = len(first)
     assert not old.alive and new.alive
-    with qtbot.waitSignal(jobs.manager().ended, timeout=5000, check_params_cb=lambda j: j is new):
+    with qtbot.waitSignal(
+        jobs.manager().ended, timeout=WAIT_MS, check_params_cb=lambda j: j is new
+    ):
         pass
-    qtbot.waitUntil(lambda: old.state != "running", timeout=5000)
+    qtbot.waitUntil(lambda: old.state != "running", timeout=WAIT_MS)
     assert len(first) == n_first  # nothing of the superseded job arrived after the switch
     assert second[-1] == "done"
     assert old.state == "aborted"
@@ -100,9 +103,9 @@ def test_supersede_drops_stale_results(qtbot):
 def test_stop_returns_best_of_anytime_job(qtbot):
     got, seen = [], []
     job = jobs.start("any", anytime, on_event=seen.append, on_done=got.append)
-    qtbot.waitUntil(lambda: bool(seen), timeout=5000)
+    qtbot.waitUntil(lambda: bool(seen), timeout=WAIT_MS)
     job.stop()  # the latency is measured by benchmarks/gui_responsiveness.py, not here
-    qtbot.waitUntil(lambda: bool(got), timeout=10_000)
+    qtbot.waitUntil(lambda: bool(got), timeout=WAIT_MS)
     assert got[0] >= 1
 
 
@@ -111,9 +114,9 @@ def test_cancel_reports_cancelled(qtbot):
     benchmarks/gui_responsiveness.py on a quiet machine)."""
     cancelled = []
     job = jobs.start("c", stream, 10**9, 0, delay=0.001, on_cancel=lambda: cancelled.append(1))
-    qtbot.waitUntil(lambda: job.progress is not None, timeout=5000)
+    qtbot.waitUntil(lambda: job.progress is not None, timeout=WAIT_MS)
     job.stop()
-    qtbot.waitUntil(lambda: bool(cancelled), timeout=10_000)
+    qtbot.waitUntil(lambda: bool(cancelled), timeout=WAIT_MS)
     assert job.state == "cancelled"
 
 
@@ -126,14 +129,14 @@ def boom(kind, *, cancel=None):
 def test_errors_reach_on_error(qtbot, kind):
     errs = []
     jobs.start("e", boom, kind, on_error=errs.append)
-    qtbot.waitUntil(lambda: bool(errs), timeout=5000)
+    qtbot.waitUntil(lambda: bool(errs), timeout=WAIT_MS)
     assert "bad value" in str(errs[0])
 
 
 def test_plain_function_result(qtbot):
     got = []
     jobs.start("f", lambda x, cancel=None: x * 2, 21, on_done=got.append)
-    qtbot.waitUntil(lambda: bool(got), timeout=5000)
+    qtbot.waitUntil(lambda: bool(got), timeout=WAIT_MS)
     assert got == [42]
 
 

@@ -10,7 +10,7 @@ from engine.batch.library import read_library
 from engine.batch.task import run_photo
 from quilt_gui.widgets.library import HEADERS
 from tests.engine.batch_helpers import SMALL, write_bad_photos, write_photos
-from tests.gui.helpers import make_window, wait_idle
+from tests.gui.helpers import WAIT_MS, make_window, wait_idle
 
 
 @pytest.fixture(scope="module")
@@ -27,7 +27,7 @@ def library(tmp_path_factory):
 
 def open_library(qtbot, window, lib):
     window.files.ask_library_path = lambda: str(lib)
-    with qtbot.waitSignal(window.library_view.model.modelReset, timeout=20_000):
+    with qtbot.waitSignal(window.library_view.model.modelReset, timeout=WAIT_MS):
         window.act_open_library.trigger()
     return window.library_view
 
@@ -79,7 +79,7 @@ def test_double_click_opens_the_project_and_next_the_following(qtbot, library):
 def test_a_library_project_opens_in_the_editor(qtbot, library):
     window = make_window(qtbot)
     view = open_library(qtbot, window, library)
-    with qtbot.waitSignal(window.doc.source_changed, timeout=20_000):
+    with qtbot.waitSignal(window.doc.source_changed, timeout=WAIT_MS):
         view.open_row(1)
     wait_idle(qtbot, window)
     assert len(window.doc.tileset.candidates) == 3

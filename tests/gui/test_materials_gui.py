@@ -8,7 +8,7 @@ from PySide6.QtCore import Qt
 
 from engine.materials import decode_normals
 from quilt_gui import settings
-from tests.gui.helpers import generate, make_window, open_sample, wait_idle
+from tests.gui.helpers import WAIT_MS, generate, make_window, open_sample, wait_idle
 
 
 def normal_map_of(gray: np.ndarray) -> np.ndarray:
@@ -25,7 +25,7 @@ def test_attached_normal_map_follows_every_cut_and_exports(qtbot, tmp_path):
     src = w.doc.source.main
     path = tmp_path / "cobbles_normal.png"
     Image.fromarray(normal_map_of(src.mean(axis=2))).save(path)
-    with qtbot.waitSignal(w.doc.maps_changed, timeout=5000):
+    with qtbot.waitSignal(w.doc.maps_changed, timeout=WAIT_MS):
         w.files.attach_map(str(path))
     assert list(w.doc.source.maps) == ["albedo", "normal"]
     assert w.doc.source.kinds["normal"] == "normal"
@@ -46,14 +46,14 @@ def test_attached_normal_map_follows_every_cut_and_exports(qtbot, tmp_path):
     dlg = w._export_dialog
     assert dlg.normal.isEnabled()
     dlg.folder.setText(str(tmp_path / "out"))
-    with qtbot.waitSignal(dlg.exported, timeout=20_000):
+    with qtbot.waitSignal(dlg.exported, timeout=WAIT_MS):
         dlg.export()
     assert len(list((tmp_path / "out").glob("*_normal.png"))) >= 2
     # a map of the wrong size is refused with a message naming it
     wrong = tmp_path / "wrong_roughness.png"
     Image.fromarray(np.zeros((10, 12), np.uint8)).save(wrong)
     w.files.attach_map(str(wrong))
-    qtbot.waitUntil(lambda: "wrong_roughness.png" in w.last_message("error"), timeout=5000)
+    qtbot.waitUntil(lambda: "wrong_roughness.png" in w.last_message("error"), timeout=WAIT_MS)
     assert list(w.doc.source.maps) == ["albedo", "normal"]
 
 
@@ -91,7 +91,7 @@ def test_seam_weights_of_the_maps_steer_the_cut_undo_and_survive_a_reopen(qtbot,
     height = np.random.default_rng(3).integers(0, 256, w.doc.source.shape, dtype=np.uint8)
     path = tmp_path / "cobbles_height.png"
     Image.fromarray(height).save(path)
-    with qtbot.waitSignal(w.doc.maps_changed, timeout=5000):
+    with qtbot.waitSignal(w.doc.maps_changed, timeout=WAIT_MS):
         w.files.attach_map(str(path))
     assert box.isVisible() and list(box.spins) == ["albedo", "height"]
     assert box.spins["albedo"].value() == 1.0 and box.spins["height"].value() == 0.0
@@ -119,6 +119,6 @@ def test_seam_weights_of_the_maps_steer_the_cut_undo_and_survive_a_reopen(qtbot,
     assert w.files.save_to(project, wait=True)
     w.doc.undo_stack.undo()
     assert box.spins["height"].value() == 0.0 and w.doc.tileset.engine_weights() is None
-    with qtbot.waitSignal(w.doc.path_changed, timeout=10_000):
+    with qtbot.waitSignal(w.doc.path_changed, timeout=WAIT_MS):
         w.files.open_path(project, confirm=False)
     assert w.doc.tileset.map_weights == {"height": 2.0} and box.spins["height"].value() == 2.0

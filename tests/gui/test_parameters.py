@@ -8,7 +8,7 @@ import numpy as np
 from PIL import Image
 
 from quilt_gui import params
-from tests.gui.helpers import make_window, open_sample, wait_idle
+from tests.gui.helpers import WAIT_MS, make_window, open_sample, wait_idle
 
 JARGON = re.compile(r"\b(w_T|w_P|rho|o_max|Max run|Tile min|Tile max|sigma|Alpha)\b|ρ")
 
@@ -87,7 +87,7 @@ def test_reset_to_defaults_and_sizes_that_follow_the_image(qtbot, tmp_path):
     small = tmp_path / "small.png"
     rng = np.random.default_rng(0)
     Image.fromarray((rng.random((150, 170, 3)) * 255).astype(np.uint8)).save(small)
-    with qtbot.waitSignal(w.doc.source_changed, timeout=5000):
+    with qtbot.waitSignal(w.doc.source_changed, timeout=WAIT_MS):
         w.files.open_path(str(small), confirm=False)
     assert w.doc.params["tile_size"] == "auto" and w.doc.params["overlap"] == 0
     assert w.params_panel.widgets["overlap"].text() == "auto"  # not a bare "0"
@@ -102,7 +102,7 @@ def test_the_quilting_output_is_twice_the_source_by_default(qtbot, tmp_path):
     src = tmp_path / "sample.png"
     rng = np.random.default_rng(1)
     Image.fromarray((rng.random((40, 56, 3)) * 255).astype(np.uint8)).save(src)
-    with qtbot.waitSignal(w.doc.source_changed, timeout=5000):
+    with qtbot.waitSignal(w.doc.source_changed, timeout=WAIT_MS):
         w.files.open_path(str(src), confirm=False)
     w.doc.set_param("block", 16)
     w.act_quilt.trigger()

@@ -10,7 +10,7 @@ from PySide6.QtGui import QImage, QPalette
 
 from quilt_gui.files import default_folder
 from quilt_gui.theme import apply_theme
-from tests.gui.helpers import generate, make_window, open_sample, wait_idle
+from tests.gui.helpers import WAIT_MS, generate, make_window, open_sample, wait_idle
 
 
 def test_no_scrollbars_when_the_image_fits(qtbot):
@@ -23,9 +23,9 @@ def test_no_scrollbars_when_the_image_fits(qtbot):
     h, vbar = v.horizontalScrollBar(), v.verticalScrollBar()
     assert not h.isVisible() and not vbar.isVisible()  # the margin to pan into brings none
     v.set_zoom(4.0)  # 512 px at 400 % does not fit: both bars
-    qtbot.waitUntil(lambda: h.isVisible() and vbar.isVisible(), timeout=2000)
+    qtbot.waitUntil(lambda: h.isVisible() and vbar.isVisible(), timeout=WAIT_MS)
     v.fit()
-    qtbot.waitUntil(lambda: not h.isVisible() and not vbar.isVisible(), timeout=2000)
+    qtbot.waitUntil(lambda: not h.isVisible() and not vbar.isVisible(), timeout=WAIT_MS)
 
 
 def mean_colour(widget) -> np.ndarray:
@@ -85,7 +85,7 @@ def test_save_and_export_start_in_the_same_folder_beside_the_source(qtbot, tmp_p
     src = folder / "bark.png"
     Image.fromarray((np.random.default_rng(1).random((64, 64, 3)) * 255).astype(np.uint8)).save(src)
     w = make_window(qtbot)
-    with qtbot.waitSignal(w.doc.source_changed, timeout=5000):
+    with qtbot.waitSignal(w.doc.source_changed, timeout=WAIT_MS):
         w.files.open_path(str(src), confirm=False)
     starts = []
     monkeypatch.setattr(

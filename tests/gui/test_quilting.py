@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from PySide6.QtCore import QPointF, Qt
 
-from tests.gui.helpers import drag, make_window, open_sample, wait_idle
+from tests.gui.helpers import WAIT_MS, drag, make_window, open_sample, wait_idle
 
 
 def small(w, **extra):
@@ -52,7 +52,7 @@ def test_parameter_change_restarts_quilting_without_stale_blocks(qtbot):
     open_sample(qtbot, w)
     small(w, out_width=256, out_height=256)
     w.act_quilt.trigger()
-    qtbot.waitUntil(lambda: len(w.doc.quilting.blocks) >= 2, timeout=10_000)
+    qtbot.waitUntil(lambda: len(w.doc.quilting.blocks) >= 2, timeout=WAIT_MS)
     first = w.jobs.get("quilt")
     w.doc.set_param("block", 24)
     assert not first.alive
@@ -95,7 +95,7 @@ def test_texture_transfer_streams_passes_and_follows_the_target(qtbot, tmp_path)
     target = np.where((xx - 64) ** 2 + (yy - 48) ** 2 < 30**2, 230, 25).astype(np.uint8)
     path = tmp_path / "disc.png"
     Image.fromarray(target).save(path)
-    with qtbot.waitSignal(w.doc.quilting.target_changed, timeout=5000):
+    with qtbot.waitSignal(w.doc.quilting.target_changed, timeout=WAIT_MS):
         w.files.load_target(str(path))
     assert w.quilt_view.target.array.shape[:2] == (96, 128)
     w.doc.set_params({"block": 24, "iterations": 2})
@@ -117,7 +117,7 @@ def test_texture_transfer_streams_passes_and_follows_the_target(qtbot, tmp_path)
     w.doc.quilting.set_target(w.doc.source.main)  # 512 px: long enough to stop midway
     w.doc.set_params({"iterations": 3, "block": 32})
     running = lambda: w.jobs.get("quilt") is not None and len(w.doc.quilting.blocks) > 0  # noqa: E731
-    qtbot.waitUntil(running, timeout=10_000)
+    qtbot.waitUntil(running, timeout=WAIT_MS)
     w.act_cancel.trigger()
     wait_idle(qtbot, w)
     assert w.last_message().startswith("Texture transfer cancelled after")
@@ -156,7 +156,7 @@ def test_quilting_job_carries_the_engine_estimate_for_the_status_bar(qtbot):
     w.act_quilt.trigger()
     job = w.jobs.get("quilt")
     assert job is not None
-    qtbot.waitUntil(lambda: job.estimate != "", timeout=10_000)
+    qtbot.waitUntil(lambda: job.estimate != "", timeout=WAIT_MS)
     # the plan's words (search, time, memory) are what the status bar shows until a rate is known
     assert job.estimate.startswith("estimate: ") and "search" in job.estimate
     assert "about" in job.estimate and "peak memory" in job.estimate

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from tests.gui.helpers import generate, make_window, open_sample, wait_idle
+from tests.gui.helpers import WAIT_MS, generate, make_window, open_sample, wait_idle
 
 
 def gallery_title(w) -> str:
@@ -19,7 +19,7 @@ def test_reopened_and_recovered_candidates_are_not_called_outdated(qtbot, tmp_pa
     path = tmp_path / "p.quiltproj"
     assert w.files.save_to(str(path), wait=True)
     again = make_window(qtbot)
-    with qtbot.waitSignal(again.doc.path_changed, timeout=20_000):
+    with qtbot.waitSignal(again.doc.path_changed, timeout=WAIT_MS):
         again.files.open_path(str(path), confirm=False)
     wait_idle(qtbot, again)
     assert again.doc.tileset.seamless is not None  # recomputed from the saved rectangle
@@ -29,7 +29,7 @@ def test_reopened_and_recovered_candidates_are_not_called_outdated(qtbot, tmp_pa
     # a recovered file too
     w.doc.tileset.set_picks([0])
     job = w.files.autosave_now()
-    qtbot.waitUntil(lambda: not job.running, timeout=20_000)
+    qtbot.waitUntil(lambda: not job.running, timeout=WAIT_MS)
     third = make_window(qtbot)
     third.files.restore_recovery(w.files.recovery_file())
     wait_idle(qtbot, third)

@@ -13,7 +13,7 @@ from PIL import Image
 from engine.io import ImageError, load_image
 from engine.project import ProjectError, load_project
 from tests.engine.hostile import candidate, png_header, project_doc, project_zip
-from tests.gui.helpers import make_window, open_sample
+from tests.gui.helpers import WAIT_MS, make_window, open_sample
 
 
 @pytest.fixture
@@ -72,12 +72,12 @@ def test_hostile_file_shows_the_engine_message_and_keeps_the_document(
         loader(path)
     source, name = win.doc.source, win.doc.name
     win.files.open_path(str(path), confirm=False)
-    qtbot.waitUntil(lambda: win.last_message("error") != "", timeout=10_000)
+    qtbot.waitUntil(lambda: win.last_message("error") != "", timeout=WAIT_MS)
     assert win.last_message("error") == f"Could not open the file. {info.value}"
     assert win.message_bar.isVisible() and win.message_bar.level == "error"
     assert win.doc.source is source and win.doc.name == name  # nothing lost
     win.act_find.trigger()  # still usable
-    qtbot.waitUntil(lambda: not win.pipeline.busy(), timeout=20_000)
+    qtbot.waitUntil(lambda: not win.pipeline.busy(), timeout=WAIT_MS)
     assert win.doc.tileset.seamless is not None
 
 
@@ -86,7 +86,7 @@ def test_animated_gif_says_the_first_frame_is_used(qtbot, win, tmp_path):
     frames = [Image.fromarray(g.integers(0, 256, (60, 70, 3), np.uint8)) for _ in range(3)]
     path = tmp_path / "anim.gif"
     frames[0].save(path, "GIF", save_all=True, append_images=frames[1:])
-    with qtbot.waitSignal(win.doc.source_changed, timeout=10_000):
+    with qtbot.waitSignal(win.doc.source_changed, timeout=WAIT_MS):
         win.files.open_path(str(path), confirm=False)
     text = win.last_message()
     assert text.startswith("Animated GIF with 3 frames; using the first frame. Opened anim.gif")

@@ -9,14 +9,14 @@ from PIL import Image
 from PySide6.QtGui import QKeySequence
 
 from engine.io import load_image
-from tests.gui.helpers import make_window, wait_idle
+from tests.gui.helpers import WAIT_MS, make_window, wait_idle
 
 
 def open_small(qtbot, w, tmp_path):
     src = tmp_path / "sample.png"
     rng = np.random.default_rng(2)
     Image.fromarray((rng.random((48, 40, 3)) * 255).astype(np.uint8)).save(src)
-    with qtbot.waitSignal(w.doc.source_changed, timeout=5000):
+    with qtbot.waitSignal(w.doc.source_changed, timeout=WAIT_MS):
         w.files.open_path(str(src), confirm=False)
     w.doc.set_param("block", 16)
 
@@ -63,7 +63,7 @@ def test_the_output_is_kept_in_the_project_and_not_replaced_without_asking(qtbot
     wait_idle(qtbot, w)
     assert len(asked) == 1
     again = make_window(qtbot)
-    with qtbot.waitSignal(again.doc.path_changed, timeout=20_000):
+    with qtbot.waitSignal(again.doc.path_changed, timeout=WAIT_MS):
         again.files.open_path(str(path), confirm=False)
     wait_idle(qtbot, again)
     kept = again.doc.quilting.finished_output

@@ -3,14 +3,14 @@
 from PIL import Image
 
 from benchmarks.evalset import shelves
-from tests.gui.helpers import make_window, wait_idle
+from tests.gui.helpers import WAIT_MS, make_window, wait_idle
 
 
 def test_a_tile_smaller_than_three_periods_is_warned_about_on_the_banner(qtbot, tmp_path):
     path = tmp_path / "shelves.png"
     Image.fromarray(shelves(256, seed=3)).save(path)  # shelves every 64 px
     w = make_window(qtbot)
-    with qtbot.waitSignal(w.doc.source_changed, timeout=5000):
+    with qtbot.waitSignal(w.doc.source_changed, timeout=WAIT_MS):
         w.files.open_path(str(path), confirm=False)
     w.doc.set_params({"tile_size": "64"})
     w.act_find.trigger()

@@ -24,7 +24,7 @@ from engine.seams import SeamSpec
 from engine.tiles import TilesetSettings
 from quilt_gui import params
 from resources import sample_path
-from tests.gui.helpers import make_window, wait_idle
+from tests.gui.helpers import WAIT_MS, make_window, wait_idle
 
 #: every tile-set option of the command line away from its default
 FLAGS = {
@@ -101,7 +101,7 @@ def test_cli_project_with_every_option_reopens_in_the_editor_with_all_of_them(qt
         rho=5,
     )
     w = make_window(qtbot)
-    with qtbot.waitSignal(w.doc.path_changed, timeout=20_000):
+    with qtbot.waitSignal(w.doc.path_changed, timeout=WAIT_MS):
         w.files.open_path(str(proj), confirm=False)
     wait_idle(qtbot, w)
     p = w.doc.params
@@ -148,7 +148,7 @@ def test_cli_project_with_every_option_reopens_in_the_editor_with_all_of_them(qt
     assert np.array_equal(_q(ts.seamless.maps["height"]), _q(cli.template["height"]))
     assert ts.picks == [0, 2]
     w.act_generate.trigger()
-    wait_idle(qtbot, w, timeout=60_000)
+    wait_idle(qtbot, w, timeout=WAIT_MS)
     assert len(ts.candidates) == 4
     for mine, theirs in zip(ts.candidates, cli.candidates, strict=True):
         assert mine.patch_origin == theirs.patch_origin
@@ -275,7 +275,7 @@ def test_editor_project_keeps_its_settings_and_own_parameters(qtbot, tmp_path):
     }
     assert saved.parameters["editor"]["block"] == 40
     other = make_window(qtbot)
-    with qtbot.waitSignal(other.doc.path_changed, timeout=20_000):
+    with qtbot.waitSignal(other.doc.path_changed, timeout=WAIT_MS):
         other.files.open_path(str(path), confirm=False)
     wait_idle(qtbot, other)
     assert {k: other.doc.params[k] for k in changes} == changes

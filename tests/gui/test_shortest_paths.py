@@ -17,7 +17,7 @@ from PySide6.QtWidgets import QApplication
 from engine.io import load_image
 from engine.metrics import wrap_border_ratio
 from resources import sample_path
-from tests.gui.helpers import click_candidate, drop, make_window, wait_idle
+from tests.gui.helpers import WAIT_MS, click_candidate, drop, make_window, wait_idle
 
 PHOTO = sample_path("grass")  # a photograph (scikit-image's grass, 512 x 512)
 
@@ -34,7 +34,7 @@ def test_photo_to_a_256_px_seamless_tile_exported_in_4_actions(qtbot, tmp_path):
     dialogs = []
     w.files.ask_image_path = lambda caption, name: dialogs.append(name) or str(target)
     actions = 0
-    with qtbot.waitSignal(w.doc.source_changed, timeout=10_000):
+    with qtbot.waitSignal(w.doc.source_changed, timeout=WAIT_MS):
         drop(w, PHOTO)  # 1: drop the photo on the window
     actions += 1
     wait_idle(qtbot, w)
@@ -61,7 +61,7 @@ def test_photo_to_a_set_of_8_picked_tiles_exported_in_7_actions(qtbot, tmp_path)
     w = make_window(qtbot)
     w.activateWindow()
     actions = 0
-    with qtbot.waitSignal(w.doc.source_changed, timeout=10_000):
+    with qtbot.waitSignal(w.doc.source_changed, timeout=WAIT_MS):
         drop(w, PHOTO)  # 1
     actions += 1
     wait_idle(qtbot, w)
@@ -82,7 +82,7 @@ def test_photo_to_a_set_of_8_picked_tiles_exported_in_7_actions(qtbot, tmp_path)
     qtbot.waitExposed(dlg)
     out = tmp_path / "grass_set"
     dlg.folder.setText(str(out))  # (the test's folder instead of the default beside the photo)
-    with qtbot.waitSignal(dlg.exported, timeout=30_000):
+    with qtbot.waitSignal(dlg.exported, timeout=WAIT_MS):
         qtbot.keyClick(dlg.folder, Qt.Key.Key_Return)  # 7: Enter exports
     actions += 1
     assert actions == 7 <= 8

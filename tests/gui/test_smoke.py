@@ -2,7 +2,7 @@ import subprocess
 import sys
 
 from resources import SAMPLE_NAMES, sample_path
-from tests.gui.helpers import make_window, open_sample
+from tests.gui.helpers import WAIT_MS, make_window, open_sample
 
 
 def test_main_window_shows_bundled_sample(qtbot):
@@ -19,7 +19,10 @@ def test_samples_exist():
 
 def test_entry_point_sends_subcommands_to_the_cli():
     out = subprocess.run(
-        [sys.executable, "-m", "quilt_gui", "--help"], capture_output=True, text=True, timeout=60
+        [sys.executable, "-m", "quilt_gui", "--help"],
+        capture_output=True,
+        text=True,
+        timeout=WAIT_MS / 1000,
     )
     assert out.returncode == 0 and "SUBCOMMAND" in out.stdout
 

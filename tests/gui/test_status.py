@@ -6,7 +6,7 @@ import re
 import threading
 
 from engine.events import Progress
-from tests.gui.helpers import make_window
+from tests.gui.helpers import WAIT_MS, make_window
 
 
 def held(n, done, gate, *, cancel=None):
@@ -27,7 +27,7 @@ def test_a_long_job_keeps_its_progress_and_time_left_and_the_others_are_named(qt
     gate = threading.Event()
     try:
         long = w.jobs.start("candidates", held, 10, 3, gate, label="Generating 10 candidates")
-        qtbot.waitUntil(lambda: long.progress is not None, timeout=5000)
+        qtbot.waitUntil(lambda: long.progress is not None, timeout=WAIT_MS)
         long.started_at -= 6.0  # it has run 6 s for 3 of 10 steps: ~14 s left
         auto = w.jobs.start("autosave", waiting, gate, label="Autosaving", pass_cancel=False)
         auto.started_at -= 1.0
@@ -40,4 +40,4 @@ def test_a_long_job_keeps_its_progress_and_time_left_and_the_others_are_named(qt
         assert "Autosaving" in status.others.text()  # named, not "(+1)"
     finally:
         gate.set()
-    qtbot.waitUntil(lambda: not w.jobs.running(), timeout=5000)
+    qtbot.waitUntil(lambda: not w.jobs.running(), timeout=WAIT_MS)

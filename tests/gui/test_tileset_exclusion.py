@@ -11,7 +11,7 @@ from PySide6.QtCore import QPointF, Qt
 
 from quilt_gui import main_window
 from quilt_gui.pipeline import excluded_mask
-from tests.gui.helpers import drag, make_window, open_sample, template, wait_idle
+from tests.gui.helpers import WAIT_MS, drag, make_window, open_sample, template, wait_idle
 
 
 @pytest.fixture
@@ -118,7 +118,7 @@ def test_painted_exclusion_is_saved_in_the_project(qtbot, win, tmp_path):
     path = str(tmp_path / "p.quiltproj")
     assert win.files.save_to(path, wait=True)
     w2 = make_window(qtbot)
-    with qtbot.waitSignal(w2.doc.exclusion_changed, timeout=10_000):
+    with qtbot.waitSignal(w2.doc.exclusion_changed, timeout=WAIT_MS):
         w2.files.open_path(path, confirm=False)
     wait_idle(qtbot, w2)
     np.testing.assert_array_equal(w2.doc.exclude_painted, painted)
@@ -133,7 +133,7 @@ def test_seam_kernels_warm_up_once_in_a_worker(qtbot, monkeypatch):
     monkeypatch.setattr(main_window, "_warmup_started", False)
     monkeypatch.setattr(engine.seams, "warmup", lambda: calls.append(threading.current_thread()))
     w = make_window(qtbot)
-    qtbot.waitUntil(lambda: bool(calls), timeout=5000)
+    qtbot.waitUntil(lambda: bool(calls), timeout=WAIT_MS)
     assert calls[0] is not threading.main_thread()
     make_window(qtbot)
     wait_idle(qtbot, w)

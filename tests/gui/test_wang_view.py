@@ -99,7 +99,7 @@ def test_reroll_a_sample_save_reopen_and_export(qtbot, tmp_path):
     p = load_project(path)
     assert p.wang["colours"] == 2 and len(p.wang_tiles) == 16
     win2 = make_window(qtbot)
-    with qtbot.waitSignal(win2.doc.source_changed, timeout=10_000):
+    with qtbot.waitSignal(win2.doc.source_changed, timeout=WAIT_MS):
         win2.files.open_path(str(path), confirm=False)
     wait_wang(qtbot, win2)
     w2 = win2.doc.wang
@@ -114,7 +114,7 @@ def test_reroll_a_sample_save_reopen_and_export(qtbot, tmp_path):
     assert dlg.wang and "Wang" in dlg.windowTitle()
     dlg.folder.setText(str(tmp_path / "bundle"))
     dlg.export()
-    qtbot.waitUntil(lambda: dlg.manifest is not None, timeout=30_000)
+    qtbot.waitUntil(lambda: dlg.manifest is not None, timeout=WAIT_MS)
     name = dlg.manifest["name"]
     man = json.loads((tmp_path / "bundle" / f"{name}.json").read_text())
     assert man["wang"]["colours"] == 2 and len(man["tiles"]) == 16

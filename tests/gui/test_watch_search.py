@@ -7,7 +7,7 @@ import numpy as np
 from engine.events import drain
 from engine.tiles import SeamlessUpdate, iter_make_seamless
 from quilt_gui.widgets.watch_search import INTERVAL_MS, MAX_PER_SECOND, describe_seam
-from tests.gui.helpers import make_window, open_sample, template, wait_idle
+from tests.gui.helpers import WAIT_MS, make_window, open_sample, template, wait_idle
 
 RECT = (150, 120, 128, 112)
 
@@ -45,11 +45,11 @@ def test_watch_mode_draws_every_improvement_then_keeps_or_goes_back(qtbot):
     watch.watch_button.click()
     assert watch.state == "watching" and watch.skip_button.isVisible()
     assert "published" in w.criterion_label.text()  # the status bar names the variant
-    qtbot.waitUntil(lambda: watch.drawn > 50, timeout=60_000)
+    qtbot.waitUntil(lambda: watch.drawn > 50, timeout=WAIT_MS)
     assert per_tick and max(per_tick) == 1  # one per tick
     assert len(drawn) >= 50 and all(isinstance(u, SeamlessUpdate) for u in drawn)
     watch.skip()  # the rest at once
-    qtbot.waitUntil(lambda: watch.state == "finished", timeout=60_000)
+    qtbot.waitUntil(lambda: watch.state == "finished", timeout=WAIT_MS)
     expected = engine_improvements(w, watch.spec)
     assert watch.drawn == len(expected) > 50  # every improvement reached the queue
     crit = [float(u.seam.criterion) for u in drawn[:50]]
@@ -75,7 +75,7 @@ def test_watch_mode_draws_every_improvement_then_keeps_or_goes_back(qtbot):
     # watch again and keep: the parameters become the paper's and recompute the same seams
     watch.start()
     watch.skip()
-    qtbot.waitUntil(lambda: watch.state == "finished", timeout=60_000)
+    qtbot.waitUntil(lambda: watch.state == "finished", timeout=WAIT_MS)
     watched = watch.result
     watch.keep_button.click()
     wait_idle(qtbot, w)
