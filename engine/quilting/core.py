@@ -30,7 +30,7 @@ from engine.matching import (
 from engine.pyramid import PyramidSearch
 from engine.quilting.cut import Cut, blend_alpha, cut_overlap, straight_alpha
 from engine.quilting.estimate import TILE, Plan
-from engine.quilting.kernels import dp_cut_paste, footprint
+from engine.quilting.kernels import PAIRWISE_BLOCK, dp_cut_paste, footprint
 from engine.quilting.layout import arms_of, canvas_index
 from engine.quilting.records import EMPTY_PATH, BlockRecord, read_only
 from engine.stitch_numpy import SMALL_CUT_PIXELS, dp_l_cuts
@@ -390,13 +390,12 @@ class Quilter:
         if wk.old is None:
             pixels = new.copy()
         elif self.dp_paste and wk.arms[0] and wk.arms[1] and not any(wk.arms[2:]) and jit.loaded():
-            err, keep, path, pixels = dp_cut_paste(
+            err, keep, path, pixels, values, crit, peak = dp_cut_paste(
                 wk.old, new, wk.filled, wk.arms[1], wk.arms[0], self.canvas[ix]
             )
-            crit = peak = 0.0
+            if len(values) > PAIRWISE_BLOCK:
+                crit = float(values.sum())
             if len(path):
-                values = err[path[:, 0], path[:, 1]].astype(np.float64)
-                crit, peak = float(values.sum()), float(values.max())
                 read_only(path)
             else:
                 path = EMPTY_PATH

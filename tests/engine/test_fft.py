@@ -181,7 +181,9 @@ def test_query_spectra_from_a_threads_kept_buffers_equal_fresh_ones_and_numpys(b
     t = transforms(backend)
     rng = np.random.default_rng(6)
     shape = (24, 20)
-    for kshape in ((2, 3, 10, 12), (2, 3, 7, 12), (2, 3, 10, 5), (2, 3, 10, 12), (1, 9, 4)):
+    kshapes = ((2, 3, 10, 12), (2, 3, 7, 12), (2, 3, 10, 5), (2, 3, 10, 12), (1, 9, 4))
+    kshapes += ((3, 3, 10, 12), (1, 3, 10, 12), (9, 4), (2, 1, 10, 12), (2, 3, 10, 12))
+    for kshape in kshapes:
         k = rng.random(kshape, dtype=np.float32)
         kept = fft.spectra(t, k, shape, conj=True, reuse=True)
         np.testing.assert_array_equal(kept, fft.spectra(t, k, shape, conj=True))
@@ -226,3 +228,25 @@ def test_an_extension_that_no_longer_takes_scipys_arguments_falls_back_to_scipy_
     assert fft._works(
         fft._Pocketfft(fft._load_pocketfft())
     )  # the installed scipy's extension passes the check
+
+
+def test_a_threads_kept_buffers_serve_smaller_batches_and_two_shapes():
+    """Job A's batches of 1 to 8 blocks and its weight maps take the same kept buffers (the
+    first n entries of the largest batch's) instead of allocating and zeroing new ones."""
+    t = transforms("ducc0")
+    if not isinstance(t, fft._Padded):
+        pytest.skip("ducc0 not installed")
+    rng = np.random.default_rng(7)
+    shape = (24, 20)
+    fft.spectra(t, rng.random((4, 3, 10, 12), dtype=np.float32), shape, conj=True, reuse=True)
+    fft.spectra(t, rng.random((1, 1, 10, 12), dtype=np.float32), shape, conj=True, reuse=True)
+    kept = {key: (pad, mid) for key, (pad, mid) in t._kept().items()}
+    for n in (2, 1, 4, 3):
+        k = rng.random((n, 3, 10, 12), dtype=np.float32)
+        got = fft.spectra(t, k, shape, conj=True, reuse=True)
+        np.testing.assert_array_equal(got, fft.spectra(t, k, shape, conj=True))
+        w = rng.random((1, 1, 10, 12), dtype=np.float32)
+        fft.spectra(t, w, shape, conj=True, reuse=True)
+    now = t._kept()
+    assert now.keys() == kept.keys()
+    assert all(now[key][0] is kept[key][0] and now[key][1] is kept[key][1] for key in kept)

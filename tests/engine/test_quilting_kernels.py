@@ -103,3 +103,19 @@ def test_records_are_identical_on_one_two_and_three_threads():
     for run in runs[1:]:
         assert np.array_equal(run.image, runs[0].image)
         assert _records(run) == _records(runs[0])
+
+
+def test_the_paths_sum_adds_as_numpy_does():
+    """The kernel's sum of the error along a cut has the bits of numpy's pairwise ``sum`` (the
+    records' criterion is compared bit for bit), for every length it takes."""
+    from engine.quilting import kernels
+
+    _jit.load()
+    rng = np.random.default_rng(5)
+    for n in list(range(0, kernels.PAIRWISE_BLOCK + 1)) * 3:
+        values = (rng.random(n) * 10.0 ** rng.integers(-4, 6, n)).astype(np.float32)
+        values = values.astype(np.float64)
+        assert kernels._pairwise_sum(values) == values.sum()
+        if n:
+            assert kernels._nan_max(values) == values.max()
+    assert np.isnan(kernels._nan_max(np.array([1.0, np.nan, 3.0])))
