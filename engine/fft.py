@@ -185,8 +185,10 @@ kernels of a batch of three blocks of job B: 2.8 MB): a larger one (a large samp
 allocated per call, where its transforms dwarf the allocation."""
 
 
-KEPT_SHAPES = 2
-"""Shapes whose buffers a thread keeps (a search's kernels and its weight maps)."""
+KEPT_SHAPES = 8
+"""Shapes whose buffers a thread keeps: a search's kernels and its weight maps, of each block
+shape (job A's blocks come in four: cropped at the right and at the bottom edge); at most
+``KEPT_SHAPES`` × :data:`BUFFER_BYTES` a thread (job A's: 4.5 MB in all)."""
 
 
 def spectra(t, k, shape, *, conj=False, workers=1, reuse=False) -> np.ndarray:
