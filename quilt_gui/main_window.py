@@ -312,6 +312,7 @@ class MainWindow(QMainWindow):
         lay.addWidget(self.tabs, 1)
         self.message_bar = MessageBar(central)  # floats over the canvas, outside the layout
         self.message_bar.covered.connect(self.wang_view.keep_clear_of)  # but not the Wang tab's
+        self.message_bar.dismissed.connect(self._clear_status_message)
         self.setCentralWidget(central)
         self.params_panel = ParamsPanel(
             doc,
@@ -492,6 +493,12 @@ class MainWindow(QMainWindow):
         if actions or level != "info" or not self.message_bar.waiting_for_answer():
             self.message_bar.show_message(level, text, actions)
         self.statusBar().showMessage(text, 10_000)
+
+    @Slot(str)
+    def _clear_status_message(self, text: str) -> None:
+        """The banner's message closed: its copy in the status bar goes too (not a newer one)."""
+        if self.statusBar().currentMessage() == text:
+            self.statusBar().clearMessage()
 
     def last_message(self, level: str | None = None) -> str:
         for lv, text in reversed(self.messages):

@@ -35,6 +35,7 @@ class MessageBar(QWidget):
     #: the height the banner covers at the bottom of its parent (0: hidden), for a view that
     #: must not be covered (the Wang tab's layout ends above it)
     covered = Signal(int)
+    dismissed = Signal(str)  # the text of the message closed (by ✕, its answer or fading)
 
     def __init__(self, parent=None) -> None:
         super().__init__(parent)
@@ -117,8 +118,11 @@ class MessageBar(QWidget):
     @Slot()
     def dismiss(self) -> None:
         self._timer.stop()
+        shown = self.isVisibleTo(self.parentWidget()) if self.parentWidget() else self.isVisible()
         self.hide()
         self.covered.emit(0)
+        if shown:
+            self.dismissed.emit(self.label.text())
 
 
 #: Jobs that run beside a long one without taking the status bar from it.

@@ -5,8 +5,10 @@ from __future__ import annotations
 import re
 import threading
 
+import numpy as np
+
 from engine.events import Progress
-from tests.gui.helpers import WAIT_MS, make_window
+from tests.gui.helpers import WAIT_MS, make_window, open_sample, wait_idle
 
 
 def held(n, done, gate, *, cancel=None):
@@ -41,3 +43,23 @@ def test_a_long_job_keeps_its_progress_and_time_left_and_the_others_are_named(qt
     finally:
         gate.set()
     qtbot.waitUntil(lambda: not w.jobs.running(), timeout=WAIT_MS)
+
+
+def test_closing_the_banner_takes_its_line_off_the_status_bar(qtbot):
+    w = make_window(qtbot)
+    open_sample(qtbot, w)
+    w.doc.set_params({"out_width": 128, "out_height": 128})
+    w.act_quilt.trigger()
+    wait_idle(qtbot, w)
+    w.tabs.setCurrentWidget(w.source_view)
+    painted = np.zeros(w.doc.source.shape, bool)
+    painted[:40, :40] = True
+    w.doc.set_painted(painted)  # the quilt shown runs again without these pixels: says so
+    wait_idle(qtbot, w)
+    assert w.last_message().startswith("Synthesized 128×128")
+    w.message_bar.dismiss()  # closed (or faded already on a slow machine)
+    assert w.statusBar().currentMessage() == ""  # not the quilt's line on the Source tab
+    w.show_message("warning", "a question")
+    w.statusBar().showMessage("a newer line")
+    w.message_bar.dismiss()
+    assert w.statusBar().currentMessage() == "a newer line"  # only the banner's own text goes
