@@ -187,8 +187,8 @@ allocated per call, where its transforms dwarf the allocation."""
 
 KEPT_SHAPES = 8
 """Shapes whose buffers a thread keeps: a search's kernels and its weight maps, of each block
-shape (job A's blocks come in four: cropped at the right and at the bottom edge); at most
-``KEPT_SHAPES`` × :data:`BUFFER_BYTES` a thread (job A's: 4.5 MB in all)."""
+shape (job A's blocks come in four: cropped at the right and at the bottom edge), together at
+most :data:`BUFFER_BYTES` (the oldest go first; the peak memory estimate counts one buffer)."""
 
 
 def spectra(t, k, shape, *, conj=False, workers=1, reuse=False) -> np.ndarray:
@@ -227,7 +227,7 @@ class _Padded:
     def spectra(self, k, shape, *, conj=False, workers=1, reuse=False) -> np.ndarray:
         """:func:`spectra`. ``reuse``: the zero-padded copies of ``k`` live in buffers the
         calling thread keeps for the next call of the same shape (their padding stays zero: no
-        allocation and no zero-filling per call; :data:`KEPT_SHAPES` shapes, each up to
+        allocation and no zero-filling per call; :data:`KEPT_SHAPES` shapes, together up to
         :data:`BUFFER_BYTES`, with room for the largest batch seen: job A's batches of 1 to 8
         blocks allocated and zeroed their buffers in 94 % of the calls). The
         conjugate comes from the transforms of opposite sign (no pass of its own)."""
@@ -249,7 +249,11 @@ class _Padded:
             kept = (pad, mid) if pad.nbytes + mid.nbytes <= BUFFER_BYTES else None
             if kept is not None and reuse:
                 store.pop(key, None)
-                while len(store) >= KEPT_SHAPES:
+                size = pad.nbytes + mid.nbytes
+                while store and (
+                    len(store) >= KEPT_SHAPES
+                    or size + sum(p.nbytes + m.nbytes for p, m in store.values()) > BUFFER_BYTES
+                ):
                     del store[next(iter(store))]  # the oldest
                 store[key] = kept
         if not lead:
