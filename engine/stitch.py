@@ -56,6 +56,7 @@ __all__ = [
     "PatchCut",
     "PatchResult",
     "StitchResult",
+    "dp_arm_cut_kernel",
     "dp_l_cut_kernel",
     "l_cut",
     "map_points",
@@ -379,6 +380,25 @@ def _dp_l_cut(e, ovl, ovt):  # pragma: no cover - compiled
 dp_l_cut_kernel = _dp_l_cut
 """The compiled dp L-cut (path, old side, meeting row, meeting col) of a float64 error map with
 both arms, for other kernels to call without the checks of :func:`l_cut` (quilting's)."""
+
+
+@njit(cache=True, nogil=True)
+def dp_arm_cut_kernel(e, ovl, ovt):  # pragma: no cover - compiled
+    """:func:`l_cut`'s dp cut (path, old side) of a float64 error map with one arm (``ovt``
+    or ``ovl`` 0: the first row or column of blocks): the same pixels, for other kernels."""
+    bh, bw = e.shape
+    strip = np.ascontiguousarray(e[:, :ovl] if ovt == 0 else e[:ovt].T)
+    cost, step = _dp_to_bottom(strip)
+    cols = _trace_down(step, 0, np.argmin(cost[0]))
+    n = len(cols)
+    path = np.empty((n, 2), np.intp)
+    barrier = np.zeros((bh, bw), np.bool_)
+    for i in range(n):
+        j = n - 1 - i if ovt == 0 else i  # the left arm bottom to top; the top one rightwards
+        r, c = (j, cols[j]) if ovt == 0 else (cols[j], j)
+        path[i, 0], path[i, 1] = r, c
+        barrier[r, c] = True
+    return path, _old_side_of_barrier(barrier, ovl > 0, ovt > 0)
 
 
 def _numpy_cut(e: np.ndarray) -> bool:

@@ -389,7 +389,7 @@ class Quilter:
         ix = self.idx(wk.y, wk.x, h, w)
         if wk.old is None:
             pixels = new.copy()
-        elif self.dp_paste and wk.arms[0] and wk.arms[1] and not any(wk.arms[2:]) and jit.loaded():
+        elif self.dp_paste and (wk.arms[0] or wk.arms[1]) and not any(wk.arms[2:]) and jit.loaded():
             err, keep, path, pixels, values, crit, peak = dp_cut_paste(
                 wk.old, new, wk.filled, wk.arms[1], wk.arms[0], self.canvas[ix]
             )

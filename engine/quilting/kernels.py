@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from engine._jit import njit
-from engine.stitch import dp_l_cut_kernel
+from engine.stitch import dp_arm_cut_kernel, dp_l_cut_kernel
 
 __all__ = ["PAIRWISE_BLOCK", "dp_cut_paste", "footprint"]
 
@@ -58,7 +58,8 @@ def footprint(filled):  # pragma: no cover - compiled
 
 @njit(cache=True, nogil=True)
 def dp_cut_paste(old, new, filled, ovl, ovt, out):  # pragma: no cover - compiled
-    """One block's squared-error map, dp L-cut and hard paste (both arms, no blend).
+    """One block's squared-error map, dp L-cut and hard paste (a top or a left arm or both,
+    no blend).
 
     ``old`` (h, w, c) the colour channels under the block, ``new`` (h, w, C) the sample window
     (its first c channels compared), ``filled`` (h, w) the overlap, ``out`` (h, w, C) the
@@ -88,7 +89,10 @@ def dp_cut_paste(old, new, filled, ovl, ovt, out):  # pragma: no cover - compile
     pixels = new.copy()
     crit = peak = 0.0
     if anything:
-        path, keep, _, _ = dp_l_cut_kernel(err.astype(np.float64), ovl, ovt)
+        if ovl and ovt:
+            path, keep, _, _ = dp_l_cut_kernel(err.astype(np.float64), ovl, ovt)
+        else:
+            path, keep = dp_arm_cut_kernel(err.astype(np.float64), ovl, ovt)
         values = np.empty(len(path), np.float64)
         for i in range(len(path)):
             values[i] = err[path[i, 0], path[i, 1]]
