@@ -420,6 +420,15 @@ def select_within_tolerance(errors: np.ndarray, *, tolerance: float, zero_level:
     """
     flat = errors.ravel()
     small = not jit.loaded()  # the same result without starting numba (a small job)
+    if not small and type(tolerance) is float and type(zero_level) is float:
+        # the least error, the limit and the count in one call (the same float64 arithmetic;
+        # numpy scalars may round in their own type: the general lines below)
+        i_min, e_min, n, limit = _least_and_count(flat, tolerance, zero_level)
+        if not math.isfinite(e_min):
+            raise ValueError("no valid candidate position (every position is excluded)")
+        if n == 0:  # float round-off
+            return i_min, e_min, 1
+        return int(_kth_at_most(flat, limit, rng.integers(n))), e_min, n
     i_min = _argmin_numpy(flat) if small else int(_argmin(flat))
     e_min = float(flat[i_min])
     if not math.isfinite(e_min):
@@ -472,6 +481,21 @@ def _argmin(flat):  # pragma: no cover - compiled
         if flat[j] == best:
             return j
     return 0
+
+
+@njit(cache=True, nogil=True)
+def _least_and_count(flat, tolerance, zero_level):  # pragma: no cover - compiled
+    """:func:`select_within_tolerance`'s first steps for float ``tolerance`` and ``zero_level``:
+    (first index of the least value, that value, the number of values <= the limit, the limit
+    in ``flat``'s dtype); the count is 0 when the least value is not finite."""
+    i = _argmin(flat)
+    e = np.float64(flat[i])
+    lim = np.empty(1, flat.dtype)  # the limit rounded to flat's dtype, as numpy's scalar does
+    if not np.isfinite(e):
+        lim[0] = e
+        return i, e, 0, lim[0]
+    lim[0] = (1.0 + tolerance) * (zero_level if zero_level > e else e)  # Python's max(e, z)
+    return i, e, _count_at_most(flat, lim[0]), lim[0]
 
 
 @njit(cache=True, nogil=True)
