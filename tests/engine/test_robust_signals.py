@@ -136,9 +136,12 @@ def _interrupt_and_terminate(start, inputs, tmp_path, command, name):
         out.mkdir()
     argv, started = commands(inputs, out)[command]
     proc = start(*argv)
-    wait_for_line(proc, started)
-    time.sleep(0.3)  # as a person would: not in the middle of a lazy import (see outcome.py)
-    rc, rest = signal_and_wait(proc, sig)
+    try:
+        wait_for_line(proc, started)
+        time.sleep(0.3)  # as a person would: not in the middle of a lazy import (outcome.py)
+        rc, rest = signal_and_wait(proc, sig)
+    finally:
+        proc.stderr.close()  # not left to the collector (its warning lands in another test)
     assert rc == code, rest
     assert rest.strip().endswith(
         f"quilt-studio {command}: {word}{' (SIGTERM)' if code == 143 else ''}; "

@@ -87,6 +87,11 @@ class _Tail:
     def close(self) -> None:
         self._file.close()
 
+    def __del__(self) -> None:
+        # closed when dropped: an unclosed file's ResourceWarning would surface wherever the
+        # collector happens to run (in another test's captured stderr)
+        self._file.close()
+
 
 class Child:
     def __init__(self, server: WarmCli, pid: int, stderr: Path):
@@ -163,4 +168,5 @@ class WarmCli:
         self._end_child()
         self._proc.stdin.close()
         self._proc.wait(timeout=60)
+        self._proc.stdout.close()
         self._dir.cleanup()
