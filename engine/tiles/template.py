@@ -35,6 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
+from engine import _jit as jit
 from engine._checks import as_size
 from engine._validate import as_image, positive_int
 from engine.cancel import Cancelled, is_cancelled
@@ -44,6 +45,7 @@ from engine.tiles.detail import DETAIL_WEIGHT, DetailTerm, check_detail_weight
 from engine.tiles.scale import Scale, structure_scale, whole_structure_range
 from engine.tiles.stationarity import stationarity_of
 from engine.tiles.template_scan import (
+    SMALL_SCAN_PAIRS,
     Scan,
     argmin_cost,
     rect_costs,
@@ -583,6 +585,11 @@ def _phases(
     a_shifts = np.arange(lo[1], hi[1] + 1)
     b_shifts = np.arange(lo[0], hi[0] + 1)
     rounds = 4 if refine else 1
+    if H * W * (a_shifts.size + b_shifts.size) * rounds >= SMALL_SCAN_PAIRS:
+        # the whole search's pixel pairs decide whether numba's start-up pays: a search over a
+        # range of tile sizes runs several scans of many shifts, each small on its own (512²,
+        # 224..288: 3.2 s on the numpy twins, 0.49 s with the kernels, their loading included)
+        jit.load()
     best: Template | None = None
 
     def scan(St, vt, rows, shifts, feasible, what, to_rect, footprint=None):

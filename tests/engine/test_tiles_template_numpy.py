@@ -77,13 +77,17 @@ def run():
 
 first = run()
 print("numba" in sys.modules, _jit.loaded())
-_jit.load()
+# a search over tile sizes: many scans, numba's start-up pays
+find_template(np.tile(S, (2, 2, 1)), tile_min=48, tile_max=96)
+print(_jit.loaded())
 print(run() == first)
 """
 
 
 def test_a_small_template_and_seamless_tile_start_no_numba_and_match_the_kernels():
+    """... while a search over a range of tile sizes loads the kernels (their start-up pays
+    for its many scans: 512², 224..288 took 3.2 s on the numpy twins against 0.49 s)."""
     out = subprocess.run(
         [sys.executable, "-c", PROBE], capture_output=True, text=True, check=True, timeout=300
     )
-    assert out.stdout.split() == ["False", "False", "True"]
+    assert out.stdout.split() == ["False", "False", "True", "True"]
