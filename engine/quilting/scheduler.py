@@ -208,7 +208,8 @@ def uses_processes(q: Quilter) -> bool:
     :data:`POOL_MIN_SAMPLE_AREA` and :data:`BATCH_MAX_SAMPLE_AREA`, where a block's Python glue
     holds the GIL for about a third of its time (larger samples' transforms release the GIL
     long enough for threads), on a system with ``fork``. Same records and image either way
-    (each task is one block on one thread and on workers alike). Job B fast, interleaved with
+    (every block is searched alone, whether a task holds one block, on one thread, or
+    :data:`PROCESS_BATCH` blocks, on workers). Job B fast, interleaved with
     threads under load 9-10: 2 threads 0.461 s (slower than one, 0.422 s), 2 workers 0.307 s."""
     area = q.sample.shape[0] * q.sample.shape[1]
     return (

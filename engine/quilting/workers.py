@@ -13,7 +13,8 @@ threads were no faster than one. So where ``fork`` exists,
   options) copy-on-write;
 * the calling process and ``threads - 1`` forked workers each take the lowest ready task (the
   ready set, a lock and a semaphore live in shared memory), run exactly the task a thread would
-  run (:meth:`Quilter.run_batch` of one block whose predecessors are placed) and release its
+  run (:meth:`Quilter.run_batch` of a task's blocks, each searched alone, once their
+  predecessors are placed) and release its
   dependents; the workers send their records and pixels back through a ring of shared memory
   each (:class:`_Mailbox`; a pipe for what does not fit), packed by :func:`pack_records`;
 * every block is searched and placed by the same code on exactly the canvas its predecessors
@@ -22,7 +23,10 @@ threads were no faster than one. So where ``fork`` exists,
 
 No worker is forked while another thread loads the numba kernels, an FFT backend or compiles
 (a child would inherit that lock held and wait for it forever): this process then runs every
-task itself. Cancelling, an error in a worker or closing the generator kills the workers at once.
+task itself. Cancelling, an error in a worker or closing the generator kills the workers at once;
+a worker that sends nothing for :data:`STUCK_S` while this process waits for it is taken as
+stuck (a lock this process held at the fork that the list above misses) and the run fails with
+that message rather than waiting forever.
 ``QUILT_STUDIO_WORKERS=threads`` keeps threads.
 """
 
@@ -40,6 +44,7 @@ import signal
 import struct
 import sys
 import threading
+import time
 from multiprocessing.connection import Pipe
 
 import numpy as np
@@ -99,7 +104,8 @@ def _shared(n: int, dtype) -> np.ndarray:
 class WorkerPool:
     """Runs every task once, each as soon as the tasks it ``needs`` have run, in this process
     and ``workers - 1`` forked ones; :meth:`result` returns one task's result (``run(task)``'s,
-    through ``receive`` when it ran in a worker; it must pickle). Tasks before ``done`` count
+    through ``receive`` when it ran in a worker; it must pickle unless ``pack`` packs it). Tasks
+    before ``done`` count
     as run.
 
     The tasks must write their effects only to memory shared before the pool was made (see
@@ -115,7 +121,8 @@ class WorkerPool:
 
         ctx = get_context("fork")
         self.run, self.receive, self.cancel = run, receive, cancel
-        # pack(result) -> bytes, sent as is and handed to receive (default: pickled, unpickled)
+        # pack(result) -> uint8 arrays sent one after the other; receive then gets the message's
+        # bytes (a memoryview, valid during the call) instead of the unpickled result
         self.pack = pack
         self.results: dict[int, object] = {}
         n = len(needs)
@@ -134,6 +141,7 @@ class WorkerPool:
             self.ready.release()
         self.left = n - done  # tasks whose results are not in yet
         self.news = ctx.Semaphore(0)  # released by a worker after each message
+        self.heard = time.monotonic()  # when a message last came in (or this process last ran one)
         self.boxes: list[_Mailbox] = []
         self.conns, self.procs = [], []
         owner = os.getpid()
@@ -228,11 +236,17 @@ class WorkerPool:
         elif any(proc.exitcode is not None for proc in self.procs):  # no message, one gone
             self._take_messages()  # (its error, if it sent one)
             raise RuntimeError("a quilting worker process died")
+        elif time.monotonic() - self.heard > STUCK_S:
+            raise RuntimeError(
+                f"a quilting worker process sent nothing for {STUCK_S:.0f} s: it is stuck"
+            )
 
     def _take_messages(self) -> bool:
         got = False
         for box in self.boxes:
             got |= box.take(self._handle)
+        if got:
+            self.heard = time.monotonic()
         return got
 
     def _handle(self, data) -> None:
@@ -256,6 +270,7 @@ class WorkerPool:
                 self.results[j] = self.run(j)
                 self.left -= 1
                 self._finish(j)
+                self.heard = time.monotonic()  # the workers' silence counts from here
             elif self.conns:
                 self._collect(0.05)
             else:  # pragma: no cover - a task whose needs never run
@@ -283,6 +298,9 @@ class WorkerPool:
 
 READY, TAKEN = 1, 2
 OK, ERROR = 0, 1
+STUCK_S = 120.0
+"""Seconds without a message from a worker, while this process has nothing to run, after which
+the worker counts as stuck (a task takes milliseconds; this is a margin for a loaded machine)."""
 RING_BYTES = 1 << 20
 """Each worker's ring of shared memory for its messages (job B's are ~40 kB)."""
 
@@ -355,7 +373,10 @@ class _Mailbox:
 
 
 def _recv(conn) -> bytes:
+    """The next piped message (counted by the worker just before it sends it)."""
     try:
+        if not conn.poll(STUCK_S):  # e.g. a copy of the pipe's end kept open by another fork
+            raise RuntimeError(f"a quilting worker process sent nothing for {STUCK_S:.0f} s")
         return conn.recv_bytes()
     except EOFError:
         raise RuntimeError("a quilting worker process died") from None

@@ -108,7 +108,10 @@ def test_messages_through_a_small_ring_and_the_pipe(ring, pools, monkeypatch):
     monkeypatch.setattr(workers, "RING_BYTES", ring)
     kw = dict(block=28, overlap=6, rng=4, mode="exact", adaptive_threshold=0.02)
     mine, ref = (list(iter_quilt(SAMPLE, (200, 220), threads=t, **kw)) for t in (2, 1))
-    assert pools
+    assert pools and pools[0].boxes
+    piped = sum(box.piped for box in pools[0].boxes)
+    through_ring = sum(box.read for box in pools[0].boxes)
+    assert piped > 0 if ring == 4096 else through_ring > 0  # the path this size takes
     placed = [[e for e in run if isinstance(e, BlockPlaced)] for run in (mine, ref)]
     assert len(placed[0]) == len(placed[1])
     for a, b in zip(*placed, strict=True):
@@ -213,11 +216,12 @@ from engine.quilting.workers import WorkerPool
 
 def run(k):  # a task that loads the kernels' lock, as a worker's first kernel call does
     with _jit.LOADING_LOCK:
-        time.sleep(0.02)  # long enough for both processes to take tasks
+        time.sleep(0.05)  # 2 s in all: time enough for both processes to take tasks
         return os.getpid()
 
-def pids():
+def pids(made=lambda: None):
     pool = WorkerPool(run, lambda pid: pid, [[] for _ in range(40)], 2)
+    made()
     try:
         return {pool.result(k) for k in range(40)}
     finally:
@@ -230,8 +234,7 @@ def warm_up():  # another thread holding the lock while the pool forks (the edit
         stop.wait()
 threading.Thread(target=warm_up, daemon=True).start()
 started.wait()
-threading.Timer(0.5, stop.set).start()
-busy = pids()
+busy = pids(stop.set)  # made while the lock is held; the warm-up ends before the tasks run
 free = pids()
 print(busy == {os.getpid()}, len(free))
 """
@@ -249,3 +252,27 @@ def test_no_worker_is_forked_while_another_thread_loads_the_kernels():
     )
     assert out.returncode == 0, out.stderr
     assert out.stdout.split() == ["True", "2"]
+
+
+def test_a_stuck_worker_fails_the_run_instead_of_waiting_forever(monkeypatch):
+    """A worker that sends nothing (stuck, e.g. on a lock inherited held) ends the run with an
+    error after :data:`workers.STUCK_S` instead of holding it forever."""
+    import time
+
+    monkeypatch.setattr(workers, "STUCK_S", 1.0)
+    parent = os.getpid()
+
+    def run(k):
+        if os.getpid() != parent:
+            time.sleep(60)  # stuck (killed at shutdown)
+        time.sleep(0.05)  # 2 s in all: time enough for the worker to take a task
+        return k
+
+    pool = workers.WorkerPool(run, lambda k: k, [[] for _ in range(40)], 2)
+    try:
+        assert pool.procs  # a worker was forked
+        with pytest.raises(RuntimeError, match="stuck"):
+            for k in range(40):
+                pool.result(k)
+    finally:
+        pool.shutdown(kill=True)
