@@ -36,7 +36,9 @@ def test_library_lists_every_photo_failed_first_with_the_index_columns(qtbot, li
     window = make_window(qtbot)
     view = open_library(qtbot, window, library)
     assert window.docks["library"].isVisible()
-    qtbot.waitUntil(lambda: window.docks["library"].height() >= 0.4 * window.height())  # browsable
+    qtbot.waitUntil(  # browsable
+        lambda: window.docks["library"].height() >= 0.4 * window.height(), timeout=WAIT_MS
+    )
     table = view.table
     names = [table.model().index(r, 0).data() for r in range(table.model().rowCount())]
     assert names == [e.name for e in read_library(library)]

@@ -59,6 +59,10 @@ def test_closing_the_banner_takes_its_line_off_the_status_bar(qtbot):
     assert w.last_message().startswith("Synthesized 128×128")
     w.message_bar.dismiss()  # closed (or faded already on a slow machine)
     assert w.statusBar().currentMessage() == ""  # not the quilt's line on the Source tab
+    w.show_message("info", "a note")  # the same, without the 10 s fade a slow machine may reach
+    assert w.statusBar().currentMessage() == "a note"
+    w.message_bar.dismiss()
+    assert w.statusBar().currentMessage() == ""
     w.show_message("warning", "a question")
     w.statusBar().showMessage("a newer line")
     w.message_bar.dismiss()
