@@ -294,6 +294,14 @@ def crop_frame(S, T: int, limit: int, tiles: int = 16, sets: int = 1) -> float:
     return float(np.median(values))
 
 
+def layouts_of(ws, seed: int):
+    """The benchmark's random valid 8x8 layouts of one Wang set (the lattice's and corners')."""
+    return [
+        wang_layout(ws.signatures, 8, 8, rng=100 * seed + k, no_equal_neighbours=True)
+        for k in range(LATTICE_LAYOUTS)
+    ]
+
+
 def wang_figures(S, T: int, seed: int, options: dict, docs_file: Path | None = None):
     """One Wang set's figures: joint ratios (list), lattice dB above its floor, frame over
     2 w_P of the default ring, frame over half the tile, detail (the tiles' median detail
@@ -301,17 +309,13 @@ def wang_figures(S, T: int, seed: int, options: dict, docs_file: Path | None = N
     detail ratio itself, the lattice above the continued floor, and the frame's ratio profile
     (:attr:`engine.metrics.Frame.ratio`)."""
     ws = wang_set(S, tile_size=T, rng=seed, **options)
-    sigs = ws.signatures
 
     def touches(a, b, direction):
         i, j = (1, 3) if direction == "horizontal" else (2, 0)
         return a.signature[i] == b.signature[j]
 
     pairs = _pairs(ws.tiles, touches)
-    layouts = [
-        wang_layout(sigs, 8, 8, rng=100 * seed + k, no_equal_neighbours=True)
-        for k in range(LATTICE_LAYOUTS)
-    ]
+    layouts = layouts_of(ws, seed)
     # the crops carry each tile's outer pixel: what every construction takes from its edge
     # samples (a wider margin would hide a construction's own shared ring)
     lat = lattice(ws.tiles, S, margin=1, layouts=layouts)

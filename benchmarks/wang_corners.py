@@ -32,24 +32,15 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from benchmarks._util import format_table  # noqa: E402
-from benchmarks.wang import RESULTS, _fit, _stamp, _textures  # noqa: E402
+from benchmarks.wang import RESULTS, _fit, _stamp, _textures, layouts_of  # noqa: E402
 from engine.metrics import LATTICE_LAYOUTS, corner_energy, mean_step, step_windows  # noqa: E402
 from engine.tiles.layout import assemble  # noqa: E402
 from engine.tiles.wang import wang_set  # noqa: E402
-from engine.tiles.wang_layout import wang_layout  # noqa: E402
 
 #: draws of random source windows behind the floor
 FLOOR_DRAWS = 200
 #: side of the patch pasted on every crossing by the planted oracle
 PLANT = 6
-
-
-def layouts_of(ws, seed: int):
-    """The benchmark's layouts of one set (as :func:`benchmarks.wang.wang_figures`)."""
-    return [
-        wang_layout(ws.signatures, 8, 8, rng=100 * seed + k, no_equal_neighbours=True)
-        for k in range(LATTICE_LAYOUTS)
-    ]
 
 
 def set_corners(S, T: int, seed: int, options: dict, docs_file: Path | None = None):

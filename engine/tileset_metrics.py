@@ -474,7 +474,9 @@ _ADVICE = {
 }
 
 
-def quality_warnings(q: dict) -> list[str]:
+def quality_warnings(q: dict, advice: dict[str, str] | None = None) -> list[str]:
     """What :func:`tileset_quality`'s figures mean for a person, in words (empty: none of
-    issue 10's limits is exceeded)."""
-    return [_ADVICE[k].format(v=q[k], lim=lim) for k, lim in QUALITY_LIMITS.items() if q[k] > lim]
+    issue 10's limits is exceeded); ``advice`` replaces the texts (``{v}`` the figure, ``{lim}``
+    its limit), e.g. in the editor's words."""
+    advice = _ADVICE if advice is None else advice
+    return [advice[k].format(v=q[k], lim=lim) for k, lim in QUALITY_LIMITS.items() if q[k] > lim]

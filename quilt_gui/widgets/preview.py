@@ -63,10 +63,9 @@ def editor_advice(flattened: bool) -> dict[str, str]:
 
 def editor_warnings(q: dict, flattened: bool) -> list[str]:
     """:func:`engine.metrics.quality_warnings` of the figures ``q`` in the editor's words."""
-    from engine.metrics import QUALITY_LIMITS
+    from engine.metrics import quality_warnings
 
-    advice = editor_advice(flattened)
-    return [advice[k].format(v=q[k], lim=lim) for k, lim in QUALITY_LIMITS.items() if q[k] > lim]
+    return quality_warnings(q, editor_advice(flattened))
 
 
 def set_quality(tiles, source, template, settings, *, cancel=None) -> dict:
