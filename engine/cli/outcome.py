@@ -30,6 +30,10 @@ _received: list[int] = []
 the middle of an extension module's import: the command then still ends with its code)."""
 
 
+RAISE_AGAIN = 5
+"""Times a dropped signal is raised again (each lands somewhere new: one more drop is rare)."""
+
+
 def _on_signal(signum, frame):
     _received.append(signum)
     raise Terminated if signum == signal.SIGTERM else KeyboardInterrupt
@@ -42,18 +46,27 @@ def _sigterm_as_interrupt():
         return
     previous = {s: signal.signal(s, _on_signal) for s in (signal.SIGTERM, signal.SIGINT)}
     hook = sys.unraisablehook
+    active = [True]
 
-    def quiet_swallowed_signal(unraisable):
-        """The signal's exception raised where Python cannot pass it on (a ctypes callback of
-        numba's compiler, seen in CI on a cold cache) is printed as a traceback and dropped;
-        the command still ends with the signal's code and line (:func:`run_command`)."""
+    def again(signum):
+        if active[0]:
+            signal.raise_signal(signum)
+
+    def swallowed_signal_again(unraisable):
+        """The signal's exception raised where Python cannot pass it on — a ctypes callback of
+        numba's compiler, a destructor, an at-fork hook (seen: logging's, at the quilting
+        workers' fork) — is dropped: print nothing and raise the signal again a moment later,
+        once that code has returned, so the job still stops."""
         if not (_received and isinstance(unraisable.exc_value, KeyboardInterrupt)):
             hook(unraisable)
+        elif len(_received) <= RAISE_AGAIN:
+            threading.Timer(0.05, again, (_received[-1],)).start()
 
-    sys.unraisablehook = quiet_swallowed_signal
+    sys.unraisablehook = swallowed_signal_again
     try:
         yield
     finally:
+        active[0] = False
         sys.unraisablehook = hook
         for s, handler in previous.items():
             signal.signal(s, handler)

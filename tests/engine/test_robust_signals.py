@@ -230,3 +230,34 @@ def test_a_signal_swallowed_where_it_was_raised_still_ends_with_its_code(capsys,
         "no output was left half-written"
     ), err
     assert "Traceback" not in err and "internal error" not in err
+
+
+@pytest.mark.parametrize("name", ["SIGINT", "SIGTERM"])
+def test_a_signal_dropped_where_it_was_raised_still_stops_the_job(capsys, name):
+    """A signal landing where Python drops its exception (a ctypes callback here; seen in a
+    destructor of numba's compiler and in logging's at-fork hook at the workers' fork, 1 run in
+    20 under load) is raised again once that code has returned: the job stops instead of
+    running to its end ("interrupted as it finished")."""
+    import ctypes
+    import types
+
+    from engine.cli.outcome import run_command
+
+    sig, code, word = SIGNALS[name]
+    steps = []
+
+    def job(args):
+        ctypes.CFUNCTYPE(None)(lambda: os.kill(os.getpid(), sig))()  # dropped here
+        for _ in range(100):  # 10 s of work unless stopped
+            time.sleep(0.1)
+            steps.append(1)
+        return 0
+
+    rc = run_command(types.SimpleNamespace(command="synth", func=job))
+    err = capsys.readouterr().err
+    assert rc == code, err
+    assert err.strip().endswith(
+        f"quilt-studio synth: {word}{' (SIGTERM)' if code == 143 else ''}; "
+        "no output was left half-written"
+    ), err
+    assert len(steps) < 100 and "Traceback" not in err
