@@ -132,8 +132,10 @@ def run_command(args) -> int:
     try:
         with _sigterm_as_interrupt(), _warnings_as_lines(name):
             code = int(args.func(args) or 0)
-        if _received:  # a signal came but was swallowed where it was raised: the work is done
-            term = _received[0] == signal.SIGTERM
+        term = bool(_received) and _received[0] == signal.SIGTERM
+        if _received and code != (143 if term else 130):
+            # a signal came but was swallowed where it was raised: the work is done (a command
+            # that stops on it itself, the batch, returns its code and has said so)
             what = "terminated (SIGTERM)" if term else "interrupted"
             print(f"{name}: {what} as it finished; its outputs are complete", file=sys.stderr)
             return 143 if term else 130

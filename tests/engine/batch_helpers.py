@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import json
+import os
+import time
 from pathlib import Path
 
 import numpy as np
@@ -69,3 +71,35 @@ def tile_bytes(lib: Path) -> dict[str, bytes]:
         for p in sorted(lib.glob("*/*"))
         if p.suffix in (".png", ".quiltproj") and not p.parent.name.startswith(".")
     }
+
+
+HOLD = "QUILT_TEST_BATCH_HOLD"
+"""Environment of a batch run by a test: ``FOLDER`` + ``os.pathsep`` + ``NAME`` makes its
+worker hold photo NAME (file name) once its temporary folder is filled, before the rename
+into the library, and touch ``FOLDER/NAME.held``: the test kills or interrupts it there,
+whatever the machine's load."""
+HOLD_S = 300.0  # a held worker that no one stops fails its photo after this (never reached)
+
+
+def held_worker_main(*args) -> None:
+    """The batch worker's loop (``engine.batch.pool``'s), holding as :data:`HOLD` says; a
+    test's ``quilt-studio batch`` process starts its workers on this (it is importable by
+    name in a spawned process)."""
+    import engine.batch.pool as pool
+    import engine.batch.task as task
+
+    folder, name = os.environ[HOLD].split(os.pathsep, 1)
+    make = task.make_folder
+
+    def make_folder(tmp, photo, *a, **kw):
+        record = make(tmp, photo, *a, **kw)
+        if photo.name == name:
+            (Path(folder) / f"{name}.held").touch()
+            t0 = time.monotonic()
+            while time.monotonic() - t0 < HOLD_S:
+                time.sleep(0.01)
+            raise RuntimeError(f"{name} was held {HOLD_S:.0f} s and not stopped")
+        return record
+
+    task.make_folder = make_folder
+    pool._worker_main(*args)

@@ -18,6 +18,7 @@ from engine.batch.task import run_photo
 from engine.cli import main
 from tests.engine.batch_helpers import (
     FAST,
+    HOLD,
     SMALL,
     photo_folders,
     tile_bytes,
@@ -39,35 +40,38 @@ def batch(*args, capsys=None) -> tuple[int, str]:
     return code, err
 
 
-def cli(*args, **kwargs) -> subprocess.Popen:
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def cli(*args, hold: tuple[Path, str] | None = None, **kwargs) -> subprocess.Popen:
+    """``quilt-studio batch ARGS`` in a process of its own; with ``hold`` (folder, photo file
+    name) its worker holds that photo before its rename (:func:`held_worker_main`)."""
+    code = "import sys; from engine.cli import main; sys.exit(main())"
+    env = None
+    if hold is not None:
+        code = (
+            f"import sys; sys.path.insert(0, {str(ROOT)!r}); import engine.batch.pool as p; "
+            "from tests.engine.batch_helpers import held_worker_main as w; "
+            f"p._worker_main = w; {code}"
+        )
+        env = {**os.environ, HOLD: f"{hold[0]}{os.pathsep}{hold[1]}"}
     return subprocess.Popen(
-        [
-            sys.executable,
-            "-c",
-            "import sys; from engine.cli import main; sys.exit(main())",
-            "batch",
-            *map(str, args),
-        ],
+        [sys.executable, "-c", code, "batch", *map(str, args)],
         stderr=subprocess.PIPE,
         text=True,
+        env=env,
         **kwargs,
     )
 
 
-def wait_for_done(lib: Path, n: int, proc: subprocess.Popen, timeout: float = 120) -> None:
+def wait_for_held(folder: Path, name: str, proc: subprocess.Popen, timeout: float = 120) -> None:
+    """Wait until the batch's worker holds photo ``name`` (a margin, not a bound)."""
     t0 = time.monotonic()
-    while time.monotonic() - t0 < timeout:
-        if lib.is_dir():
-            done = [
-                d
-                for d in lib.iterdir()
-                if not d.name.startswith(".") and (d / "manifest.json").is_file()
-            ]
-            if len(done) >= n:
-                return
+    while not (folder / f"{name}.held").exists():
         assert proc.poll() is None, proc.stderr.read()
+        if time.monotonic() - t0 > timeout:
+            pytest.fail(f"the batch did not reach {name} in {timeout} s")
         time.sleep(0.02)
-    pytest.fail(f"no {n} photo(s) finished in {timeout} s")
 
 
 def test_failures_are_listed_the_rest_done_exit_3_then_resume(tmp_path, capsys):
@@ -123,13 +127,26 @@ def group_alive(pgid: int) -> list[int]:
 
 
 def test_kill_9_then_ctrl_c_each_rerun_finishes_only_the_rest(tmp_path, capsys):
-    write_photos(tmp_path / "in", names=("brick", "gravel", "lichen", "grass", "cobblestones"))
-    lib = tmp_path / "lib"
+    """Each stop lands while a photo's folder is filled but not yet in place (the worker holds
+    there: the test does not race the batch, which on a loaded machine had made one photo
+    more, or all of them, before the signal came)."""
+    names = ("brick", "cobblestones", "grass", "gravel", "lichen")  # the order they are made
+    write_photos(tmp_path / "in", names=names)
+    lib, gate = tmp_path / "lib", tmp_path / "gate"
+    gate.mkdir()
     # 1. kill -9 halfway: complete folders or none, never a torn one. The library is read once
-    # every process of the batch has ended: its worker, killed with it by the kernel, may still
-    # finish the rename it is in on a loaded machine (one more photo done than read here)
-    proc = cli(tmp_path / "in", "--out", lib, *FAST, "--jobs", "1", start_new_session=True)
-    wait_for_done(lib, 1, proc)
+    # every process of the batch has ended (the worker dies with the batch)
+    proc = cli(
+        tmp_path / "in",
+        "--out",
+        lib,
+        *FAST,
+        "--jobs",
+        "1",
+        start_new_session=True,
+        hold=(gate, "cobblestones.png"),
+    )
+    wait_for_held(gate, "cobblestones.png", proc)
     proc.send_signal(signal.SIGKILL)
     proc.wait()
     t0 = time.monotonic()
@@ -137,23 +154,33 @@ def test_kill_9_then_ctrl_c_each_rerun_finishes_only_the_rest(tmp_path, capsys):
         time.sleep(0.02)
     assert group_alive(proc.pid) == [], "the killed batch's worker did not end"
     first = photo_folders(lib)  # raises on a torn folder
-    assert 1 <= len(first) < 4
+    assert [d.split("-")[0] for d in first] == ["brick"]  # the filled temporary is not done
+    assert any(t.startswith(".cobblestones-") for t in temporaries(lib))
     stamps = {d: (lib / d / "manifest.json").stat().st_mtime_ns for d in first}
     # 2. the re-run skips those, makes more, and is stopped by Ctrl-C (the process group's)
-    proc = cli(tmp_path / "in", "--out", lib, *FAST, "--jobs", "1", start_new_session=True)
-    wait_for_done(lib, len(first) + 1, proc)
+    proc = cli(
+        tmp_path / "in",
+        "--out",
+        lib,
+        *FAST,
+        "--jobs",
+        "1",
+        start_new_session=True,
+        hold=(gate, "gravel.png"),
+    )
+    wait_for_held(gate, "gravel.png", proc)
     os.killpg(proc.pid, signal.SIGINT)
     _, err = proc.communicate(timeout=120)
     assert proc.returncode == 130, err
-    assert "interrupted" in err
+    assert "interrupted: the photos made so far are kept" in err and "as it finished" not in err
     second = photo_folders(lib)
-    assert summary(err) == (5, len(second) - len(first), len(first), 0, 0)
-    assert len(second) < 5
+    assert [d.split("-")[0] for d in second] == ["brick", "cobblestones", "grass"]
+    assert summary(err) == (5, 2, 1, 0, 0)
     assert temporaries(lib) == []  # the killed run's are cleaned, Ctrl-C leaves none
     # 3. the last run finishes the rest only; nothing made before is touched
     code, err = batch(tmp_path / "in", "--out", lib, *FAST, "--jobs", "1", capsys=capsys)
     assert code == 0, err
-    assert summary(err) == (5, 5 - len(second), len(second), 0, 0)
+    assert summary(err) == (5, 2, 3, 0, 0)
     assert len(photo_folders(lib)) == 5 and temporaries(lib) == []
     assert all((lib / d / "manifest.json").stat().st_mtime_ns == stamps[d] for d in first)
 
