@@ -38,6 +38,7 @@ __all__ = [
     "Frame",
     "Lattice",
     "QUALITY_LIMITS",
+    "command_advice",
     "duplicates",
     "edge_distance",
     "frame",
@@ -460,23 +461,33 @@ def tileset_quality(tiles, source, *, template, ring: int, margin: int, rng=0) -
     }
 
 
-#: Per figure of :func:`tileset_quality`: what exceeding its limit means, in words.
-_ADVICE = {
-    "frame": "the tiles show a frame (frame {v:.2f} > {lim}): try Flatten lighting, a wider "
-    "patch search or a smaller patch ring",
-    "ring_tone": "the shared ring differs in tone from the patches (ring tone {v:.2f} > {lim}): "
-    "try Flatten lighting or another template position",
-    "duplicates": "{v} candidate(s) repeat the template or each other: use a larger source, "
-    "smaller tiles or fewer candidates",
-    "lattice": "a layout shows a lattice at the tile period ({v:+.1f} dB above the floor of a "
-    "shared border): structured textures may need smaller patch rings, larger tiles or a Wang "
-    "set",
-}
+def command_advice(flattened: bool = False) -> dict[str, str]:
+    """Per figure of :func:`tileset_quality`: what exceeding its limit means and what to try,
+    in the command line's words; Flatten lighting is suggested only while it is off
+    (``flattened`` False), else said to be on (as the editor's texts do)."""
+    if flattened:
+        tone, frame_try, ring_try = " although Flatten lighting is on", "", ""
+    else:
+        tone, frame_try, ring_try = "", "Flatten lighting, ", "Flatten lighting or "
+    return {
+        "frame": f"the tiles show a frame (frame {{v:.2f}} > {{lim}}){tone}: try {frame_try}a "
+        "wider patch search or a smaller patch ring",
+        "ring_tone": "the shared ring differs in tone from the patches (ring tone {v:.2f} > "
+        f"{{lim}}){tone}: try {ring_try}another template position",
+        "duplicates": "{v} candidate(s) repeat the template or each other: use a larger source, "
+        "smaller tiles or fewer candidates",
+        "lattice": "a layout shows a lattice at the tile period ({v:+.1f} dB above the floor of "
+        "a shared border): structured textures may need smaller patch rings, larger tiles or a "
+        "Wang set",
+    }
 
 
-def quality_warnings(q: dict, advice: dict[str, str] | None = None) -> list[str]:
+def quality_warnings(
+    q: dict, advice: dict[str, str] | None = None, *, flattened: bool = False
+) -> list[str]:
     """What :func:`tileset_quality`'s figures mean for a person, in words (empty: none of
     issue 10's limits is exceeded); ``advice`` replaces the texts (``{v}`` the figure, ``{lim}``
-    its limit), e.g. in the editor's words."""
-    advice = _ADVICE if advice is None else advice
+    its limit), e.g. in the editor's words; without it, :func:`command_advice` of
+    ``flattened`` (whether the set was made with Flatten lighting on)."""
+    advice = command_advice(flattened) if advice is None else advice
     return [advice[k].format(v=q[k], lim=lim) for k, lim in QUALITY_LIMITS.items() if q[k] > lim]

@@ -533,7 +533,7 @@ def _quality_summary(S, result, say) -> dict:
             f"lattice {q['lattice']:+.1f} dB above its floor, template share "
             f"{q['template_share']:.0%}; template wrap {q['wrap']:.2f}, detail {q['detail']:.2f}"
         )
-    q["warnings"] = quality_warnings(q) if result.candidates else []
+    q["warnings"] = quality_warnings(q, flattened=s.flatten) if result.candidates else []
     for text in q["warnings"]:
         warnings.warn(text, stacklevel=2)
     return q

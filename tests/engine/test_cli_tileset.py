@@ -364,3 +364,22 @@ def test_default_patch_ring_is_the_engines(src, tmp_path):
     for c in cands:
         tile = png(out / f"tile_{c.index:03d}.png")
         np.testing.assert_array_equal(tile, quantize(c.tile, 8, dither=False))
+
+
+def test_quality_warnings_do_not_suggest_flatten_lighting_when_it_is_on(tmp_path, capsys):
+    """A set made with ``--flatten`` whose tiles show a frame (1.52 here, limit 1.15): the
+    warning says Flatten lighting is on rather than suggesting it (as the editor's do)."""
+    from PIL import Image
+
+    photo = tmp_path / "brick.png"
+    Image.open(resources.sample_path("brick")).convert("RGB").crop((0, 30, 96, 126)).save(photo)
+    out = tmp_path / "set"
+    args = ["--tile-size", "32", "--candidates", "3", "--flatten"]
+    assert main(["tileset", str(photo), "--out", str(out), *args]) == 0
+    err = capsys.readouterr().err
+    (text,) = [w for w in err.splitlines() if "the tiles show a frame" in w]
+    assert "although Flatten lighting is on: try a wider patch search" in text, text
+    assert "try Flatten lighting" not in err
+    assert (
+        text.split("warning: ", 1)[1] in json.loads((out / "manifest.json").read_text())["warnings"]
+    )

@@ -162,3 +162,16 @@ def test_tileset_quality_and_its_warnings_in_words(source):
     framed = [np.where(ring[..., None], c * 0.5, c) for c in cs]
     words = quality_warnings(tileset_quality(framed, source, template=t, ring=8, margin=1))
     assert any(w.startswith("the tiles show a frame") for w in words)
+
+
+def test_quality_warnings_suggest_flatten_lighting_only_while_it_is_off():
+    from engine.metrics import quality_warnings
+
+    q = {"frame": 1.3, "ring_tone": 1.5, "duplicates": 0, "lattice": 0.0}
+    off, on = quality_warnings(q), quality_warnings(q, flattened=True)
+    assert [w.split(":")[-1] for w in off] == [
+        " try Flatten lighting, a wider patch search or a smaller patch ring",
+        " try Flatten lighting or another template position",
+    ]
+    assert all("although Flatten lighting is on: try" in w for w in on), on
+    assert not any("try Flatten lighting" in w for w in on), on
