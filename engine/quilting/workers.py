@@ -151,7 +151,7 @@ class WorkerPool:
             # the objects alive now are left out of the garbage collector's passes while the
             # workers run: a full pass writes to every object, and after the fork every page
             # written is copied (a pass in this process took 57 ms instead of ~25 ms)
-            gc.freeze()
+            _GC_FREEZE.enter()
         try:
             # with a loading lock held by another thread (the editor's kernel warm-up), a forked
             # worker would inherit it held by no one and wait for it forever: no fork then, this
@@ -293,7 +293,32 @@ class WorkerPool:
         self.conns, self.procs = [], []
         if self.frozen:
             self.frozen = False
-            gc.unfreeze()
+            _GC_FREEZE.leave()
+
+
+class _GcFreeze:
+    """``gc.freeze()`` while any pool runs. The freeze is the process's: with two pools at once
+    (the editor's two jobs, the batch's threads) the first pool's end must not end the other's
+    freeze, so the pools are counted and the last one to end unfreezes. Each pool freezes
+    again as it starts (the objects made since the first freeze are its parent's too)."""
+
+    def __init__(self):
+        self.lock = threading.Lock()  # never taken by a forked worker
+        self.pools = 0
+
+    def enter(self) -> None:
+        with self.lock:
+            self.pools += 1
+            gc.freeze()
+
+    def leave(self) -> None:
+        with self.lock:
+            self.pools -= 1
+            if not self.pools:
+                gc.unfreeze()
+
+
+_GC_FREEZE = _GcFreeze()
 
 
 READY, TAKEN = 1, 2

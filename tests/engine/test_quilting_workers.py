@@ -276,3 +276,23 @@ def test_a_stuck_worker_fails_the_run_instead_of_waiting_forever(monkeypatch):
                 pool.result(k)
     finally:
         pool.shutdown(kill=True)
+
+
+def test_one_pools_end_does_not_end_anothers_gc_freeze():
+    """``gc.freeze`` is the process's: with two pools at once (the editor's two jobs) the
+    objects stay frozen until the last pool ends, not the first."""
+    import gc
+
+    assert gc.get_freeze_count() == 0
+    a = workers.WorkerPool(lambda k: k, lambda k: k, [[] for _ in range(4)], 2)
+    try:
+        b = workers.WorkerPool(lambda k: k, lambda k: k, [[] for _ in range(4)], 2)
+        try:
+            assert a.frozen and b.frozen  # both forked their workers
+            a.shutdown(kill=True)
+            assert gc.get_freeze_count() > 0  # b's workers still run: still frozen
+        finally:
+            b.shutdown(kill=True)
+    finally:
+        a.shutdown(kill=True)
+    assert gc.get_freeze_count() == 0
