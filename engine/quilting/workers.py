@@ -131,6 +131,8 @@ class WorkerPool:
             for j in p:
                 self.dependents[j].append(k)
         self.lock, self.ready = ctx.Lock(), ctx.Semaphore(0)
+        self.procs = []
+        self.guard = _Holding(self.lock, self.procs)
         self.waiting = _shared(n, np.int32)
         self.waiting[:] = [sum(j >= done for j in p) for p in needs]
         self.state = _shared(n + 1, np.int8)  # last: stop
@@ -143,8 +145,8 @@ class WorkerPool:
         self.news = ctx.Semaphore(0)  # released by a worker after each message
         self.heard = time.monotonic()  # when a message last came in (or this process last ran one)
         self.boxes: list[_Mailbox] = []
-        self.conns, self.procs = [], []
-        owner = os.getpid()
+        self.conns = []
+        owner = self.owner = os.getpid()
         held = _take_loading_locks()
         self.frozen = held is not None and workers > 1
         if self.frozen:
@@ -165,6 +167,7 @@ class WorkerPool:
                 proc.start()
                 child.close()
                 box.conn = parent
+                box.guard.procs.append(proc)
                 self.boxes.append(box)
                 self.conns.append(parent)
                 self.procs.append(proc)
@@ -174,16 +177,21 @@ class WorkerPool:
         finally:
             _release(held)
 
+    def _locked(self):
+        """``self.lock`` to hold; in this process, a worker killed while it held the lock fails
+        the run (:class:`_Holding`)."""
+        return self.guard if os.getpid() == self.owner else self.lock
+
     def _take(self) -> int:
         """The lowest ready task, marked taken (the caller holds one count of ``ready``)."""
-        with self.lock:
+        with self._locked():
             k = int(np.flatnonzero(self.state[:-1] == READY)[0])
             self.state[k] = TAKEN
         return k
 
     def _finish(self, k: int) -> None:
         released = 0
-        with self.lock:
+        with self._locked():
             for d in self.dependents[k]:
                 self.waiting[d] -= 1
                 if not self.waiting[d]:
@@ -345,6 +353,7 @@ class _Mailbox:
         self.counts = _shared(3, np.int64)  # written, read, piped
         self.lock = ctx.Lock()
         self.conn = conn
+        self.guard = _Holding(self.lock, [])  # the caller's; its worker added when started
         self.read, self.piped = 0, 0  # the caller's own counts
 
     def put(self, parts: list[np.ndarray], pipe: bool = False) -> None:
@@ -374,7 +383,7 @@ class _Mailbox:
     def take(self, handle) -> bool:
         """(Caller) Hand the messages in, oldest first, to ``handle`` (a message in the ring is
         a view of it, valid during the call); whether there were any."""
-        with self.lock:
+        with self.guard:
             written, piped = int(self.counts[0]), int(self.counts[2])
         r = self.read
         if r == written and self.piped == piped:
@@ -389,12 +398,36 @@ class _Mailbox:
             r += _MSG.size + -(-n // _ALIGN) * _ALIGN
         if r != self.read:
             self.read = r
-            with self.lock:
+            with self.guard:
                 self.counts[1] = r
         while self.piped < piped:
             self.piped += 1
             handle(_recv(self.conn))
         return True
+
+
+class _Holding:
+    """``with`` it: ``lock``, held by the calling process. The workers hold their shared locks
+    for microseconds, but one killed meanwhile (the OOM killer, a user's kill) leaves its lock
+    held for ever: when the lock does not come within a second and one of ``procs`` (the
+    workers that take it) has ended, or after :data:`STUCK_S`, the run fails with that instead
+    of waiting for ever."""
+
+    __slots__ = ("lock", "procs")
+
+    def __init__(self, lock, procs: list):
+        self.lock, self.procs = lock, procs
+
+    def __enter__(self) -> None:
+        t0 = time.monotonic()
+        while not self.lock.acquire(timeout=1.0):
+            if any(proc.exitcode is not None for proc in self.procs):
+                raise RuntimeError("a quilting worker process died holding the pool's lock")
+            if time.monotonic() - t0 > STUCK_S:
+                raise RuntimeError(f"a quilting worker process held a lock for {STUCK_S:.0f} s")
+
+    def __exit__(self, *exc) -> None:
+        self.lock.release()
 
 
 def _recv(conn) -> bytes:

@@ -296,3 +296,52 @@ def test_one_pools_end_does_not_end_anothers_gc_freeze():
     finally:
         a.shutdown(kill=True)
     assert gc.get_freeze_count() == 0
+
+
+KILLED_HOLDING_SCENARIO = """
+import os, signal, time
+import numpy as np
+from engine.quilting.workers import WorkerPool, share
+
+parent = os.getpid()
+killed = share(np.zeros(1, np.int8))  # set by the worker as it dies holding the lock
+
+class Pool(WorkerPool):
+    def _finish(self, k):
+        if os.getpid() != parent:  # a worker killed inside its critical section
+            self.lock.acquire()
+            killed[0] = 1
+            os.kill(os.getpid(), signal.SIGKILL)
+        super()._finish(k)
+
+def run(k):  # this process's first task ends once the worker has died (a margin of 60 s)
+    t0 = time.monotonic()
+    while os.getpid() == parent and not killed[0] and time.monotonic() - t0 < 60:
+        time.sleep(0.01)
+    return k
+
+pool = Pool(run, lambda k: k, [[] for _ in range(40)], 2)
+try:
+    assert pool.procs  # a worker was forked
+    for k in range(40):
+        pool.result(k)
+    print("finished")
+except RuntimeError as exc:
+    print(exc)
+finally:
+    pool.shutdown(kill=True)
+"""
+
+
+def test_a_worker_killed_holding_the_pools_lock_fails_the_run():
+    """A worker killed (OOM killer, a user's kill) while it holds the pool's shared lock: the
+    run fails with that instead of waiting for the lock for ever (in a process of its own,
+    which would hang without the fix)."""
+    import subprocess
+    import sys
+
+    out = subprocess.run(
+        [sys.executable, "-c", KILLED_HOLDING_SCENARIO], capture_output=True, text=True, timeout=120
+    )
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "a quilting worker process died holding the pool's lock"
