@@ -63,6 +63,7 @@ def _worker_main(conn, parent: int, settings: BatchSettings, library: str, threa
     signal.signal(signal.SIGINT, _interrupt_once)
     signal.signal(signal.SIGTERM, _interrupt_once)
     try:
+        _unblock_stops()  # a Ctrl-C of the worker's start-up lands here (see _Worker)
         while True:
             photo = conn.recv()
             if photo is None:
@@ -85,7 +86,21 @@ def _death(code: int | None) -> str:
     return f"the worker process died (exit code {code})"
 
 
+_STOPS = {signal.SIGINT, signal.SIGTERM}
+
+
+def _unblock_stops() -> None:
+    if hasattr(signal, "pthread_sigmask"):
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, _STOPS)
+
+
 class _Worker:
+    """One worker process. It starts with Ctrl-C and SIGTERM blocked (the signal mask is
+    inherited through the spawn): one that comes while its interpreter starts waits until
+    :func:`_worker_main` handles it (exit 130, no photo failed) instead of a traceback of the
+    start-up on the user's terminal and a worker dead with code 1. This process's own signal
+    waits those few milliseconds of the start, not more."""
+
     def __init__(self, ctx, settings, library, threads):
         self.conn, child = ctx.Pipe()
         self.process = ctx.Process(
@@ -94,7 +109,17 @@ class _Worker:
             daemon=True,
             name="quilt-batch-worker",
         )
-        self.process.start()
+        mask = None
+        if hasattr(signal, "pthread_sigmask"):
+            from multiprocessing import resource_tracker
+
+            resource_tracker.ensure_running()  # its start unblocks the signals: done first
+            mask = signal.pthread_sigmask(signal.SIG_BLOCK, _STOPS)
+        try:
+            self.process.start()
+        finally:
+            if mask is not None:
+                signal.pthread_sigmask(signal.SIG_SETMASK, mask)
         child.close()
         self.photo: Photo | None = None
 

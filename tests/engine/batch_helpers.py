@@ -103,3 +103,14 @@ def held_worker_main(*args) -> None:
 
     task.make_folder = make_folder
     pool._worker_main(*args)
+
+
+def interrupted_at_start_worker_main(*args) -> None:
+    """The batch worker's loop, after a Ctrl-C of the worker's own start-up (sent to itself
+    before the loop sets its handlers: a Ctrl-C while the interpreter starts)."""
+    import signal
+
+    import engine.batch.pool as pool
+
+    os.kill(os.getpid(), signal.SIGINT)
+    pool._worker_main(*args)

@@ -251,3 +251,20 @@ def test_a_worker_stopped_by_ctrl_c_stops_the_batch_and_fails_no_photo(tmp_path)
     assert not worker.is_alive() and worker.exitcode == 130
     assert {k: v["status"] for k, v in photo_folders(lib).items()} == {first.key: "done"}
     assert temporaries(lib) == []
+
+
+def test_a_ctrl_c_while_a_worker_starts_stops_the_batch_and_fails_no_photo(tmp_path, monkeypatch):
+    """A Ctrl-C that reaches a worker while its interpreter starts (before its handler is
+    set: the first second of a batch) waits for the handler: the worker stops as interrupted
+    (130), not with a traceback of its start-up and code 1 that failed its photo."""
+    import engine.batch.pool as pool
+    from tests.engine.batch_helpers import interrupted_at_start_worker_main
+
+    photos, _, _ = find_photos([str(p) for p in write_photos(tmp_path / "in", names=("brick",))])
+    lib = tmp_path / "lib"
+    lib.mkdir()
+    monkeypatch.setattr(pool, "_worker_main", interrupted_at_start_worker_main)
+    records = pool.iter_local(photos, SMALL, lib, jobs=1)
+    with pytest.raises(KeyboardInterrupt):
+        next(records)
+    assert photo_folders(lib) == {} and temporaries(lib) == []
