@@ -30,6 +30,7 @@ from engine import _jit as jit
 from engine._jit import njit
 from engine._validate import as_image, as_rng, positive_int
 from engine.fft import default_backend, inverse, next_fast_len, spectra, transforms
+from engine.spectral import product_sum
 
 __all__ = [
     "ZERO_ERROR_FRACTION",
@@ -40,6 +41,8 @@ __all__ = [
     "summed_area",
     "check_block",
     "error_floor",
+    "kth_at_most",
+    "least_and_count",
     "masked_ssd",
     "select_within_tolerance",
     "smallest_indices",
@@ -140,7 +143,7 @@ class SampleSpectrum:
         """``Σ_c corr(S_c, K_c)`` at every valid position for a batch of kernels (n, C, kh, kw)."""
         k = np.asarray(kernels, dtype=np.float32)
         n, c, kh, kw = k.shape
-        x = _product_sum(self._conj_spectra(k), self._hs)
+        x = product_sum(self._conj_spectra(k), self._hs)
         x *= np.float32(-0.5)
         h, w = self.shape
         return self._inverse(x, h - kh + 1, w - kw + 1)
@@ -153,7 +156,7 @@ class SampleSpectrum:
         out = [self._wcache.get(key) for key in keys]
         todo = [i for i, v in enumerate(out) if v is None]
         if todo:
-            fresh = _product_sum(self._conj_spectra(wts[todo], workers), self._fsq)
+            fresh = product_sum(self._conj_spectra(wts[todo], workers), self._fsq)
             for i, v in zip(todo, fresh, strict=True):
                 out[i] = v
                 if (len(self._wcache) + 1) * v.nbytes <= WEIGHT_CACHE_BYTES:
@@ -208,9 +211,7 @@ class SampleSpectrum:
         if bh > h or bw > w:
             raise ValueError(f"block {bw}x{bh} is larger than the sample {w}x{h}")
         const = np.asarray(const, dtype=np.float64).astype(np.float32)
-        x = _product_sum(self._conj_spectra(k, workers), self._hs)
-        for xi, wt in zip(x, self._weight_terms(wts, workers), strict=True):
-            xi += wt
+        x = product_sum(self._conj_spectra(k, workers), self._hs, self._weight_terms(wts, workers))
         if not jit.loaded():  # a small job without numba: the same values from numpy
             e = self._inverse(x, h - bh + 1, w - bw + 1, workers)
             e += const[:, None, None]
@@ -259,15 +260,6 @@ class TiledSpectrum(SampleSpectrum):
                 part = spec.ssd_terms(k, weights, const, workers=wk)
                 out[:, y0 : y0 + part.shape[1], x0 : x0 + part.shape[2]] = part
         return out
-
-
-def _product_sum(fk: np.ndarray, hs: np.ndarray) -> np.ndarray:
-    """``Σ_c fk[:, c] · hs[c]`` (one temporary for all channels)."""
-    x = np.multiply(fk[:, 0], hs[0])
-    t = np.empty_like(x) if fk.shape[1] > 1 else None
-    for c in range(1, fk.shape[1]):
-        x += np.multiply(fk[:, c], hs[c], out=t)
-    return x
 
 
 @njit(cache=True, nogil=True)
@@ -423,12 +415,12 @@ def select_within_tolerance(errors: np.ndarray, *, tolerance: float, zero_level:
     if not small and type(tolerance) is float and type(zero_level) is float:
         # the least error, the limit and the count in one call (the same float64 arithmetic;
         # numpy scalars may round in their own type: the general lines below)
-        i_min, e_min, n, limit = _least_and_count(flat, tolerance, zero_level)
+        i_min, e_min, n, limit = least_and_count(flat, tolerance, zero_level)
         if not math.isfinite(e_min):
             raise ValueError("no valid candidate position (every position is excluded)")
         if n == 0:  # float round-off
             return i_min, e_min, 1
-        return int(_kth_at_most(flat, limit, rng.integers(n))), e_min, n
+        return int(kth_at_most(flat, limit, rng.integers(n))), e_min, n
     i_min = _argmin_numpy(flat) if small else int(_argmin(flat))
     e_min = float(flat[i_min])
     if not math.isfinite(e_min):
@@ -442,7 +434,7 @@ def select_within_tolerance(errors: np.ndarray, *, tolerance: float, zero_level:
     if n == 0:  # float round-off
         return i_min, e_min, 1
     k = rng.integers(n)
-    return int(at_most[k] if small else _kth_at_most(flat, limit, k)), e_min, n
+    return int(at_most[k] if small else kth_at_most(flat, limit, k)), e_min, n
 
 
 def _argmin_numpy(flat: np.ndarray) -> int:
@@ -484,7 +476,7 @@ def _argmin(flat):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _least_and_count(flat, tolerance, zero_level):  # pragma: no cover - compiled
+def least_and_count(flat, tolerance, zero_level):  # pragma: no cover - compiled
     """:func:`select_within_tolerance`'s first steps for float ``tolerance`` and ``zero_level``:
     (first index of the least value, that value, the number of values <= the limit, the limit
     in ``flat``'s dtype); the count is 0 when the least value is not finite."""
@@ -507,7 +499,7 @@ def _count_at_most(flat, limit):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _kth_at_most(flat, limit, k):  # pragma: no cover - compiled
+def kth_at_most(flat, limit, k):  # pragma: no cover - compiled
     """Index of the ``k``-th (0-based) entry ``<= limit``."""
     for j in range(flat.size):
         if flat[j] <= limit:

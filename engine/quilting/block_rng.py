@@ -15,7 +15,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from engine import _jit as jit
 from engine._jit import njit
+from engine.matching import kth_at_most, least_and_count, select_within_tolerance
 
 __all__ = ["BlockRng"]
 
@@ -147,6 +149,16 @@ def bounded(st, n):  # pragma: no cover - compiled
     return np.int64(m >> np.uint64(32))
 
 
+@njit(cache=True, nogil=True)
+def _select_drawn(flat, tolerance, zero_level, st):  # pragma: no cover - compiled
+    """select_within_tolerance's compiled path with ``integers(n)`` drawn from state ``st``:
+    (pick, least error, count); count 0 (nothing drawn) when no entry is within the limit."""
+    i, e, n, limit = least_and_count(flat, tolerance, zero_level)
+    if n == 0:
+        return i, e, n
+    return kth_at_most(flat, limit, bounded(st, n)), e, n
+
+
 class BlockRng:
     """``np.random.default_rng([seed, index])`` (``0 <= seed < 2**63``, ``0 <= index < 2**32``):
     ``integers(n)`` compiled, anything else on a numpy ``Generator`` in the same state."""
@@ -163,6 +175,20 @@ class BlockRng:
             if isinstance(n, int | np.integer) and 1 <= n <= 2**32:
                 return bounded(self._st, int(n))
         return self.generator().integers(*args, **kwargs)
+
+    def select(self, errors: np.ndarray, *, tolerance: float, zero_level: float):
+        """:func:`engine.matching.select_within_tolerance` with this generator (the same
+        choice and draw): once numba is loaded, with float tolerances and no numpy generator
+        yet, in one compiled call (the least error, the count, the draw and the pick)."""
+        if self._gen is None and jit.loaded() and type(tolerance) is type(zero_level) is float:
+            flat = errors.ravel()
+            i, e_min, n = _select_drawn(flat, tolerance, zero_level, self._st)
+            if n == 0:  # nothing drawn: every position excluded, or float round-off
+                return select_within_tolerance(
+                    errors, tolerance=tolerance, zero_level=zero_level, rng=self
+                )
+            return int(i), e_min, int(n)
+        return select_within_tolerance(errors, tolerance=tolerance, zero_level=zero_level, rng=self)
 
     def generator(self) -> np.random.Generator:
         """The numpy generator in this one's state (from now on every draw goes to it)."""

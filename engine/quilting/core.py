@@ -28,6 +28,7 @@ from engine.matching import (
     ssd_at,
 )
 from engine.pyramid import PyramidSearch
+from engine.quilting.block_rng import BlockRng
 from engine.quilting.cut import Cut, blend_alpha, cut_overlap, straight_alpha
 from engine.quilting.estimate import TILE, Plan
 from engine.quilting.kernels import PAIRWISE_BLOCK, dp_cut_paste, footprint
@@ -339,9 +340,12 @@ class Quilter:
         zero = self.zero_level_for(wk)
         if wk.found[0] == "map":
             e = wk.found[1]
-            k, e_min, n = select_within_tolerance(
-                e, tolerance=self.tolerance, zero_level=zero, rng=wk.rng
-            )
+            if isinstance(wk.rng, BlockRng):  # one compiled call
+                k, e_min, n = wk.rng.select(e, tolerance=self.tolerance, zero_level=zero)
+            else:
+                k, e_min, n = select_within_tolerance(
+                    e, tolerance=self.tolerance, zero_level=zero, rng=wk.rng
+                )
             return divmod(k, e.shape[1]), float(e.flat[k]), e_min, n
         _, anchors, errs = wk.found
         if self.select == "sampled":

@@ -1,6 +1,7 @@
 import numpy as np
 import pytest
 
+from engine import spectral
 from engine.matching import (
     PCAMatcher,
     SampleSpectrum,
@@ -188,3 +189,35 @@ def test_the_sample_spectra_do_not_depend_on_the_workers():
     s = np.random.default_rng(1).random((120, 90, 3), dtype=np.float32)
     one, two = SampleSpectrum(s, workers=1), SampleSpectrum(s, workers=2)
     assert np.array_equal(one._hs, two._hs) and np.array_equal(one._fsq, two._fsq)
+
+
+@pytest.mark.parametrize("shape", [(1, 3, 129, 256), (8, 3, 65, 128), (2, 1, 7, 5), (3, 4, 9, 6)])
+def test_the_product_sums_kernel_gives_the_numpy_twins_bits(monkeypatch, shape):
+    """The compiled product sum (numba loaded) and its numpy twin (a small job without numba)
+    give the same bits, with and without the weight terms added, on any channel count; and
+    the sum is the complex products' up to float32 round-off."""
+    from engine import _jit
+
+    rng = np.random.default_rng(sum(shape))
+
+    def spectra(*s):
+        scale = 10.0 ** rng.uniform(-4, 4, s)  # magnitudes far apart: rounding matters
+        return (scale * (rng.standard_normal(s) + 1j * rng.standard_normal(s))).astype(np.complex64)
+
+    fk, hs = spectra(*shape), spectra(*shape[1:])
+    add = [spectra(*shape[2:]) for _ in range(shape[0])]
+    for extra in (None, add):
+        monkeypatch.setattr(_jit, "loaded", lambda: False)
+        twin = spectral.product_sum(fk, hs, extra)
+        monkeypatch.undo()
+        _jit.load()
+        kernel = spectral.product_sum(fk, hs, extra)
+        assert kernel.dtype == twin.dtype == np.complex64
+        assert np.array_equal(kernel.view(np.float32), twin.view(np.float32))
+        exact = np.einsum("nc...,c...->n...", fk.astype(complex), hs.astype(complex))
+        if extra is not None:
+            exact += np.stack(extra)
+        bound = np.einsum("nc...,c...->n...", np.abs(fk), np.abs(hs)) + (
+            0 if extra is None else np.abs(np.stack(extra))
+        )
+        assert np.all(np.abs(kernel - exact) <= 8 * np.finfo(np.float32).eps * bound)
