@@ -27,6 +27,7 @@ from engine.tiles.wang_types import (
     CORNER_QUANTILE,
     CORNER_STEPS,
     DETAIL_QUANTILE,
+    EDGE_BAND_QUANTILE,
     INTERIOR_BLENDS,
     INTERIORS,
     PATCH_LABEL,
@@ -219,25 +220,29 @@ class WangSetup:
                 rx = (gx + dx - px) ** 2
                 allowed[rows] &= ry[rows, None] + rx[None, :] >= d2
 
+    def _laplacian_sat(self) -> np.ndarray:
+        """Summed-area table of the luminance's squared Laplacian (once per run)."""
+        if self._energy_sat is None:
+            lum = colour_channels(self.S).mean(axis=2, dtype=np.float32)
+            lap = np.zeros(lum.shape, np.float64)
+            lap[1:-1, 1:-1] = (
+                lum[:-2, 1:-1]
+                + lum[2:, 1:-1]
+                + lum[1:-1, :-2]
+                + lum[1:-1, 2:]
+                - 4 * lum[1:-1, 1:-1]
+            )
+            np.square(lap, out=lap)
+            self._energy_sat = np.pad(lap.cumsum(axis=0).cumsum(axis=1), ((1, 0), (1, 0)))
+        return self._energy_sat
+
     def detailed(self, shape: tuple[int, int]) -> np.ndarray:
         """Window anchors of ``shape`` whose detail (mean squared Laplacian of the luminance)
         is at least :data:`DETAIL_QUANTILE` of the source's windows: a matcher alone
         favours flat regions (they match anything calm), and flat samples or interiors
         read as blurred patches in a layout."""
         if shape not in self._detail:
-            if self._energy_sat is None:  # once per run: every window shape shares it
-                lum = colour_channels(self.S).mean(axis=2, dtype=np.float32)
-                lap = np.zeros(lum.shape, np.float64)
-                lap[1:-1, 1:-1] = (
-                    lum[:-2, 1:-1]
-                    + lum[2:, 1:-1]
-                    + lum[1:-1, :-2]
-                    + lum[1:-1, 2:]
-                    - 4 * lum[1:-1, 1:-1]
-                )
-                np.square(lap, out=lap)
-                self._energy_sat = np.pad(lap.cumsum(axis=0).cumsum(axis=1), ((1, 0), (1, 0)))
-            sat = self._energy_sat
+            sat = self._laplacian_sat()
             h, w = shape
             energy = sat[h:, w:] - sat[:-h, w:] - sat[h:, :-w] + sat[:-h, :-w]
             self._detail[shape] = energy >= np.quantile(energy, DETAIL_QUANTILE)
@@ -265,6 +270,37 @@ class WangSetup:
             calm = ratio <= np.median(ratio)
             self._calm[axis] = calm if axis == "h" else calm.T
         return self._calm[axis]
+
+    def edge_band(self, axis: str) -> np.ndarray:
+        """Window anchors of an ``axis`` sample whose edge band (the ring's width either side
+        of the edge line, along the tile) is no calmer than the median, relative to the
+        sample's whole window (detail: the luminance's squared Laplacian, as :meth:`detailed`;
+        the quantile is :data:`EDGE_BAND_QUANTILE`).
+
+        The calm-joint rule keeps edge lines off a texture's lines; alone, on lines parallel
+        to the edge (brick's mortar) it puts the edge line mid-way between two, the same in
+        every sample, so every tile had a calm band along its W/E edges and the mortar
+        12-16 px inside them. A band as detailed as its window puts the edge line beside a
+        line instead, at varying distances. (Relative to the window, as the calm joint, so
+        that detailed regions are not preferred: the absolute band moved moon's E/W edges
+        into its craters, frame 0.99 -> 1.14.)"""
+        key = f"band-{axis}"
+        if key not in self._calm:
+            sat = self._laplacian_sat()
+            T, h, r = self.T, self.reach, self.ring
+            wh, ww = self.window_shape(axis)
+            H, W = self.S.shape[:2]
+            y0 = np.arange(H - wh + 1)[:, None]
+            x0 = np.arange(W - ww + 1)[None, :]
+            window = sat[y0 + wh, x0 + ww] - sat[y0, x0 + ww] - sat[y0 + wh, x0] + sat[y0, x0]
+            if axis == "h":  # anchor (y, x): the edge line between rows y + h - 1 and y + h
+                by, bx, bh, bw = y0 + h - r, x0, 2 * r, T
+            else:
+                by, bx, bh, bw = y0, x0 + h - r, T, 2 * r
+            band = sat[by + bh, bx + bw] - sat[by, bx + bw] - sat[by + bh, bx] + sat[by, bx]
+            ratio = (band / (2 * r)) / (window / (2 * h) + 1e-12)
+            self._calm[key] = ratio >= np.quantile(ratio, EDGE_BAND_QUANTILE)
+        return self._calm[key]
 
     def phase(self) -> tuple[float | None, float | None]:
         """Per axis (y, x): T / k where the texture is periodic and the tile holds k whole
@@ -395,6 +431,8 @@ class WangSetup:
                 "exclusion or use a smaller tile_size"
             )
         allowed &= self.calm_joint(axis) & self.detailed((wh, ww))
+        if axis == "v" and (allowed & self.edge_band(axis)).any():
+            allowed &= self.edge_band(axis)
         h, T = self.reach, self.T
         if others or same:  # the phase of the samples chosen first
             ref = self.tile_origin([*others, *same][0])

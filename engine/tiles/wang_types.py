@@ -47,6 +47,13 @@ CORNER_QUANTILE = 0.05
 #: the whole pixel nearest to the phase. 1.0 (until session 7) let two windows lie 2 px apart,
 #: so shelves' boards stepped by 1-2 px at the tile lines (frame 1.215 -> 1.085, seeds 0-2)
 PHASE_SLACK = 0.5
+#: v samples (the E/W edges) come from the positions whose edge band (the ring's width either
+#: side of the edge line, along the tile), relative to their window, is at least this quantile
+#: of the source's by detail (see WangSetup.edge_band): the calm-joint rule alone put every E/W
+#: edge line mid-way between a texture's lines parallel to it (brick's mortar 12-16 px inside
+#: every tile's W/E edges: frame 1.188, seeds 0-2). h samples keep without it (coins 1.18 ->
+#: 1.52, brick 1.22: their rows then run along the coins and the brick ends)
+EDGE_BAND_QUANTILE = 0.5
 
 #: How the interior patch is blended (``interior_blend``): "auto" = gradient domain unless the
 #: seam's blend is "none" (hard cuts asked for: every pixel stays a source copy), or one of
