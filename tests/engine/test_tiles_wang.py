@@ -410,9 +410,11 @@ def test_hv_corner_errors_are_the_v_end_pixels_steps_by_brute_force(source):
         assert err[y, xx] == pytest.approx(want, rel=1e-4, abs=1e-6)
 
 
-def test_corner_match_draws_h_samples_whose_corners_meet_the_v_ends(source, k2):
-    """With ``corner_match`` the last h sample's steps to the v samples' end pixels lie in the
-    low tail of the source's positions; without it, anywhere."""
+def test_corner_match_draws_h_samples_whose_corners_meet_the_v_ends(source):
+    """With ``corner_match`` the last h sample's steps to the v samples' end pixels lie lower
+    in the source's positions than without (mean over 8 seeds: 0.019 against 0.051; one
+    seed's draw is no test: seed 5 read 0.27 without until the v samples' edge band rule,
+    0.05 since)."""
     from engine.tiles.wang import WangSetup
 
     setup = WangSetup(source, tile_size=T)
@@ -423,9 +425,15 @@ def test_corner_match_draws_h_samples_whose_corners_meet_the_v_ends(source, k2):
         s = ws.sample("h", 1)
         return np.mean(e < e[s.origin[0] - setup.reach, s.origin[1]])
 
-    matched = wang_set(source, tile_size=T, rng=5, workers=2, corner_match=True)
-    assert tail(matched) < 0.08 < tail(k2)
-    assert matched.samples[:2] != k2.samples[:2]
+    plain, matched, moved = [], [], 0
+    for seed in range(5, 13):
+        a = wang_set(source, tile_size=T, rng=seed, workers=1, tiles=[0])
+        b = wang_set(source, tile_size=T, rng=seed, workers=1, tiles=[0], corner_match=True)
+        plain.append(tail(a))
+        matched.append(tail(b))
+        moved += a.samples[:2] != b.samples[:2]
+    assert np.mean(matched) < 0.03 < np.mean(plain)
+    assert moved
 
 
 def test_a_tile_survives_the_projects_candidate_type(k2):
@@ -462,18 +470,22 @@ def test_corner_errors_are_the_steps_at_every_crossing_by_brute_force(source, k2
         assert e[y, x] == pytest.approx(want, rel=1e-4, abs=1e-6)
 
 
-def test_h_samples_keep_the_corner_steps_low(source, k2):
+def test_h_samples_keep_the_corner_steps_low(source):
     """Where four tiles meet, the h samples' edge-row ends touch (the corner problem): the
     last chosen h sample's corner steps (with itself and the other) lie in the low tail of
     the source's positions (it is drawn among those no rougher than CORNER_STEPS x the
-    source's own steps or the CORNER_QUANTILE least of the positions still allowed)."""
+    source's own steps or the CORNER_QUANTILE least of the positions still allowed). Mean
+    over 8 seeds: 0.04; without the filter 0.50 (random: 0.5)."""
     from engine.tiles.wang import WangSetup
 
     setup = WangSetup(source, tile_size=T)
-    s = k2.sample("h", 1)  # chosen last, against the final h colour 0
-    e = setup.corner_errors([k2.sample("h", 0)])
-    y, x = s.origin[0] - setup.reach, s.origin[1]
-    assert np.mean(e < e[y, x]) < 0.08  # without the filter: 0.11 here (random: 0.5)
+    tails = []
+    for seed in range(5, 13):
+        ws = wang_set(source, tile_size=T, rng=seed, workers=1, tiles=[0])
+        s = ws.sample("h", 1)  # chosen last, against the final h colour 0
+        e = setup.corner_errors([ws.sample("h", 0)])
+        tails.append(np.mean(e < e[s.origin[0] - setup.reach, s.origin[1]]))
+    assert np.mean(tails) < 0.1
 
 
 def test_the_interior_is_blended_in_the_gradient_domain_unless_hard_cuts_are_asked_for(source):
