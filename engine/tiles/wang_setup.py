@@ -121,6 +121,7 @@ class WangSetup:
         self._energy_sat: np.ndarray | None = None
         self._corner: tuple | None = None
         self._phase: tuple | None = None
+        self._periodic = (False, False)
         step = np.diff(colour_channels(self.S), axis=1)
         #: mean squared colour step between horizontally adjacent source pixels
         self.natural_step = float(np.einsum("yxc,yxc->", step, step, dtype=np.float64)) / (
@@ -316,6 +317,7 @@ class WangSetup:
             from engine.tiles.scale import structure_scale
 
             scale = structure_scale(self.S)
+            self._periodic = (bool(scale.periodic[0]), bool(scale.periodic[1]))
             axes = phase_axes(scale, (self.T, self.T))
             self._phase = tuple(
                 self.T / round(self.T / scale.size[i]) if axes[i] else None for i in range(2)
@@ -324,6 +326,12 @@ class WangSetup:
             if note:
                 self.notes.append(note)
         return self._phase
+
+    def periodic(self) -> tuple[bool, bool]:
+        """Per axis (y, x): whether the texture is periodic along it (its structure scale's
+        autocorrelation, as :meth:`phase`; the tile need not hold whole periods)."""
+        self.phase()
+        return self._periodic
 
     def keep_phase(self, allowed: np.ndarray, offset, point) -> None:
         """Clear ``allowed`` (window anchors) where anchor + ``offset`` (the source position
@@ -431,7 +439,7 @@ class WangSetup:
                 "exclusion or use a smaller tile_size"
             )
         allowed &= self.calm_joint(axis) & self.detailed((wh, ww))
-        if axis == "v" and (allowed & self.edge_band(axis)).any():
+        if axis == "v" and not self.periodic()[1] and (allowed & self.edge_band(axis)).any():
             allowed &= self.edge_band(axis)
         h, T = self.reach, self.T
         if others or same:  # the phase of the samples chosen first

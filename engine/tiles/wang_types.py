@@ -52,7 +52,9 @@ PHASE_SLACK = 0.5
 #: of the source's by detail (see WangSetup.edge_band): the calm-joint rule alone put every E/W
 #: edge line mid-way between a texture's lines parallel to it (brick's mortar 12-16 px inside
 #: every tile's W/E edges: frame 1.188, seeds 0-2). h samples keep without it (coins 1.18 ->
-#: 1.52, brick 1.22: their rows then run along the coins and the brick ends)
+#: 1.52, brick 1.22: their rows then run along the coins and the brick ends), and so do the v
+#: samples of a texture periodic along x (planks 1.36 -> 1.52: beside one board gap, the next
+#: lies a period away in every tile; coins 1.18 -> 1.16-1.33 over four seed triples)
 EDGE_BAND_QUANTILE = 0.5
 
 #: How the interior patch is blended (``interior_blend``): "auto" = gradient domain unless the
