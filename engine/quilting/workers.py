@@ -132,7 +132,7 @@ class WorkerPool:
                 self.dependents[j].append(k)
         self.lock, self.ready = ctx.Lock(), ctx.Semaphore(0)
         self.procs = []
-        self.guard = _Holding(self.lock, self.procs)
+        self.guard = _Holding(self.lock, self.procs)  # this process's
         self.waiting = _shared(n, np.int32)
         self.waiting[:] = [sum(j >= done for j in p) for p in needs]
         self.state = _shared(n + 1, np.int8)  # last: stop
@@ -147,6 +147,7 @@ class WorkerPool:
         self.boxes: list[_Mailbox] = []
         self.conns = []
         owner = self.owner = os.getpid()
+        self.worker_guard = _Holding(self.lock, [], owner)  # the workers'
         held = _take_loading_locks()
         self.frozen = held is not None and workers > 1
         if self.frozen:
@@ -160,7 +161,7 @@ class WorkerPool:
             # process runs every task (the same results)
             for _ in range(workers - 1 if held is not None else 0):
                 parent, child = Pipe()
-                box = _Mailbox(ctx, child)
+                box = _Mailbox(ctx, child, owner)
                 proc = ctx.Process(
                     target=self._serve, args=(box, owner, list(self.conns), held), daemon=True
                 )
@@ -177,10 +178,11 @@ class WorkerPool:
         finally:
             _release(held)
 
-    def _locked(self):
-        """``self.lock`` to hold; in this process, a worker killed while it held the lock fails
-        the run (:class:`_Holding`)."""
-        return self.guard if os.getpid() == self.owner else self.lock
+    def _locked(self) -> _Holding:
+        """``self.lock`` to hold (:class:`_Holding`): in this process, a worker killed while it
+        held the lock fails the run; in a worker, this process killed while it held the lock
+        ends the worker."""
+        return self.guard if os.getpid() == self.owner else self.worker_guard
 
     def _take(self) -> int:
         """The lowest ready task, marked taken (the caller holds one count of ``ready``)."""
@@ -220,6 +222,8 @@ class WorkerPool:
                 out = self.run(k)
                 self._finish(k)
                 parts = self.pack(out) if self.pack is not None else [_bytes(_dumps(out))]
+            except SystemExit:  # the parent is gone (_Holding): no one will collect
+                raise
             except BaseException as exc:
                 try:
                     data = _dumps(exc)
@@ -348,24 +352,25 @@ class _Mailbox:
     to send and the caller 80-200 us to read under load (it slept in the read while the worker
     wrote); the ring needs no system call."""
 
-    def __init__(self, ctx, conn):
+    def __init__(self, ctx, conn, owner: int):
         self.ring = np.frombuffer(mmap.mmap(-1, RING_BYTES), np.uint8)
         self.counts = _shared(3, np.int64)  # written, read, piped
         self.lock = ctx.Lock()
         self.conn = conn
         self.guard = _Holding(self.lock, [])  # the caller's; its worker added when started
+        self.worker_guard = _Holding(self.lock, [], owner)
         self.read, self.piped = 0, 0  # the caller's own counts
 
     def put(self, parts: list[np.ndarray], pipe: bool = False) -> None:
         """(Worker) Send one message: the bytes of ``parts`` (uint8 arrays) one after another."""
         n = sum(len(p) for p in parts)
         need = _MSG.size + -(-n // _ALIGN) * _ALIGN
-        with self.lock:
+        with self.worker_guard:
             written, read = int(self.counts[0]), int(self.counts[1])
         at = written % RING_BYTES
         skip = RING_BYTES - at if at + need > RING_BYTES else 0
         if pipe or need > RING_BYTES // 4 or written + skip + need - read > RING_BYTES:
-            with self.lock:
+            with self.worker_guard:
                 self.counts[2] += 1  # counted first: the reader then waits for all its bytes
             self.conn.send_bytes(b"".join(parts))
             return
@@ -377,7 +382,7 @@ class _Mailbox:
         for p in parts:
             self.ring[at : at + len(p)] = p
             at += len(p)
-        with self.lock:
+        with self.worker_guard:
             self.counts[0] = written + skip + need
 
     def take(self, handle) -> bool:
@@ -407,20 +412,25 @@ class _Mailbox:
 
 
 class _Holding:
-    """``with`` it: ``lock``, held by the calling process. The workers hold their shared locks
-    for microseconds, but one killed meanwhile (the OOM killer, a user's kill) leaves its lock
-    held for ever: when the lock does not come within a second and one of ``procs`` (the
+    """``with`` it: ``lock``, held. The processes hold their shared locks for microseconds, but
+    one killed meanwhile (the OOM killer, a user's kill) leaves its lock held for ever. In the
+    calling process: when the lock does not come within a second and one of ``procs`` (the
     workers that take it) has ended, or after :data:`STUCK_S`, the run fails with that instead
-    of waiting for ever."""
+    of waiting for ever. In a worker (``owner``: the calling process): when the lock does not
+    come within a second and the caller is gone, the worker ends (SystemExit)."""
 
-    __slots__ = ("lock", "procs")
+    __slots__ = ("lock", "procs", "owner")
 
-    def __init__(self, lock, procs: list):
-        self.lock, self.procs = lock, procs
+    def __init__(self, lock, procs: list, owner: int | None = None):
+        self.lock, self.procs, self.owner = lock, procs, owner
 
     def __enter__(self) -> None:
         t0 = time.monotonic()
         while not self.lock.acquire(timeout=1.0):
+            if self.owner is not None:
+                if os.getppid() != self.owner:
+                    raise SystemExit(0)
+                continue
             if any(proc.exitcode is not None for proc in self.procs):
                 raise RuntimeError("a quilting worker process died holding the pool's lock")
             if time.monotonic() - t0 > STUCK_S:

@@ -345,3 +345,67 @@ def test_a_worker_killed_holding_the_pools_lock_fails_the_run():
     )
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == "a quilting worker process died holding the pool's lock"
+
+
+CALLER_KILLED_HOLDING_SCENARIO = """
+import os, signal, sys, time
+import numpy as np
+from engine.quilting.workers import WorkerPool, share
+
+parent = os.getpid()
+locked = share(np.zeros(1, np.int8))  # set once this process holds the pool's lock
+
+def run(k):  # the worker's task ends once this process holds the lock (a margin of 60 s)
+    t0 = time.monotonic()
+    while os.getpid() != parent and not locked[0] and time.monotonic() - t0 < 60:
+        time.sleep(0.01)
+    return k
+
+pool = WorkerPool(run, lambda k: k, [[] for _ in range(40)], 2)
+with open(sys.argv[1], "w") as f:
+    f.write(" ".join(str(proc.pid) for proc in pool.procs))
+pool.lock.acquire()  # killed inside a critical section: the lock stays held
+locked[0] = 1
+os.kill(os.getpid(), signal.SIGKILL)
+"""
+
+
+def _ended(pid: int) -> bool:
+    try:
+        with open(f"/proc/{pid}/stat", "rb") as f:
+            return f.read().rsplit(b")", 1)[1].split()[0] == b"Z"
+    except OSError:
+        return True
+
+
+def test_workers_end_when_their_caller_is_killed_holding_the_pools_lock(tmp_path):
+    """The calling process killed while it holds the pool's shared lock: its workers, waiting
+    for that lock, end (they check that the caller lives) instead of waiting for ever."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    if not os.path.isdir("/proc"):
+        pytest.skip("needs /proc to see the workers end")
+    listed, err = tmp_path / "pids", tmp_path / "stderr"
+    with open(err, "wb") as f:  # not a pipe: a worker left waiting would hold it open
+        out = subprocess.run(
+            [sys.executable, "-c", CALLER_KILLED_HOLDING_SCENARIO, str(listed)],
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.DEVNULL,
+            stderr=f,
+            timeout=120,
+        )
+    assert out.returncode == -signal.SIGKILL, err.read_text()
+    pids = [int(p) for p in listed.read_text().split()]
+    assert pids  # a worker was forked
+    t0 = time.monotonic()
+    try:
+        while not all(_ended(p) for p in pids) and time.monotonic() - t0 < 60:  # a margin
+            time.sleep(0.05)
+        assert all(_ended(p) for p in pids), "a worker still waits for the dead caller's lock"
+    finally:
+        for p in pids:
+            if not _ended(p):
+                os.kill(p, signal.SIGKILL)
