@@ -149,6 +149,7 @@ def test_kill_9_then_ctrl_c_each_rerun_finishes_only_the_rest(tmp_path, capsys):
     wait_for_held(gate, "cobblestones.png", proc)
     proc.send_signal(signal.SIGKILL)
     proc.wait()
+    proc.stderr.close()  # (unread: an open pipe would warn later, in another test's output)
     t0 = time.monotonic()
     while group_alive(proc.pid) and time.monotonic() - t0 < 120:  # a margin, not a bound
         time.sleep(0.02)
