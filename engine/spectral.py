@@ -24,7 +24,14 @@ def product_sum(fk: np.ndarray, hs: np.ndarray, add=None) -> np.ndarray:
     to float32 on its own, and the channels added in order, then ``add``: one compiled pass per
     query once numba is loaded (:func:`_product_sum_kernel`; numpy's SIMD complex multiply
     fuses one product of each part into the other, other bits), the same operations on the
-    real and imaginary planes from numpy while it is not (:func:`_product_sum_numpy`)."""
+    real and imaginary planes from numpy while it is not (:func:`_product_sum_numpy`). Inputs
+    are taken as complex64 (numpy < 2's FFTs give complex128), so both paths see the same
+    operands."""
+    fk, hs = np.asarray(fk, np.complex64), np.asarray(hs, np.complex64)
+    if add is not None:
+        add = np.asarray(add, np.complex64)
+        if add.shape != (fk.shape[0], *fk.shape[2:]):
+            raise ValueError(f"add has shape {add.shape}, not {(fk.shape[0], *fk.shape[2:])}")
     if not jit.loaded():
         return _product_sum_numpy(fk, hs, add)
     n, c = fk.shape[:2]

@@ -115,13 +115,19 @@ class _Worker:
 
             resource_tracker.ensure_running()  # its start unblocks the signals: done first
             mask = signal.pthread_sigmask(signal.SIG_BLOCK, _STOPS)
-        try:
-            self.process.start()
-        finally:
-            if mask is not None:
-                signal.pthread_sigmask(signal.SIG_SETMASK, mask)
-        child.close()
         self.photo: Photo | None = None
+        try:
+            try:
+                self.process.start()
+            finally:
+                if mask is not None:
+                    signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+            child.close()
+        except BaseException:  # e.g. the Ctrl-C that waited for the unblock: no orphan
+            if self.process.pid is not None:
+                self.process.kill()
+                self.process.join(5)
+            raise
 
 
 def iter_local(
@@ -140,9 +146,11 @@ def iter_local(
     n = min(jobs or default_jobs(), len(todo))
     threads = max(1, default_jobs() // n)
     ctx = mp.get_context("spawn")
-    workers = [_Worker(ctx, settings, library, threads) for _ in range(n)]
+    workers: list[_Worker] = []
     clean = False
     try:
+        for _ in range(n):
+            workers.append(_Worker(ctx, settings, library, threads))
         while True:
             for w in workers:
                 if w.photo is None and todo:

@@ -254,6 +254,7 @@ def test_a_worker_stopped_by_ctrl_c_stops_the_batch_and_fails_no_photo(tmp_path)
     assert temporaries(lib) == []
 
 
+@pytest.mark.skipif(not hasattr(signal, "pthread_sigmask"), reason="POSIX signal masks only")
 def test_a_ctrl_c_while_a_worker_starts_stops_the_batch_and_fails_no_photo(tmp_path, monkeypatch):
     """A Ctrl-C that reaches a worker while its interpreter starts (before its handler is
     set: the first second of a batch) waits for the handler: the worker stops as interrupted

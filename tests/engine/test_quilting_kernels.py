@@ -119,3 +119,27 @@ def test_the_paths_sum_adds_as_numpy_does():
         if n:
             assert kernels._nan_max(values) == values.max()
     assert np.isnan(kernels._nan_max(np.array([1.0, np.nan, 3.0])))
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_block_rngs_compiled_select_chooses_and_draws_as_numpy_does(dtype):
+    """BlockRng.select (one compiled call) against select_within_tolerance drawing from the
+    numpy generator of the same seed: the same pick, least error and count, and the same
+    next draw, on maps with ties, forbidden entries and calm zeros."""
+    from engine.matching import select_within_tolerance
+
+    _jit.load()
+    gen = np.random.default_rng(5)
+    for trial in range(300):
+        errors = gen.integers(0, 6, 40).astype(dtype) * dtype(0.25)  # many ties
+        errors[gen.random(40) < 0.3] = np.inf
+        if trial % 50 == 0:
+            errors[:] = np.inf
+            errors[gen.integers(40)] = 0.0
+        tol, zero = float(gen.choice([0.0, 0.1, 0.5])), float(gen.choice([0.0, 0.3]))
+        ours = BlockRng(trial, 7)
+        theirs = np.random.default_rng([trial, 7])
+        got = ours.select(errors, tolerance=tol, zero_level=zero)
+        want = select_within_tolerance(errors, tolerance=tol, zero_level=zero, rng=theirs)
+        assert (got[0], float(got[1]), got[2]) == (want[0], float(want[1]), want[2])
+        assert ours.integers(1000) == theirs.integers(1000)

@@ -278,11 +278,13 @@ def test_a_stuck_worker_fails_the_run_instead_of_waiting_forever(monkeypatch):
         pool.shutdown(kill=True)
 
 
-def test_one_pools_end_does_not_end_anothers_gc_freeze():
+def test_one_pools_end_does_not_end_anothers_gc_freeze(monkeypatch):
     """``gc.freeze`` is the process's: with two pools at once (the editor's two jobs) the
-    objects stay frozen until the last pool ends, not the first."""
+    objects stay frozen until the last pool ends, not the first. (No loading lock counts as
+    held: another test's warm-up thread in this process must not stop the forks.)"""
     import gc
 
+    monkeypatch.setattr(workers, "_take_loading_locks", lambda: [])
     assert gc.get_freeze_count() == 0
     a = workers.WorkerPool(lambda k: k, lambda k: k, [[] for _ in range(4)], 2)
     try:
@@ -344,7 +346,7 @@ def test_a_worker_killed_holding_the_pools_lock_fails_the_run():
         [sys.executable, "-c", KILLED_HOLDING_SCENARIO], capture_output=True, text=True, timeout=120
     )
     assert out.returncode == 0, out.stderr
-    assert out.stdout.strip() == "a quilting worker process died holding the pool's lock"
+    assert out.stdout.strip() == "a quilting worker process ended while a shared lock was held"
 
 
 CALLER_KILLED_HOLDING_SCENARIO = """
