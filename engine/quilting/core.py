@@ -27,7 +27,7 @@ from engine.matching import (
     select_within_tolerance,
     ssd_at,
 )
-from engine.pyramid import PyramidSearch
+from engine.pyramid import PyramidSearch, quilt_keeps
 from engine.quilting.block_rng import BlockRng
 from engine.quilting.cut import Cut, blend_alpha, cut_overlap, straight_alpha
 from engine.quilting.estimate import TILE, Plan
@@ -169,7 +169,15 @@ class Quilter:
 
     def make_pyramid(self) -> PyramidSearch:
         stack, groups = self.search_sample()
-        return PyramidSearch(stack, levels=self.plan.levels, groups=groups, workers=self.threads)
+        keep, coarse_keep = quilt_keeps(self.plan.levels)
+        return PyramidSearch(
+            stack,
+            levels=self.plan.levels,
+            groups=groups,
+            keep=keep,
+            coarse_keep=coarse_keep,
+            workers=self.threads,
+        )
 
     def search_sample(self) -> tuple[np.ndarray, tuple | None]:
         """The channels the search matches and their groups (None: one group): the colours."""

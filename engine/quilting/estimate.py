@@ -27,7 +27,12 @@ from engine.budget import check_memory, format_bytes
 from engine.events import Item
 from engine.fft import BUFFER_BYTES, default_backend, next_fast_len
 from engine.matching import WEIGHT_CACHE_BYTES
-from engine.pyramid import CHILDREN, SEED_NEIGHBOURS, pyramid_levels
+from engine.pyramid import (
+    CHILDREN,
+    SEED_NEIGHBOURS,
+    pyramid_levels,
+    quilt_keeps,
+)
 from engine.quilting.layout import grid_rects
 
 __all__ = [
@@ -62,6 +67,13 @@ BLOCK_OVERHEAD = 0.25e-3  # Python work per block: load, choose, records, events
 PASTE_PER_PIXEL = 0.12e-6  # error map, cut, composite, per block pixel (dp)
 GATHER_NS = 1.7e-9  # one weighted squared difference of an exact SSD at a candidate
 PYRAMID_OVERHEAD = 1.5e-3  # reduction of the target and bookkeeping per pyramid query
+#: quilting's pyramid search (2026-11-25, 4096² cobblestones, block 96, overlap 16): its gathers
+#: took 1.24 ns per squared difference on one thread at machine_factor 0.49 (scattered windows
+#: of a large sample: they do not speed up with the reference FFT, nor fully with a second
+#: thread), and about 0.45 µs per scored candidate went to bounds, best child and distinct
+#: places; the gather figure is set so that L4's estimate meets its 2-thread time (7.1 s)
+PYRAMID_GATHER_NS = 3.8e-9
+ANCHOR_NS = 0.9e-6
 REFERENCE_SECONDS = 4.1e-3  # the reference FFT (machine_factor) on the development machine
 #: seam methods slower than dp, relative cost of one cut
 SEAM_COST = {"dijkstra": 8.0, "minimax": 12.0, "oscillating": 3.0, "oscillating-optimal": 6.0}
@@ -271,10 +283,19 @@ def plan(
     if levels:
         lh, lw = H >> levels, W >> levels
         coarse = _fft_query_seconds((lh, lw), cm + groups)
-        anchors = opts.get("coarse_keep", 64) + len(CHILDREN) * 24 * levels
-        anchors += 2 * len(SEED_NEIGHBOURS)
-        gathers = anchors * overlap_px * cm * (1 + 1 / 3)
-        per = PYRAMID_OVERHEAD + coarse + gathers * GATHER_NS
+        if terms == "overlap":  # quilting: the exact SSDs of every level, per level's pixels
+            kids = len(CHILDREN)
+            keep, coarse_keep = quilt_keeps(levels)
+            # per level from full resolution up: the kept candidates' children, the top level's
+            # places' children one level below it, and the seeds' neighbourhoods
+            scored = [kids * keep] * (levels - 1) + [kids * coarse_keep]
+            scored[0] += 2 * len(SEED_NEIGHBOURS)
+            gathers = sum(n / 4**lev for lev, n in enumerate(scored)) * overlap_px * cm
+            search = gathers * PYRAMID_GATHER_NS + sum(scored) * ANCHOR_NS
+        else:
+            anchors = 64 + len(CHILDREN) * 24 * levels + 2 * len(SEED_NEIGHBOURS)
+            search = anchors * overlap_px * cm * (1 + 1 / 3) * GATHER_NS
+        per = PYRAMID_OVERHEAD + coarse + search
         mem = sum(H * W * cm * 4 // 4**lev for lev in range(1, levels + 1))
         mem += spectra_bytes((lh, lw), cm + groups) + conc * exact_query_bytes((lh, lw), cm)
         mem += out_h * out_w * 8  # the origin of every output pixel (the seeds)

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from engine.matching import ssd_at
-from engine.pyramid import PyramidSearch, pyramid_levels, weighted_ssd_at
+from engine.pyramid import PyramidSearch, pyramid_levels, quilt_keeps, weighted_ssd_at
 from tests.engine.helpers import smooth_texture
 
 
@@ -90,3 +90,30 @@ def test_levels_follow_area_overlap_and_block():
     # a thin overlap on a huge sample: reduced to 256² anyway, the block keeps 2 px
     assert pyramid_levels((4096, 4096), (96, 96), 4) == 4
     assert pyramid_levels((4096, 4096), (12, 12), 8) == 2
+
+
+class _Built(Exception):
+    pass
+
+
+@pytest.mark.parametrize(("side", "levels"), [(1100, 3), (600, 2)])
+def test_quilting_keeps_more_places_in_deep_pyramids(monkeypatch, side, levels):
+    """A 3-level pyramid (4096² with a 16-pixel overlap in issue 15) keeps 512 top-level places
+    and 32 candidates per level (the seed-0 gap to the exact search closed); shallower ones keep
+    the former 128 and 24."""
+    import engine.quilting.core as core
+    from engine.quilting import quilt
+
+    built = {}
+
+    def record(sample, **kw):
+        built.update(kw)
+        raise _Built
+
+    monkeypatch.setattr(core, "PyramidSearch", record)
+    s = smooth_texture((side, side))
+    with pytest.raises(_Built):
+        quilt(s, (200, 200), block=96, overlap=16, rng=0, mode="fast", threads=1)
+    assert built["levels"] == levels
+    assert (built["keep"], built["coarse_keep"]) == quilt_keeps(levels)
+    assert quilt_keeps(levels) == ((32, 512) if levels >= 3 else (24, 128))

@@ -119,3 +119,13 @@ def test_a_run_beyond_the_memory_limit_is_refused_before_any_work(monkeypatch):
     s = smooth_texture((300, 300))
     with pytest.raises(MemoryBudgetError, match=r"quilting .* needs about .* smaller sample"):
         iter_quilt(s, (400, 400), block=32, overlap=6, rng=0)
+
+
+def test_the_pyramid_estimate_counts_its_kept_places(monkeypatch):
+    """The deep pyramid's 512 top-level places cost their children's exact SSDs one level down:
+    the plan's time grows with them (issue 15: L4 4.8 -> 7.1 s measured)."""
+    opts = options(smooth_texture((1100, 1100)), (512, 512), block=96, overlap=16, mode="fast")
+    deep = estimate.plan(opts, 2)
+    assert (deep.search, deep.levels) == ("pyramid", 3)
+    monkeypatch.setattr(estimate, "quilt_keeps", lambda levels: (24, 128))
+    assert estimate.plan(opts, 2).seconds < 0.8 * deep.seconds
