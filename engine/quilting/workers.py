@@ -132,7 +132,7 @@ class WorkerPool:
                 self.dependents[j].append(k)
         self.lock, self.ready = ctx.Lock(), ctx.Semaphore(0)
         self.procs = []
-        self.guard = _Holding(self.lock, self.procs)  # this process's
+        self.guard = _Holding(self.lock, self.procs, os.getpid())
         self.waiting = _shared(n, np.int32)
         self.waiting[:] = [sum(j >= done for j in p) for p in needs]
         self.state = _shared(n + 1, np.int8)  # last: stop
@@ -146,8 +146,7 @@ class WorkerPool:
         self.heard = time.monotonic()  # when a message last came in (or this process last ran one)
         self.boxes: list[_Mailbox] = []
         self.conns = []
-        owner = self.owner = os.getpid()
-        self.worker_guard = _Holding(self.lock, [], owner)  # the workers'
+        owner = os.getpid()
         held = _take_loading_locks()
         self.frozen = held is not None and workers > 1
         if self.frozen:
@@ -178,22 +177,16 @@ class WorkerPool:
         finally:
             _release(held)
 
-    def _locked(self) -> _Holding:
-        """``self.lock`` to hold (:class:`_Holding`): in this process, a worker killed while it
-        held the lock fails the run; in a worker, this process killed while it held the lock
-        ends the worker."""
-        return self.guard if os.getpid() == self.owner else self.worker_guard
-
     def _take(self) -> int:
         """The lowest ready task, marked taken (the caller holds one count of ``ready``)."""
-        with self._locked():
+        with self.guard:
             k = int(np.flatnonzero(self.state[:-1] == READY)[0])
             self.state[k] = TAKEN
         return k
 
     def _finish(self, k: int) -> None:
         released = 0
-        with self._locked():
+        with self.guard:
             for d in self.dependents[k]:
                 self.waiting[d] -= 1
                 if not self.waiting[d]:
@@ -357,20 +350,19 @@ class _Mailbox:
         self.counts = _shared(3, np.int64)  # written, read, piped
         self.lock = ctx.Lock()
         self.conn = conn
-        self.guard = _Holding(self.lock, [])  # the caller's; its worker added when started
-        self.worker_guard = _Holding(self.lock, [], owner)
+        self.guard = _Holding(self.lock, [], owner)  # its worker added when started
         self.read, self.piped = 0, 0  # the caller's own counts
 
     def put(self, parts: list[np.ndarray], pipe: bool = False) -> None:
         """(Worker) Send one message: the bytes of ``parts`` (uint8 arrays) one after another."""
         n = sum(len(p) for p in parts)
         need = _MSG.size + -(-n // _ALIGN) * _ALIGN
-        with self.worker_guard:
+        with self.guard:
             written, read = int(self.counts[0]), int(self.counts[1])
         at = written % RING_BYTES
         skip = RING_BYTES - at if at + need > RING_BYTES else 0
         if pipe or need > RING_BYTES // 4 or written + skip + need - read > RING_BYTES:
-            with self.worker_guard:
+            with self.guard:
                 self.counts[2] += 1  # counted first: the reader then waits for all its bytes
             self.conn.send_bytes(b"".join(parts))
             return
@@ -382,7 +374,7 @@ class _Mailbox:
         for p in parts:
             self.ring[at : at + len(p)] = p
             at += len(p)
-        with self.worker_guard:
+        with self.guard:
             self.counts[0] = written + skip + need
 
     def take(self, handle) -> bool:
@@ -414,22 +406,23 @@ class _Mailbox:
 class _Holding:
     """``with`` it: ``lock``, held. The processes hold their shared locks for microseconds, but
     one killed meanwhile (the OOM killer, a user's kill) leaves its lock held for ever. In the
-    calling process: when the lock does not come within a second and one of ``procs`` (the
-    workers that take it) has ended, or after :data:`STUCK_S`, the run fails with that instead
-    of waiting for ever. In a worker (``owner``: the calling process): when the lock does not
+    calling process (``owner``): when the lock does not come within a second and one of
+    ``procs`` (the workers that take it) has ended, or after :data:`STUCK_S`, the run fails with
+    that instead of waiting for ever. In a worker (a fork of ``owner``): when the lock does not
     come within a second and the caller is gone, the worker ends (SystemExit)."""
 
     __slots__ = ("lock", "procs", "owner")
 
-    def __init__(self, lock, procs: list, owner: int | None = None):
+    def __init__(self, lock, procs: list, owner: int):
         self.lock, self.procs, self.owner = lock, procs, owner
 
     def __enter__(self) -> None:
         if self.lock.acquire(False):  # the usual case; and macOS emulates timed waits by polling
             return
+        in_worker = os.getpid() != self.owner
         t0 = time.monotonic()
         while not self.lock.acquire(timeout=1.0):
-            if self.owner is not None:
+            if in_worker:
                 if os.getppid() != self.owner:
                     raise SystemExit(0)
                 continue

@@ -14,7 +14,7 @@ from engine.cancel import check
 from engine.errormap import colour_channels
 from engine.events import frozen_array
 from engine.exclusion import valid_anchors
-from engine.matching import ZERO_ERROR_FRACTION, SampleSpectrum, error_floor
+from engine.matching import ZERO_ERROR_FRACTION, SampleSpectrum, box_sums_float, error_floor
 from engine.matching import select_within_tolerance as _select
 from engine.seams.spec import POISSON, as_seam_spec
 from engine.stitch import PATCH_SEAM
@@ -243,9 +243,7 @@ class WangSetup:
         favours flat regions (they match anything calm), and flat samples or interiors
         read as blurred patches in a layout."""
         if shape not in self._detail:
-            sat = self._laplacian_sat()
-            h, w = shape
-            energy = sat[h:, w:] - sat[:-h, w:] - sat[h:, :-w] + sat[:-h, :-w]
+            energy = box_sums_float(self._laplacian_sat(), shape)
             self._detail[shape] = energy >= np.quantile(energy, DETAIL_QUANTILE)
         return self._detail[shape]
 
@@ -289,16 +287,10 @@ class WangSetup:
         if key not in self._calm:
             sat = self._laplacian_sat()
             T, h, r = self.T, self.reach, self.ring
-            wh, ww = self.window_shape(axis)
-            H, W = self.S.shape[:2]
-            y0 = np.arange(H - wh + 1)[:, None]
-            x0 = np.arange(W - ww + 1)[None, :]
-            window = sat[y0 + wh, x0 + ww] - sat[y0, x0 + ww] - sat[y0 + wh, x0] + sat[y0, x0]
-            if axis == "h":  # anchor (y, x): the edge line between rows y + h - 1 and y + h
-                by, bx, bh, bw = y0 + h - r, x0, 2 * r, T
-            else:
-                by, bx, bh, bw = y0, x0 + h - r, T, 2 * r
-            band = sat[by + bh, bx + bw] - sat[by, bx + bw] - sat[by + bh, bx] + sat[by, bx]
+            window = box_sums_float(sat, self.window_shape(axis))
+            # anchor (y, x) of an h sample: the edge line between rows y + h - 1 and y + h
+            box, at = ((2 * r, T), (h - r, 0)) if axis == "h" else ((T, 2 * r), (0, h - r))
+            band = box_sums_float(sat, box, at, window.shape)
             ratio = (band / (2 * r)) / (window / (2 * h) + 1e-12)
             self._calm[key] = ratio >= np.quantile(ratio, EDGE_BAND_QUANTILE)
         return self._calm[key]

@@ -134,19 +134,26 @@ def test_kill_9_then_ctrl_c_each_rerun_finishes_only_the_rest(tmp_path, capsys):
     write_photos(tmp_path / "in", names=names)
     lib, gate = tmp_path / "lib", tmp_path / "gate"
     gate.mkdir()
+
+    def batch_held_at(photo: str):
+        """The batch on one worker, started in its own session, held once ``photo``'s folder
+        is filled."""
+        proc = cli(
+            tmp_path / "in",
+            "--out",
+            lib,
+            *FAST,
+            "--jobs",
+            "1",
+            start_new_session=True,
+            hold=(gate, photo),
+        )
+        wait_for_held(gate, photo, proc)
+        return proc
+
     # 1. kill -9 halfway: complete folders or none, never a torn one. The library is read once
     # every process of the batch has ended (the worker dies with the batch)
-    proc = cli(
-        tmp_path / "in",
-        "--out",
-        lib,
-        *FAST,
-        "--jobs",
-        "1",
-        start_new_session=True,
-        hold=(gate, "cobblestones.png"),
-    )
-    wait_for_held(gate, "cobblestones.png", proc)
+    proc = batch_held_at("cobblestones.png")
     proc.send_signal(signal.SIGKILL)
     proc.wait()
     proc.stderr.close()  # (unread: an open pipe would warn later, in another test's output)
@@ -159,17 +166,7 @@ def test_kill_9_then_ctrl_c_each_rerun_finishes_only_the_rest(tmp_path, capsys):
     assert any(t.startswith(".cobblestones-") for t in temporaries(lib))
     stamps = {d: (lib / d / "manifest.json").stat().st_mtime_ns for d in first}
     # 2. the re-run skips those, makes more, and is stopped by Ctrl-C (the process group's)
-    proc = cli(
-        tmp_path / "in",
-        "--out",
-        lib,
-        *FAST,
-        "--jobs",
-        "1",
-        start_new_session=True,
-        hold=(gate, "gravel.png"),
-    )
-    wait_for_held(gate, "gravel.png", proc)
+    proc = batch_held_at("gravel.png")
     os.killpg(proc.pid, signal.SIGINT)
     _, err = proc.communicate(timeout=120)
     assert proc.returncode == 130, err

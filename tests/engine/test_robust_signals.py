@@ -130,7 +130,7 @@ def test_a_fresh_process_ends_cleanly(inputs, tmp_path, name):
 
 
 def _interrupt_and_terminate(start, inputs, tmp_path, command, name):
-    sig, code, word = SIGNALS[name]
+    sig = SIGNALS[name][0]
     out = tmp_path / "out"
     if command not in ("tileset", "export"):
         out.mkdir()
@@ -142,14 +142,20 @@ def _interrupt_and_terminate(start, inputs, tmp_path, command, name):
         rc, rest = signal_and_wait(proc, sig)
     finally:
         proc.stderr.close()  # not left to the collector (its warning lands in another test)
-    assert rc == code, rest
-    assert rest.strip().endswith(
-        f"quilt-studio {command}: {word}{' (SIGTERM)' if code == 143 else ''}; "
-        "no output was left half-written"
-    ), rest
+    assert_ended_by(name, command, rc, rest)
     assert "Traceback" not in rest
     leftovers = sorted(os.listdir(tmp_path)) + (sorted(os.listdir(out)) if out.is_dir() else [])
     assert leftovers in (["out"], []), leftovers
+
+
+def assert_ended_by(name: str, command: str, rc: int, err: str) -> None:
+    """The command ended with signal ``name``'s code and its one closing line."""
+    _, code, word = SIGNALS[name]
+    assert rc == code, err
+    assert err.strip().endswith(
+        f"quilt-studio {command}: {word}{' (SIGTERM)' if code == 143 else ''}; "
+        "no output was left half-written"
+    ), err
 
 
 def temporaries(folder: Path) -> list[str]:
@@ -214,7 +220,7 @@ def test_a_signal_swallowed_where_it_was_raised_still_ends_with_its_code(capsys,
 
     from engine.cli.outcome import run_command
 
-    sig, code, word = SIGNALS[name]
+    sig = SIGNALS[name][0]
 
     def job(args):
         callback = ctypes.CFUNCTYPE(None)(lambda: os.kill(os.getpid(), sig))
@@ -224,11 +230,7 @@ def test_a_signal_swallowed_where_it_was_raised_still_ends_with_its_code(capsys,
 
     rc = run_command(types.SimpleNamespace(command="heal", func=job))
     err = capsys.readouterr().err
-    assert rc == code, err
-    assert err.strip().endswith(
-        f"quilt-studio heal: {word}{' (SIGTERM)' if code == 143 else ''}; "
-        "no output was left half-written"
-    ), err
+    assert_ended_by(name, "heal", rc, err)
     assert "Traceback" not in err and "internal error" not in err
 
 
@@ -243,7 +245,7 @@ def test_a_signal_dropped_where_it_was_raised_still_stops_the_job(capsys, name):
 
     from engine.cli.outcome import run_command
 
-    sig, code, word = SIGNALS[name]
+    sig = SIGNALS[name][0]
     steps = []
 
     def job(args):
@@ -255,9 +257,5 @@ def test_a_signal_dropped_where_it_was_raised_still_stops_the_job(capsys, name):
 
     rc = run_command(types.SimpleNamespace(command="synth", func=job))
     err = capsys.readouterr().err
-    assert rc == code, err
-    assert err.strip().endswith(
-        f"quilt-studio synth: {word}{' (SIGTERM)' if code == 143 else ''}; "
-        "no output was left half-written"
-    ), err
+    assert_ended_by(name, "synth", rc, err)
     assert len(steps) < 100 and "Traceback" not in err
