@@ -120,8 +120,8 @@ class SampleSpectrum:
         return spectra(self.fft, k, self.padded, workers=1)
 
     def _conj_spectra(self, k: np.ndarray, workers: int | None = None) -> np.ndarray:
-        """The conjugate of :meth:`_forward` for a query's kernels (from the thread's padded
-        buffers)."""
+        """The conjugate of :meth:`_forward` for a query's kernels, in the thread's kept buffer
+        (:meth:`engine.fft._Padded.spectra`): use it before the next call."""
         wk = self.workers if workers is None else workers
         return spectra(self.fft, k, self.padded, conj=True, workers=wk, reuse=True)
 
@@ -132,12 +132,12 @@ class SampleSpectrum:
         return np.ascontiguousarray(self._inverse_rows(x, rows, cols, workers))
 
     def _inverse_rows(
-        self, x: np.ndarray, rows: int, cols: int, workers: int | None = None
+        self, x: np.ndarray, rows: int, cols: int, workers: int | None = None, out=None
     ) -> np.ndarray:
         """The first ``rows`` × ``cols`` values of the inverse of :meth:`_forward`'s spectra (a
-        view; ``x`` is overwritten)."""
+        view; ``x`` is overwritten; ``out`` see :func:`engine.fft.inverse`)."""
         wk = self.workers if workers is None else workers
-        return inverse(self.fft, x, self.padded, rows, cols, workers=wk)
+        return inverse(self.fft, x, self.padded, rows, cols, workers=wk, out=out)
 
     def correlate(self, kernels: np.ndarray) -> np.ndarray:
         """``Σ_c corr(S_c, K_c)`` at every valid position for a batch of kernels (n, C, kh, kw)."""
@@ -188,6 +188,12 @@ class SampleSpectrum:
             raise ValueError(f"targets must have {self.channels} channels, got {c}")
         tt = t.transpose(0, 3, 1, 2)  # (n, C, bh, bw): np.moveaxis(t, 3, 1), a third the cost
         k = (wts if len(self.groups) == 1 else wts[:, self.group_of]) * tt  # broadcast: same
+        return self.ssd_weighted(tt, wts, k, workers=workers)
+
+    def ssd_weighted(self, tt, wts, k, *, workers: int | None = None) -> np.ndarray:
+        """:meth:`ssd` of targets ``tt`` (n, C, bh, bw) float32, weights ``wts`` (n, G, bh, bw)
+        float32 and the weighted targets ``k`` (n, C, bh, bw), given (quilting's
+        :func:`engine.quilting.kernels.query_inputs` makes them in one pass)."""
         const = np.einsum("nchw,nchw->n", k, tt, dtype=np.float64)
         return self.ssd_terms(k, wts, const, workers=workers)
 
@@ -211,13 +217,19 @@ class SampleSpectrum:
         if bh > h or bw > w:
             raise ValueError(f"block {bw}x{bh} is larger than the sample {w}x{h}")
         const = np.asarray(const, dtype=np.float64).astype(np.float32)
-        x = product_sum(self._conj_spectra(k, workers), self._hs, self._weight_terms(wts, workers))
+        add = self._weight_terms(wts, workers)  # first: the kernels' spectra are a kept buffer
+        fk = self._conj_spectra(k, workers)
+        x = product_sum(fk, self._hs, add)
         if not jit.loaded():  # a small job without numba: the same values from numpy
             e = self._inverse(x, h - bh + 1, w - bw + 1, workers)
             e += const[:, None, None]
             np.maximum(e, 0, out=e)
             return e
-        y = self._inverse_rows(x, h - bh + 1, w - bw + 1, workers)
+        # the inverse into the kernels' spectra, read by now (a thread's kept buffer, in cache;
+        # each query's slab holds its (hp, w - bw + 1) real values)
+        hp, cols = self.padded[0], w - bw + 1
+        out = fk.reshape(n, -1).view(np.float32)[:, : hp * cols].reshape(n, hp, cols)
+        y = self._inverse_rows(x, h - bh + 1, cols, workers, out)
         e = np.empty((n, h - bh + 1, w - bw + 1), np.float32)
         _add_clip(y, const, e)
         return e

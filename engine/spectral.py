@@ -36,11 +36,8 @@ def product_sum(fk: np.ndarray, hs: np.ndarray, add=None) -> np.ndarray:
         return _product_sum_numpy(fk, hs, add)
     n, c = fk.shape[:2]
     x = np.empty((n, *fk.shape[2:]), np.complex64)
-    h = hs.reshape(c, -1)
-    none = np.empty(0, np.complex64)
-    for i in range(n):
-        a = none if add is None else add[i].reshape(-1)
-        _product_sum_kernel(fk[i].reshape(c, -1), h, a, x[i].reshape(-1))
+    a = np.empty((n, 0), np.complex64) if add is None else add.reshape(n, -1)
+    _product_sums(fk.reshape(n, c, -1), hs.reshape(c, -1), a, x.reshape(n, -1))
     return x
 
 
@@ -61,6 +58,14 @@ def _product_sum_numpy(fk, hs, add=None) -> np.ndarray:
         for i in range(n):
             x[i] += add[i]
     return x
+
+
+@njit(cache=True, nogil=True)
+def _product_sums(fk, hs, add, out):  # pragma: no cover - compiled
+    """:func:`_product_sum_kernel` for each query ``i`` of ``fk`` (n, c, m) into ``out`` (n, m),
+    ``add`` (n, m) or (n, 0): one call per batch instead of one per query."""
+    for i in range(fk.shape[0]):
+        _product_sum_kernel(fk[i], hs, add[i], out[i])
 
 
 @njit(cache=True, nogil=True)

@@ -31,7 +31,14 @@ from engine.pyramid import PyramidSearch, quilt_keeps
 from engine.quilting.block_rng import BlockRng
 from engine.quilting.cut import Cut, blend_alpha, cut_overlap, straight_alpha
 from engine.quilting.estimate import TILE, Plan
-from engine.quilting.kernels import PAIRWISE_BLOCK, dp_cut_paste, footprint
+from engine.quilting.kernels import (
+    PAIRWISE_BLOCK,
+    SQUARE_SUM_MAX,
+    dp_cut_paste,
+    footprint,
+    query_inputs,
+    square_sum_is_einsums,
+)
 from engine.quilting.layout import arms_of, canvas_index
 from engine.quilting.records import EMPTY_PATH, BlockRecord, read_only
 from engine.stitch_numpy import SMALL_CUT_PIXELS, dp_l_cuts
@@ -306,22 +313,37 @@ class Quilter:
             groups.setdefault((wk.h, wk.w), []).append(wk)
         for (h, w), group in groups.items():
             check(self.cancel)
-            if self.alone:  # the same transforms however the blocks are batched
-                maps = [
-                    self.spectrum.ssd(wk.old[None], wk.filled[None], workers=self.fft_workers)[0]
-                    for wk in group
-                ]
-            else:
-                maps = self.spectrum.ssd(
-                    np.stack([wk.old for wk in group]),
-                    np.stack([wk.filled for wk in group]),
-                    workers=self.fft_workers,
-                )
+            # alone: the same transforms however the blocks are batched
+            maps = [self._ssd([wk])[0] for wk in group] if self.alone else self._ssd(group)
             v, _ = self.valid(h, w)
             for wk, e in zip(group, maps, strict=True):
                 if v is not None:
                     e[~v] = np.inf
                 wk.found = ("map", e)
+
+    def _ssd(self, group: list[BlockWork]) -> np.ndarray:
+        """The exact search's error maps of blocks of one shape (their canvas loaded)."""
+        spec = self.spectrum
+        H, W = self.out_shape
+        h, w = group[0].h, group[0].w
+        if (
+            jit.loaded()
+            and len(spec.groups) == 1
+            and type(self).load is Quilter.load
+            and all(wk.y + h <= H and wk.x + w <= W for wk in group)
+        ):  # what load read, gathered in one compiled pass (no wrap-around)
+            ys = np.array([wk.y for wk in group], np.int64)
+            xs = np.array([wk.x for wk in group], np.int64)
+            wts, k, const = query_inputs(self.canvas, self.filled, ys, xs, h, w, spec.channels)
+            k = k.transpose(0, 3, 1, 2)
+            if h * w * spec.channels <= SQUARE_SUM_MAX and square_sum_is_einsums():
+                return spec.ssd_terms(k, wts, const, workers=self.fft_workers)
+            return spec.ssd_weighted(k, wts, k, workers=self.fft_workers)  # k·content = k²
+        return spec.ssd(
+            np.stack([wk.old for wk in group]),
+            np.stack([wk.filled for wk in group]),
+            workers=self.fft_workers,
+        )
 
     def _sampled(self, wk: BlockWork):
         H, W = self.sample.shape[:2]
@@ -399,11 +421,14 @@ class Quilter:
         err = keep = None
         path, crit, peak = EMPTY_PATH, math.nan, math.nan
         ix = self.idx(wk.y, wk.x, h, w)
+        written = False  # whether the kernel wrote the canvas (a view of it: no wrap-around)
         if wk.old is None:
             pixels = new.copy()
         elif self.dp_paste and (wk.arms[0] or wk.arms[1]) and not any(wk.arms[2:]) and jit.loaded():
+            written = isinstance(ix[0], slice)
+            under = self.filled[ix] if written else wk.filled
             err, keep, path, pixels, values, crit, peak = dp_cut_paste(
-                wk.old, new, wk.filled, wk.arms[1], wk.arms[0], self.canvas[ix]
+                wk.old, new, wk.filled, wk.arms[1], wk.arms[0], self.canvas[ix], under, written
             )
             if len(values) > PAIRWISE_BLOCK:
                 crit = float(values.sum())
@@ -444,8 +469,9 @@ class Quilter:
                 pixels = a * old_full + (1 - a) * new
             read_only(err)
             read_only(keep)
-        self.canvas[ix] = pixels
-        self.filled[ix] = True
+        if not written:
+            self.canvas[ix] = pixels
+            self.filled[ix] = True
         if self.origin is not None:
             org = np.empty((h, w, 2), np.int32)
             org[:, :, 0] = np.arange(ay, ay + h)[:, None]

@@ -17,7 +17,15 @@ import numpy as np
 from engine._jit import njit
 from engine.stitch import dp_arm_cut_kernel, dp_l_cut_kernel
 
-__all__ = ["PAIRWISE_BLOCK", "dp_cut_paste", "footprint"]
+__all__ = [
+    "PAIRWISE_BLOCK",
+    "dp_cut_paste",
+    "footprint",
+    "query_inputs",
+    "SQUARE_SUM_MAX",
+    "square_sum",
+    "square_sum_is_einsums",
+]
 
 
 @njit(cache=True, nogil=True)
@@ -57,13 +65,94 @@ def footprint(filled):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def dp_cut_paste(old, new, filled, ovl, ovt, out):  # pragma: no cover - compiled
+def query_inputs(canvas, filled, ys, xs, h, w, c):  # pragma: no cover - compiled
+    """An exact search's inputs for blocks (h, w) at (``ys[i]``, ``xs[i]``) inside the canvas:
+    their overlaps as weights (n, 1, h, w) float32 (1 filled, 0 not), the weighted content
+    (n, h, w, c) (the first ``c`` channels) and its sum of squares (n,) float64 — what
+    ``np.stack`` of the blocks' ``filled`` and ``old``, the float32 cast, the product and the
+    ``einsum`` give :meth:`engine.matching.SampleSpectrum.ssd` (the same values, the weighted
+    content in the layout numpy's product gives it there), in one pass instead of five numpy
+    calls. With weights 0 or 1, weighted content times content is weighted content squared,
+    bit for bit (t², or +0 where the weight is 0); the sums are :func:`square_sum`'s."""
+    n = len(ys)
+    wts = np.empty((n, 1, h, w), np.float32)
+    k = np.empty((n, h, w, c), np.float32)
+    const = np.empty(n, np.float64)
+    one, zero = np.float32(1), np.float32(0)
+    for i in range(n):
+        y0, x0 = ys[i], xs[i]
+        for u in range(h):
+            for v in range(w):
+                f = one if filled[y0 + u, x0 + v] else zero
+                wts[i, 0, u, v] = f
+                for ch in range(c):
+                    k[i, u, v, ch] = f * canvas[y0 + u, x0 + v, ch]
+        const[i] = square_sum(k[i].ravel())
+    return wts, k, const
+
+
+@njit(cache=True, nogil=True)
+def square_sum(x):  # pragma: no cover - compiled
+    """Σ x² of a contiguous float32 array in float64, added as numpy's ``einsum("i,i->",
+    x, x, dtype=np.float64)`` adds it on this machine when :func:`square_sum_is_einsums` says
+    so: two lanes (even and odd entries), eight entries a step taken from the last pair to
+    the first, the rest a pair at a time, then the two lanes added (its SIMD loop with 128-bit
+    vectors; each float32 product is exact in float64, so its fused multiply-adds round as
+    one addition)."""
+    acc0 = acc1 = 0.0
+    j, count = 0, x.size
+    while count >= 8:
+        for p in (6, 4, 2, 0):
+            a, b = np.float64(x[j + p]), np.float64(x[j + p + 1])
+            acc0 = a * a + acc0
+            acc1 = b * b + acc1
+        j += 8
+        count -= 8
+    while count > 0:
+        a = np.float64(x[j])
+        acc0 = a * a + acc0
+        if count > 1:
+            b = np.float64(x[j + 1])
+            acc1 = b * b + acc1
+        j += 2
+        count -= 2
+    return 0.0 + (acc0 + acc1)
+
+
+SQUARE_SUM_MAX = 8192
+"""Most values a block's :func:`square_sum` may add for quilting to take it instead of the
+``einsum``: numpy's default buffer (its larger sums, 64² × 3 here, add in other chunks)."""
+
+_SAME_SUMS: list[bool] = []
+
+
+def square_sum_is_einsums() -> bool:
+    """Whether :func:`square_sum` gives numpy's ``einsum`` sums bit for bit here for blocks of
+    up to :data:`SQUARE_SUM_MAX` values (checked once per process on random L-masked blocks:
+    another numpy build may add in another order; then quilting keeps the ``einsum``)."""
+    if not _SAME_SUMS:
+        rng = np.random.default_rng(0)
+        same = np.getbufsize() >= SQUARE_SUM_MAX
+        for n, h, w, c in ((1, 32, 32, 3), (3, 48, 45, 3), (2, 17, 9, 1), (8, 48, 48, 3)):
+            k = rng.random((n, h, w, c), dtype=np.float32)
+            k[:, h // 3 :, w // 4 :] = 0
+            kt = k.transpose(0, 3, 1, 2)
+            want = np.einsum("nchw,nchw->n", kt, kt, dtype=np.float64)
+            same &= all(square_sum(k[i].ravel()) == want[i] for i in range(n))
+        _SAME_SUMS.append(bool(same))
+    return _SAME_SUMS[0]
+
+
+@njit(cache=True, nogil=True)
+def dp_cut_paste(old, new, filled, ovl, ovt, out, out_filled, write):  # pragma: no cover
     """One block's squared-error map, dp L-cut and hard paste (a top or a left arm or both,
     no blend).
 
     ``old`` (h, w, c) the colour channels under the block, ``new`` (h, w, C) the sample window
     (its first c channels compared), ``filled`` (h, w) the overlap, ``out`` (h, w, C) the
-    canvas under the block (read where the cut keeps the old content). Returns the error map
+    canvas under the block (read where the cut keeps the old content; with ``write``, a view
+    of the canvas that then receives the pixels, and ``out_filled`` the canvas's filled mask
+    under the block, then set: two numpy assignments fewer per block). Returns the error map
     (float32, 0 outside the overlap, summed over channels in order as ``error_map_of``), the
     old side (bool), the path ((n, 2) intp, empty when old and new agree over the whole
     overlap: then the overlap is kept as it is, as in :meth:`Quilter.paste`), the pixels
@@ -110,6 +199,9 @@ def dp_cut_paste(old, new, filled, ovl, ovt, out):  # pragma: no cover - compile
                     pixels[u, v] = out[u, v]
                 else:
                     keep[u, v] = False
+    if write:
+        out[:] = pixels
+        out_filled[:] = True
     return err, keep, path, pixels, values, crit, peak
 
 

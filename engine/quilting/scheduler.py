@@ -43,24 +43,24 @@ def dependencies(rects, shape, torus: bool):
         for a, n in ((0, shape[0]), (1, shape[1]))
     ]
     (ry, ny), (rx, nx) = cells
-    last = np.full((ny, nx), -1, dtype=np.int64)
+    last = [[-1] * nx for _ in range(ny)]  # lists: a block's few cells without numpy's calls
     preds, levels = [], []
     for k, (y, x, h, w) in enumerate(rects):
         cy, cx = ry[y, h], rx[x, w]
-        if isinstance(cy, slice) and isinstance(cx, slice):
-            idx = (cy, cx)
-        else:  # a footprint wrapping around the torus
-            idx = np.ix_(*(np.r_[c] if isinstance(c, slice) else c for c in (cy, cx)))
-        p = sorted(v for v in set(last[idx].ravel().tolist()) if v >= 0)  # np.unique: 80 us
+        rows = [last[r] for r in cy]
+        p = sorted({row[c] for row in rows for c in cx} - {-1})
         preds.append(p)
         levels.append(1 + max((levels[j] for j in p), default=-1))
-        last[idx] = k
+        for row in rows:
+            for c in cx:
+                row[c] = k
     return preds, levels
 
 
 def _axis_cells(spans, n: int, torus: bool):
     """Cells of one canvas axis of length ``n`` cut at the ends of every span (start, length),
-    and the cells each span covers (wrapping around on a torus): ({span: cells}, count)."""
+    and the cells each span covers (wrapping around on a torus; a range or a list of cell
+    numbers): ({span: cells}, count)."""
     cuts = sorted({0, n} | {s % n for s, _ in spans} | {(s + k) % n for s, k in spans})
     cell_of = np.searchsorted(cuts, np.arange(n), side="right") - 1
     covered = {}
@@ -68,9 +68,9 @@ def _axis_cells(spans, n: int, torus: bool):
         if not torus and s + k > n:
             raise AssertionError("block outside a non-tileable canvas")
         if s + k <= n:  # no wrap: a run of cells
-            covered[s, k] = slice(int(cell_of[s]), int(cell_of[s + k - 1]) + 1)
+            covered[s, k] = range(int(cell_of[s]), int(cell_of[s + k - 1]) + 1)
         else:
-            covered[s, k] = np.unique(cell_of[np.arange(s, s + k) % n])
+            covered[s, k] = np.unique(cell_of[np.arange(s, s + k) % n]).tolist()
     return covered, len(cuts) - 1
 
 

@@ -143,3 +143,30 @@ def test_block_rngs_compiled_select_chooses_and_draws_as_numpy_does(dtype):
         want = select_within_tolerance(errors, tolerance=tol, zero_level=zero, rng=theirs)
         assert (got[0], float(got[1]), got[2]) == (want[0], float(want[1]), want[2])
         assert ours.integers(1000) == theirs.integers(1000)
+
+
+def test_query_inputs_give_the_stacked_products_and_einsums_bits():
+    """The exact search's inputs in one compiled pass (weights, weighted content, its sum of
+    squares) equal what SampleSpectrum.ssd makes from the stacked blocks with numpy, bit for
+    bit: content of either sign and signed zeros, blocks of one to eight."""
+    from engine.quilting.kernels import SQUARE_SUM_MAX, query_inputs, square_sum_is_einsums
+
+    _jit.load()
+    assert square_sum_is_einsums()  # else quilting keeps the einsum (this numpy adds otherwise)
+    rng = np.random.default_rng(5)
+    canvas = rng.standard_normal((90, 110, 3)).astype(np.float32)
+    canvas[rng.random((90, 110, 3)) < 0.1] = -0.0
+    filled = rng.random((90, 110)) < 0.6
+    for n, (h, w) in ((1, (32, 32)), (3, (48, 48)), (8, (20, 37))):
+        assert h * w * 3 <= SQUARE_SUM_MAX
+        ys, xs = rng.integers(0, 90 - h, n), rng.integers(0, 110 - w, n)
+        wts, k, const = query_inputs(canvas, filled, ys, xs, h, w, 3)
+        t = np.stack([canvas[y : y + h, x : x + w] for y, x in zip(ys, xs, strict=True)])
+        m = np.stack([filled[y : y + h, x : x + w] for y, x in zip(ys, xs, strict=True)])
+        want_w = np.asarray(m, np.float32)[:, None]
+        want_k = want_w * t.transpose(0, 3, 1, 2)
+        want_c = np.einsum("nchw,nchw->n", want_k, t.transpose(0, 3, 1, 2), dtype=np.float64)
+        assert wts.tobytes() == want_w.tobytes()
+        got_k = k.transpose(0, 3, 1, 2)
+        assert got_k.strides == want_k.strides and got_k.tobytes() == want_k.tobytes()
+        assert const.tobytes() == want_c.tobytes()
