@@ -527,7 +527,10 @@ def _estimates(q, features, base, base_row, invalid, out):  # pragma: no cover -
     """out[i, j] = base[base_row[i], j] - 2 Σ_k q[i, k] features[k, j]; inf where invalid[j].
 
     A plain loop: single-threaded and bit-identical whatever the batch (a threaded BLAS
-    product is both slower at this size on small machines and batch dependent)."""
+    product is both slower at this size on small machines and batch dependent). Each feature
+    row serves every target of the batch while it is in cache (job B's index is 4 MB, read
+    once a batch instead of once a target: a batch of 3 in 336 instead of 449 us); every
+    estimate is still its base plus the components in order, the same bits."""
     n, kk = q.shape
     nn = features.shape[1]
     for i in range(n):
@@ -535,13 +538,17 @@ def _estimates(q, features, base, base_row, invalid, out):  # pragma: no cover -
         b = base[base_row[i]]
         for j in range(nn):
             row[j] = b[j]
-        for k in range(kk):
+    for k in range(kk):
+        f = features[k]
+        for i in range(n):
             c = np.float32(-2.0) * q[i, k]  # float32 products: twice the vector width
             if c == 0.0:
                 continue
-            f = features[k]
+            row = out[i]
             for j in range(nn):
                 row[j] += c * f[j]
+    for i in range(n):
+        row = out[i]
         for j in range(nn):
             if invalid[j]:
                 row[j] = np.inf

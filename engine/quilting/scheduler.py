@@ -85,14 +85,17 @@ it one by one (batched transforms of a large sample only thrash the cache)."""
 
 BATCH = 3
 """Blocks per batch on samples between :data:`POOL_MIN_SAMPLE_AREA` and
-:data:`BATCH_MAX_SAMPLE_AREA` on more than one thread (one thread: one block per batch). Such
+:data:`BATCH_MAX_SAMPLE_AREA` on more than one thread (one thread: one block per batch, but
+see below). Such
 batches search each block alone (:attr:`Quilter.alone`: ducc0's batched transforms differ in the
 last bits with the batch, so the output would otherwise depend on the batches and so on the
 threads). Batches chain level by level, so larger ones lengthen the run's critical path on two
 threads (a unit-cost schedule of job B's 676 blocks: 1.99x one thread with batches of 1, 1.90x
 with 3, 1.83x with 4, 1.65x with 6). Job B on one thread, measured in session 6 under load:
 blocks one by one 1.15x faster than batches of 3 searched together; on two threads batches of 3
-searched block by block 1.05x faster than searched together."""
+searched block by block 1.05x faster than searched together. The fast (principal components)
+search takes batches of 3 on one thread too: its blocks' estimates share one pass over its
+index (:func:`engine.matching._estimates`), and its results do not depend on the batch."""
 
 PROCESS_BATCH = 2
 """Blocks per task in worker processes (:func:`uses_processes`; each block searched alone, so
@@ -133,8 +136,8 @@ def run_levels(q: Quilter, rects, total_label: str):
         # each block's search a query of its own: ducc0's batched transforms differ in the last
         # bits with the batch, so only then may the batches depend on the threads
         q.alone = True
-        if q.threads == 1:
-            size = 1
+        if q.threads == 1 and q.plan.search != "pca":
+            size = 1  # the fast search's batches share a pass over its index (BATCH)
         elif processes:
             size = PROCESS_BATCH
     if area > BATCH_MAX_SAMPLE_AREA:

@@ -183,6 +183,32 @@ def test_pca_query_ranks_by_estimate_reranks_exactly_and_ignores_the_batch():
     assert sorted(map(tuple, anchors.tolist())) == [(5, 7), (20, 1)] and len(errs) == 2
 
 
+def test_a_batchs_estimates_are_each_targets_own_bits():
+    """The fast search's estimates of a batch (one pass over the index for all its targets)
+    equal each target's alone, bit for bit: a batch of blocks may share a pass on any thread
+    count without changing a record."""
+    from engine import _jit, matching
+
+    _jit.load()
+    rng = np.random.default_rng(8)
+    kk, nn = 12, 5000
+    features = rng.standard_normal((kk, nn)).astype(np.float32)
+    base = (rng.random((3, nn)) * 50).astype(np.float32)
+    invalid = rng.random(nn) < 0.05
+    q = rng.standard_normal((4, kk)).astype(np.float32)
+    q[1, :4] = 0  # a target without some parts
+    rows = np.array([0, 2, 1, 0], np.intp)
+    batch = np.empty((4, nn), np.float32)
+    matching._estimates(q, features, base, rows, invalid, batch)
+    for i in range(4):
+        alone = np.empty((1, nn), np.float32)
+        matching._estimates(q[i : i + 1], features, base, rows[i : i + 1], invalid, alone)
+        assert alone[0].tobytes() == batch[i].tobytes()
+    want = base[rows].astype(np.float64) - 2 * q.astype(np.float64) @ features
+    want[:, invalid] = np.inf
+    np.testing.assert_allclose(batch, want, rtol=1e-4, atol=1e-2)
+
+
 def test_the_sample_spectra_do_not_depend_on_the_workers():
     """ducc0 splits batched transforms by thread count (the last bits differ): the sample's
     spectra are made on one thread, so a run on two threads scores as one on one thread."""
