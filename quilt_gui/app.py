@@ -10,6 +10,7 @@ from PySide6.QtGui import QIcon
 from PySide6.QtWidgets import QApplication
 
 from quilt_gui import jobs, settings
+from quilt_gui.gc_thread import GuiThreadCollector
 from quilt_gui.settings import set_names
 from quilt_gui.theme import apply_theme
 from resources import icon_path
@@ -45,6 +46,8 @@ def run(argv: list[str]) -> int:
     if chosen:
         settings.set("theme", chosen)
     app = make_app(theme=chosen)
+    collector = GuiThreadCollector(app)  # Qt objects are freed in the GUI thread only
+    app.aboutToQuit.connect(collector.stop)
     from quilt_gui.main_window import MainWindow
 
     window = MainWindow()

@@ -9,6 +9,7 @@ import pytest
 from PySide6.QtCore import QSettings
 
 from quilt_gui import jobs, settings
+from quilt_gui.gc_thread import GuiThreadCollector
 from tests.gui.helpers import WAIT_MS
 
 
@@ -48,8 +49,15 @@ def _isolated_settings(tmp_path, qapp):
 
 @pytest.fixture(autouse=True)
 def _stop_jobs(qapp):
-    yield
-    # a margin: an aborted job that cannot be cancelled (a preview, the set's figures) runs to
-    # its end, about 1 s of CPU, 5 s at load 10
-    assert jobs.shutdown(WAIT_MS), f"background jobs did not stop within {WAIT_MS // 1000} s"
-    qapp.processEvents()
+    # as in the editor, the garbage collector runs in this (the GUI) thread only: a collection
+    # in a job's thread freed a test's whole window there (quilt_gui.gc_thread); the test's
+    # garbage is collected here after its jobs have stopped
+    collector = GuiThreadCollector()
+    try:
+        yield
+        # a margin: an aborted job that cannot be cancelled (a preview, the set's figures) runs
+        # to its end, about 1 s of CPU, 5 s at load 10
+        assert jobs.shutdown(WAIT_MS), f"background jobs did not stop within {WAIT_MS // 1000} s"
+        qapp.processEvents()
+    finally:
+        collector.stop()
