@@ -189,7 +189,8 @@ def iter_wang_set(
         Draw the h samples also where their corner pixels meet the v samples' end pixels
         (columns 0 and T-1 at rows 1 and T-2, which sit between two pixels of the h layer
         where four tiles meet: :meth:`WangSetup.hv_corner_errors`), under the same bound as
-        the h samples' own corner steps (default False; README "Session 8").
+        the h samples' own corner steps (default True since session 10, with the interiors'
+        detail balance; README "Session 8" and "Session 10").
     seam : SeamSpec
         Seam method and options, error metric and blending of every cut (default
         :data:`engine.stitch.PATCH_SEAM`: dp, adaptive blending).

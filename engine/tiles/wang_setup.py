@@ -119,6 +119,8 @@ class WangSetup:
         self._calm: dict[str, np.ndarray] = {}
         self._detail: dict[tuple[int, int], np.ndarray] = {}
         self._energy_sat: np.ndarray | None = None
+        self._window_energy: np.ndarray | None = None
+        self._squares: np.ndarray | None = None
         self._corner: tuple | None = None
         self._phase: tuple | None = None
         self._periodic = (False, False)
@@ -246,6 +248,27 @@ class WangSetup:
             energy = box_sums_float(self._laplacian_sat(), shape)
             self._detail[shape] = energy >= np.quantile(energy, DETAIL_QUANTILE)
         return self._detail[shape]
+
+    def detail_half(self, placed) -> np.ndarray | None:
+        """Interior window anchors on the side of the source's median window detail (mean
+        squared Laplacian of the luminance, as :meth:`detailed`) that ``placed`` (earlier
+        tiles' windows) hold fewer of; None when they hold as many.
+
+        Keeps a set's windows as detailed as random crops are, half above the median and
+        half below: the matcher alone draws from one side (calm rings match calm windows on
+        page, whose tiles were 0.90 of its crops' detail; the flattest-quarter rule pushes
+        the other way, 10-13 of 16 windows above the median on a test source), and a set
+        busier than its crops near the edges reads as a frame."""
+        T = self.T
+        if self._window_energy is None:
+            self._window_energy = box_sums_float(self._laplacian_sat(), (T, T))
+        energy = self._window_energy
+        med = np.median(energy)
+        above = sum(1 for y, x in placed if energy[y, x] >= med)
+        below = len(placed) - above
+        if above == below:
+            return None
+        return energy >= med if below > above else energy < med
 
     def calm_joint(self, axis: str) -> np.ndarray:
         """Window anchors whose joint (the source's own step across the tile edge the sample
@@ -405,13 +428,22 @@ class WangSetup:
             ((T - 2, 0), ((-1, 0), (-2, 1))),  # SW: W(T-2, 0) above S(T-1, 0)
             ((T - 2, -1), ((-1, T - 1), (-2, T - 2))),  # SE: E(T-2, T-1)
         )
+        # per h pixel (its offset from the h origin) the v end pixels beside it, summed:
+        # sum |q - p|² = n |q|² - 2 q.(sum p) + sum |p|² (one pass per h pixel, not per v)
+        near: dict[tuple[int, int], list] = {}
         for v in vs:
             vy, vx = v.origin
             for (py, px), nbrs in corners:
-                p = S[vy + py, vx + px]
-                for dy, dx in nbrs:  # the h origin of anchor (y, x) is (y + h, x)
-                    d = S[h + dy : h + dy + ny, dx : dx + nx] - p
-                    e += np.einsum("yxc,yxc->yx", d, d)
+                for nb in nbrs:
+                    near.setdefault(nb, []).append(S[vy + py, vx + px].astype(np.float64))
+        if self._squares is None:  # once per run: |q|² of every source pixel
+            self._squares = np.einsum("yxc,yxc->yx", S, S, dtype=np.float64)
+        for (dy, dx), ps in near.items():  # the h origin of anchor (y, x) is (y + h, x)
+            rows, cols = slice(h + dy, h + dy + ny), slice(dx, dx + nx)
+            q, p = S[rows, cols], np.sum(ps, axis=0)
+            e += len(ps) * self._squares[rows, cols] + sum(float(a @ a) for a in ps)
+            for c in range(S.shape[2]):
+                e -= (2 * p[c]) * q[..., c]
         return e
 
     def choose(self, axis, colour, others, placed, rng, same=()) -> WangSample:
@@ -504,7 +536,8 @@ class WangSetup:
 
     def patch_anchor(self, errors, samples, avoid, rng) -> tuple[tuple[int, int], float, float]:
         """The interior window: within tolerance of the best ring match, away from the
-        samples and from ``avoid`` (earlier tiles' windows)."""
+        samples and from ``avoid`` (earlier tiles' windows), on the side of the median
+        window detail that ``avoid`` holds fewer of (:meth:`detail_half`)."""
         T = self.T
         allowed = np.ones(errors.shape, bool)
         allowed &= self.detailed((T, T))
@@ -517,6 +550,9 @@ class WangSetup:
             )
         if samples:
             self.keep_phase(allowed, (0, 0), self.tile_origin(samples[0]))
+        half = self.detail_half(avoid)
+        if half is not None and (allowed & half).any():
+            allowed &= half
         dist = self.min_distance
         while True:
             ok = allowed.copy()

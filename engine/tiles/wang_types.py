@@ -74,7 +74,7 @@ WANG_DEFAULTS = {
     "outward": 1.0,
     "min_distance": None,
     "tolerance": 0.1,
-    "corner_match": False,
+    "corner_match": True,
     "seam": PATCH_SEAM,
     "excluded": None,
     "maps": None,
