@@ -500,7 +500,8 @@ def main(argv=None) -> int:
     ap.add_argument(
         "--corner-match",
         action="store_true",
-        help="--quality with Wang sets of corner_match=True (wang_quality_SET_corner_match.txt)",
+        help="--quality with Wang sets of corner_match=True (wang_quality_SET_corner_match.txt; "
+        "the default since session 10, so the same sets)",
     )
     args = ap.parse_args(argv)
     RESULTS.mkdir(exist_ok=True)

@@ -145,7 +145,8 @@ def main(argv=None) -> int:
     ap.add_argument(
         "--corner-match",
         action="store_true",
-        help="Wang sets with corner_match=True (results file wang_corners_SET_corner_match.txt)",
+        help="Wang sets with corner_match=True (results file wang_corners_SET_corner_match.txt; "
+        "the default since session 10, so the same sets)",
     )
     args = ap.parse_args(argv)
     if args.docs is not None:
