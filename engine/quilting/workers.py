@@ -407,7 +407,7 @@ class _Holding:
     """``with`` it: ``lock``, held. The processes hold their shared locks for microseconds, but
     one killed meanwhile (the OOM killer, a user's kill) leaves its lock held for ever. In the
     calling process (``owner``): when the lock does not come within a second and one of
-    ``procs`` (the workers that take it) has ended, or after :data:`STUCK_S`, the run fails with
+    ``procs`` (the workers that take it) was killed, or after :data:`STUCK_S`, the run fails with
     that instead of waiting for ever. In a worker (a fork of ``owner``): when the lock does not
     come within a second and the caller is gone, the worker ends (SystemExit)."""
 
@@ -426,7 +426,9 @@ class _Holding:
                 if os.getppid() != self.owner:
                     raise SystemExit(0)
                 continue
-            if any(proc.exitcode is not None for proc in self.procs):
+            # killed (a signal: exit code < 0); one that ended by itself released its locks, and
+            # its error, if it sent one, is read once the lock comes
+            if any(proc.exitcode is not None and proc.exitcode < 0 for proc in self.procs):
                 raise RuntimeError("a quilting worker process ended while a shared lock was held")
             if time.monotonic() - t0 > STUCK_S:
                 raise RuntimeError(f"a quilting worker process held a lock for {STUCK_S:.0f} s")

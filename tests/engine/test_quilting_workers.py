@@ -300,6 +300,55 @@ def test_one_pools_end_does_not_end_anothers_gc_freeze(monkeypatch):
     assert gc.get_freeze_count() == 0
 
 
+def test_a_workers_own_error_wins_over_a_slow_lock(monkeypatch):
+    """A worker that fails sends its error and ends by itself (exit code 0, its locks released).
+    When the caller then waits over a second for that mailbox's lock (held by another, e.g. a
+    process slowed down by load), the worker's end is no held lock: the caller waits on and
+    raises the worker's own error, not "ended while a shared lock was held"."""
+    import threading
+
+    monkeypatch.setattr(workers, "_take_loading_locks", lambda: [])
+    parent = os.getpid()
+
+    def run(k):
+        if os.getpid() != parent:
+            raise ValueError("the worker's own error")
+        return k
+
+    pool = workers.WorkerPool(run, lambda k: k, [[]], 2)
+    try:
+        (proc,) = pool.procs
+        proc.join(60)
+        assert proc.exitcode == 0  # it took the task, sent its error and ended
+        box = pool.boxes[0]
+        lock, held, waited = box.guard.lock, threading.Event(), threading.Event()
+
+        class Watched:  # the mailbox's lock, telling when the caller waited a second for it
+            def acquire(self, block=True, timeout=None):
+                got = lock.acquire(block, timeout)
+                if timeout is not None and not got:
+                    waited.set()
+                return got
+
+            def release(self):
+                lock.release()
+
+        def other_holder():
+            with lock:
+                held.set()
+                waited.wait(60)
+
+        box.guard.lock = Watched()
+        holder = threading.Thread(target=other_holder)
+        holder.start()
+        held.wait(60)
+        with pytest.raises(ValueError, match="own error"):
+            pool.result(0)
+        holder.join(60)
+    finally:
+        pool.shutdown(kill=True)
+
+
 KILLED_HOLDING_SCENARIO = """
 import os, signal, time
 import numpy as np
