@@ -150,8 +150,9 @@ class WorkerPool:
         held = _take_loading_locks()
         self.frozen = held is not None and workers > 1
         if self.frozen:
-            # the objects alive now are left out of the garbage collector's passes while the
-            # workers run: a full pass writes to every object, and after the fork every page
+            # the objects alive now are left out of the garbage collector's passes in the workers
+            # (for good) and in this process while it forks and runs or waits for tasks
+            # (result()): a full pass writes to every object, and after the fork every page
             # written is copied (a pass in this process took 57 ms instead of ~25 ms)
             _GC_FREEZE.enter()
         try:
@@ -175,6 +176,8 @@ class WorkerPool:
             self.shutdown(kill=True)
             raise
         finally:
+            if self.frozen:
+                _GC_FREEZE.leave()
             _release(held)
 
     def _take(self) -> int:
@@ -264,7 +267,18 @@ class WorkerPool:
         self.left -= 1
 
     def result(self, k: int):
-        """Task ``k``'s result (running tasks here and collecting the workers' until it is in)."""
+        """Task ``k``'s result (running tasks here and collecting the workers' until it is in).
+        Frozen only meanwhile: a caller's generator abandoned in a reference cycle between two
+        calls is still collected (and its ``finally`` shuts the pool down)."""
+        if not self.frozen:
+            return self._result(k)
+        _GC_FREEZE.enter()
+        try:
+            return self._result(k)
+        finally:
+            _GC_FREEZE.leave()
+
+    def _result(self, k: int):
         while k not in self.results:
             check(self.cancel)
             self._collect(0)
@@ -296,16 +310,14 @@ class WorkerPool:
             # joined on a thread of its own: a worker's exit takes milliseconds
             threading.Thread(target=proc.join, daemon=True).start()
         self.conns, self.procs = [], []
-        if self.frozen:
-            self.frozen = False
-            _GC_FREEZE.leave()
 
 
 class _GcFreeze:
-    """``gc.freeze()`` while any pool runs. The freeze is the process's: with two pools at once
-    (the editor's two jobs, the batch's threads) the first pool's end must not end the other's
-    freeze, so the pools are counted and the last one to end unfreezes. Each pool freezes
-    again as it starts (the objects made since the first freeze are its parent's too)."""
+    """``gc.freeze()`` while any pool forks or runs tasks (:meth:`WorkerPool.result`). The
+    freeze is the process's: with two pools at once (the editor's two jobs, the batch's threads)
+    the first one's leaving must not end the other's freeze, so they are counted and the last
+    one to leave unfreezes. Entering freezes every object alive then (moving the collector's
+    lists: no pass)."""
 
     def __init__(self):
         self.lock = threading.Lock()  # never taken by a forked worker

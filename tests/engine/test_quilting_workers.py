@@ -4,6 +4,7 @@ stops its workers when cancelled or failing, and threads stay available."""
 from __future__ import annotations
 
 import os
+import time
 
 import numpy as np
 import pytest
@@ -280,24 +281,85 @@ def test_a_stuck_worker_fails_the_run_instead_of_waiting_forever(monkeypatch):
 
 def test_one_pools_end_does_not_end_anothers_gc_freeze(monkeypatch):
     """``gc.freeze`` is the process's: with two pools at once (the editor's two jobs) the
-    objects stay frozen until the last pool ends, not the first. (No loading lock counts as
-    held: another test's warm-up thread in this process must not stop the forks.)"""
+    objects stay frozen while either runs tasks, not only until the first one's call ends. (No
+    loading lock counts as held: another test's warm-up thread in this process must not stop
+    the forks.)"""
     import gc
+    import threading
 
     monkeypatch.setattr(workers, "_take_loading_locks", lambda: [])
     assert gc.get_freeze_count() == 0
-    a = workers.WorkerPool(lambda k: k, lambda k: k, [[] for _ in range(4)], 2)
+    go = workers.share(np.zeros(1, np.int8))
+
+    def held_until_go(k):  # pool a's task ends when the test says so (a margin of 60 s)
+        for _ in range(6000):
+            if go[0]:
+                break
+            time.sleep(0.01)
+        return k
+
+    a = workers.WorkerPool(held_until_go, lambda k: k, [[]], 2)
+    b = workers.WorkerPool(lambda k: k, lambda k: k, [[] for _ in range(4)], 2)
     try:
-        b = workers.WorkerPool(lambda k: k, lambda k: k, [[] for _ in range(4)], 2)
-        try:
-            assert a.frozen and b.frozen  # both forked their workers
-            a.shutdown(kill=True)
-            assert gc.get_freeze_count() > 0  # b's workers still run: still frozen
-        finally:
-            b.shutdown(kill=True)
+        assert a.frozen and b.frozen  # both forked their workers
+        assert gc.get_freeze_count() == 0  # frozen only while running tasks
+        inside = threading.Thread(target=a.result, args=(0,))
+        inside.start()
+        for _ in range(6000):  # a's call has frozen the objects
+            if gc.get_freeze_count():
+                break
+            time.sleep(0.01)
+        assert [b.result(k) for k in range(4)] == [0, 1, 2, 3]
+        assert gc.get_freeze_count() > 0  # a still runs its task: still frozen
+        go[0] = 1
+        inside.join(60)
+        assert gc.get_freeze_count() == 0
     finally:
+        go[0] = 1
         a.shutdown(kill=True)
-    assert gc.get_freeze_count() == 0
+        b.shutdown(kill=True)
+
+
+def test_a_pool_abandoned_in_a_reference_cycle_is_still_shut_down(monkeypatch):
+    """A stream that made a pool, dropped between two events inside a reference cycle: the
+    collector finds it (its objects are not frozen between the pool's calls) and its
+    ``finally`` shuts the pool and its workers down; frozen, it would be kept, and with it
+    the freeze and the workers, for good."""
+    import gc
+
+    monkeypatch.setattr(workers, "_take_loading_locks", lambda: [])
+    pools = []
+
+    def stream():
+        pool = workers.WorkerPool(lambda k: k, lambda k: k, [[] for _ in range(4)], 2)
+        pools.append(pool)
+        try:
+            for k in range(4):
+                yield pool.result(k)
+        finally:
+            pool.shutdown()
+
+    class Holder:
+        pass
+
+    holder = Holder()
+    holder.me, holder.stream = holder, stream()
+    assert next(holder.stream) == 0
+    (pool,) = pools
+    procs = list(pool.procs)
+    assert procs and pool.frozen
+    del holder
+    gc.collect()
+    try:
+        assert pool.state[-1] == 1  # stopped by the stream's finally
+        assert gc.get_freeze_count() == 0
+        for _ in range(6000):  # killed and joined (on threads of the pool's) at once
+            if all(proc.exitcode is not None for proc in procs):
+                break
+            time.sleep(0.01)
+        assert all(proc.exitcode is not None for proc in procs)
+    finally:
+        pool.shutdown(kill=True)
 
 
 def test_a_workers_own_error_wins_over_a_slow_lock(monkeypatch):
