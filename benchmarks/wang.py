@@ -498,10 +498,10 @@ def main(argv=None) -> int:
         help="Wang sets per texture (medians; default 3, 2 for --interiors)",
     )
     ap.add_argument(
-        "--corner-match",
+        "--no-corner-match",
         action="store_true",
-        help="--quality with Wang sets of corner_match=True (wang_quality_SET_corner_match.txt; "
-        "the default since session 10, so the same sets)",
+        help="--quality with Wang sets of corner_match=False, the default before session 10 "
+        "(wang_quality_SET_no_corner_match.txt)",
     )
     args = ap.parse_args(argv)
     RESULTS.mkdir(exist_ok=True)
@@ -513,11 +513,11 @@ def main(argv=None) -> int:
         (RESULTS / "wang.txt").write_text(text)
     if args.quality:
         seeds = 3 if args.seeds is None else args.seeds
-        options = {"corner_match": True} if args.corner_match else None
+        options = {"corner_match": False} if args.no_corner_match else None
         table = quality(args.quality, args.tile, args.docs, seeds, options)
-        text = f"{_stamp()}{' (corner_match=True)' if options else ''}\n\n{table}"
+        text = f"{_stamp()}{' (corner_match=False)' if options else ''}\n\n{table}"
         print(text)
-        suffix = "_corner_match" if options else ""
+        suffix = "_no_corner_match" if options else ""
         (RESULTS / f"wang_quality_{args.quality}{suffix}.txt").write_text(text)
     if args.interiors:
         seeds = 2 if args.seeds is None else args.seeds

@@ -143,18 +143,18 @@ def main(argv=None) -> int:
     ap.add_argument("--seeds", type=int, default=3)
     ap.add_argument("--docs", type=Path, default=None, help="save seed 0's first layout here")
     ap.add_argument(
-        "--corner-match",
+        "--no-corner-match",
         action="store_true",
-        help="Wang sets with corner_match=True (results file wang_corners_SET_corner_match.txt; "
-        "the default since session 10, so the same sets)",
+        help="Wang sets with corner_match=False, the default before session 10 (results file "
+        "wang_corners_SET_no_corner_match.txt)",
     )
     args = ap.parse_args(argv)
     if args.docs is not None:
         args.docs.mkdir(parents=True, exist_ok=True)
-    options = {"corner_match": True} if args.corner_match else {}
+    options = {"corner_match": False} if args.no_corner_match else {}
     text = f"{_stamp()}\n\n{corners(args.set, args.tile, args.seeds, options, args.docs)}"
     print(text)
-    suffix = "_corner_match" if args.corner_match else ""
+    suffix = "_no_corner_match" if args.no_corner_match else ""
     (RESULTS / f"wang_corners_{args.set}{suffix}.txt").write_text(text)
     return 0
 
