@@ -47,7 +47,7 @@ def run(argv: list[str]) -> int:
         settings.set("theme", chosen)
     app = make_app(theme=chosen)
     collector = GuiThreadCollector(app)  # Qt objects are freed in the GUI thread only
-    app.aboutToQuit.connect(collector.stop)
+    app.aboutToQuit.connect(lambda: collector.stop(restore=False))
     from quilt_gui.main_window import MainWindow
 
     window = MainWindow()

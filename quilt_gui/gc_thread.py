@@ -27,8 +27,10 @@ INTERVAL_MS = 100
 
 
 def due_generation() -> int | None:
-    """The oldest generation whose count is past its threshold (the collection Python would
-    run now), or None."""
+    """The oldest generation that is past its threshold with every younger one, or None (as
+    pyqtgraph's GarbageCollector decides; CPython's own rule also puts off a full collection
+    until the objects waiting for one are a quarter of the long-lived ones, so this one may
+    collect the oldest generation more often)."""
     due = None
     for generation, (count, threshold) in enumerate(
         zip(gc.get_count(), gc.get_threshold(), strict=False)
@@ -58,8 +60,11 @@ class GuiThreadCollector(QObject):
         if generation is not None:
             gc.collect(generation)
 
-    def stop(self) -> None:
+    def stop(self, *, restore: bool = True) -> None:
+        """Stop the timer, collect, and with ``restore`` turn automatic collection back on if
+        it was on (not at the editor's quit: a job thread that did not stop in time could then
+        free Qt objects)."""
         self.timer.stop()
         gc.collect()
-        if self.was_enabled:
+        if restore and self.was_enabled:
             gc.enable()

@@ -202,6 +202,9 @@ class WorkerPool:
         """A worker's loop: take tasks until told to stop (or the caller is gone); each result
         goes to the calling process through ``box``."""
         _release(held)  # this process's copies, taken by the parent around the fork
+        # the editor collects in its GUI thread only (quilt_gui.gc_thread: automatic collection
+        # off); a worker has no GUI and no Qt object but the frozen ones alive at the fork
+        gc.enable()
         for other in others:  # the other workers' pipes
             other.close()
         with contextlib.suppress(ValueError):  # a Ctrl+C is the parent's (it kills its workers)

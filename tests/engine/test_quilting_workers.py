@@ -3,6 +3,7 @@ stops its workers when cancelled or failing, and threads stay available."""
 
 from __future__ import annotations
 
+import gc
 import os
 import time
 
@@ -284,7 +285,6 @@ def test_one_pools_end_does_not_end_anothers_gc_freeze(monkeypatch):
     objects stay frozen while either runs tasks, not only until the first one's call ends. (No
     loading lock counts as held: another test's warm-up thread in this process must not stop
     the forks.)"""
-    import gc
     import threading
 
     monkeypatch.setattr(workers, "_take_loading_locks", lambda: [])
@@ -325,7 +325,6 @@ def test_a_pool_abandoned_in_a_reference_cycle_is_still_shut_down(monkeypatch):
     collector finds it (its objects are not frozen between the pool's calls) and its
     ``finally`` shuts the pool and its workers down; frozen, it would be kept, and with it
     the freeze and the workers, for good."""
-    import gc
 
     monkeypatch.setattr(workers, "_take_loading_locks", lambda: [])
     pools = []
@@ -522,3 +521,33 @@ def test_workers_end_when_their_caller_is_killed_holding_the_pools_lock(tmp_path
         for p in pids:
             if not _ended(p):
                 os.kill(p, signal.SIGKILL)
+
+
+def test_workers_collect_garbage_when_the_caller_has_automatic_collection_off(tmp_path):
+    """The editor turns automatic collection off (it collects in its GUI thread): the forked
+    workers, which have no GUI thread, must collect their own cycles."""
+    caller, marker = os.getpid(), tmp_path / "a worker ran"
+
+    def run(k):
+        if os.getpid() != caller:
+            marker.write_text(str(gc.isenabled()))
+        else:  # the caller waits for a worker's task (2 min at most): no race
+            for _ in range(12000):
+                if marker.exists():
+                    break
+                time.sleep(0.01)
+        return k
+
+    was = gc.isenabled()
+    gc.disable()
+    try:
+        pool = workers.WorkerPool(run, lambda k: k, [[] for _ in range(4)], 2)
+        try:
+            assert pool.procs  # a worker was forked
+            assert [pool.result(k) for k in range(4)] == [0, 1, 2, 3]
+        finally:
+            pool.shutdown()
+    finally:
+        if was:
+            gc.enable()
+    assert marker.read_text() == "True"

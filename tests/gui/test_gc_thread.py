@@ -51,6 +51,10 @@ def test_stop_collects_and_restores_automatic_collection_as_it_was(qapp):
             collector.stop()
             assert freed_in == [threading.main_thread()]
             assert gc.isenabled() is before
+        gc.enable()
+        collector = GuiThreadCollector()
+        collector.stop(restore=False)  # the editor's quit: a late job thread frees nothing
+        assert not gc.isenabled()
     finally:
         (gc.enable if was else gc.disable)()
 
