@@ -235,6 +235,7 @@ def large_quality(args) -> None:
             for seed in range(args.seeds):
                 res = quilt(s, (out, out), block=BLOCK, overlap=OVERLAP, rng=seed, mode=mode)
                 vals.append(block_grid_border_ratio(res))
+                print(f"  {name} {mode} seed {seed}: {vals[-1]:.3f}", flush=True)
                 if mode == "auto" and seed == 0:
                     save_image(folder / f"{name}_{side}_auto_{out}.png", res.image)
             ratio[mode] = float(np.mean(vals))
