@@ -21,6 +21,13 @@ pytestmark = pytest.mark.skipif(not hasattr(os, "fork"), reason="worker processe
 SAMPLE = np.random.default_rng(6).random((210, 200, 3), dtype=np.float32)  # >= 200² pixels
 
 
+def _poll(condition, seconds: float = 60) -> None:
+    """Wait until ``condition()`` is true, for ``seconds`` at most (the caller asserts)."""
+    end = time.monotonic() + seconds
+    while not condition() and time.monotonic() < end:
+        time.sleep(0.01)
+
+
 def _records(result):
     return [
         (
@@ -292,10 +299,7 @@ def test_one_pools_end_does_not_end_anothers_gc_freeze(monkeypatch):
     go = workers.share(np.zeros(1, np.int8))
 
     def held_until_go(k):  # pool a's task ends when the test says so (a margin of 60 s)
-        for _ in range(6000):
-            if go[0]:
-                break
-            time.sleep(0.01)
+        _poll(lambda: go[0])
         return k
 
     a = workers.WorkerPool(held_until_go, lambda k: k, [[]], 2)
@@ -305,10 +309,7 @@ def test_one_pools_end_does_not_end_anothers_gc_freeze(monkeypatch):
         assert gc.get_freeze_count() == 0  # frozen only while running tasks
         inside = threading.Thread(target=a.result, args=(0,))
         inside.start()
-        for _ in range(6000):  # a's call has frozen the objects
-            if gc.get_freeze_count():
-                break
-            time.sleep(0.01)
+        _poll(gc.get_freeze_count)  # a's call has frozen the objects
         assert [b.result(k) for k in range(4)] == [0, 1, 2, 3]
         assert gc.get_freeze_count() > 0  # a still runs its task: still frozen
         go[0] = 1
@@ -352,10 +353,8 @@ def test_a_pool_abandoned_in_a_reference_cycle_is_still_shut_down(monkeypatch):
     try:
         assert pool.state[-1] == 1  # stopped by the stream's finally
         assert gc.get_freeze_count() == 0
-        for _ in range(6000):  # killed and joined (on threads of the pool's) at once
-            if all(proc.exitcode is not None for proc in procs):
-                break
-            time.sleep(0.01)
+        # killed and joined (on threads of the pool's) at once
+        _poll(lambda: all(proc.exitcode is not None for proc in procs))
         assert all(proc.exitcode is not None for proc in procs)
     finally:
         pool.shutdown(kill=True)
@@ -532,10 +531,7 @@ def test_workers_collect_garbage_when_the_caller_has_automatic_collection_off(tm
         if os.getpid() != caller:
             marker.write_text(str(gc.isenabled()))
         else:  # the caller waits for a worker's task (2 min at most): no race
-            for _ in range(12000):
-                if marker.exists():
-                    break
-                time.sleep(0.01)
+            _poll(marker.exists, 120)
         return k
 
     was = gc.isenabled()
