@@ -369,10 +369,22 @@ def somol_row(S, T: int, docs: Path | None, name: str):
     return pairs, lat.above, fr.value, det
 
 
-def quality(which: str, tile: int, docs: Path | None, seeds: int = 3, options=None) -> str:
+def tile_for(S, tile) -> int:
+    """The quality table's tile size for ``S``: ``tile`` or the largest that fits
+    (:func:`_fit`); with ``tile="auto"`` the CLI's ``--tile-size auto`` rule
+    (:func:`engine.tiles.wang_size.auto_tile_size`) applied to that of 128 px, the same rule
+    for every texture."""
+    if tile != "auto":
+        return _fit(S, int(tile))
+    from engine.tiles.wang_size import auto_tile_size
+
+    return auto_tile_size(S, _fit(S, 128))[0]
+
+
+def quality(which: str, tile, docs: Path | None, seeds: int = 3, options=None) -> str:
     rows = []
     for name, S in _textures(which):
-        T = _fit(S, tile)
+        T = tile_for(S, tile)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             wmed, wmax, wl, wf, wd, wc, wj, wraw, wcont, wpool = wang_row(
@@ -427,7 +439,7 @@ def interiors(which: str, tile: int, docs: Path | None, seeds: int = 2) -> str:
     per: dict[str, list] = {n: [] for n in names}  # construction -> per texture figures
     textures = []
     for tex, S in _textures(which):
-        T = _fit(S, tile)
+        T = tile_for(S, tile)
         textures.append(tex)
         for n in names:
             figs = []
@@ -489,7 +501,13 @@ def main(argv=None) -> int:
         default=None,
         help="compare the interior constructions (INTERIORS) on this set",
     )
-    ap.add_argument("--tile", type=int, default=128, help="tile size of the quality table")
+    ap.add_argument(
+        "--tile",
+        type=lambda t: t if t == "auto" else int(t),
+        default=128,
+        help="tile size of the quality table (default 128; auto: the CLI's --tile-size auto "
+        "rule from 128 px for every texture, wang_quality_SET_auto.txt)",
+    )
     ap.add_argument("--docs", type=Path, default=None, help="save the 8x8 layouts here")
     ap.add_argument(
         "--seeds",
@@ -515,9 +533,12 @@ def main(argv=None) -> int:
         seeds = 3 if args.seeds is None else args.seeds
         options = {"corner_match": False} if args.no_corner_match else None
         table = quality(args.quality, args.tile, args.docs, seeds, options)
-        text = f"{_stamp()}{' (corner_match=False)' if options else ''}\n\n{table}"
+        what = (" (corner_match=False)" if options else "") + (
+            " (--tile auto: the tile column is the rule's size)" if args.tile == "auto" else ""
+        )
+        text = f"{_stamp()}{what}\n\n{table}"
         print(text)
-        suffix = "_no_corner_match" if options else ""
+        suffix = ("_no_corner_match" if options else "") + ("_auto" if args.tile == "auto" else "")
         (RESULTS / f"wang_quality_{args.quality}{suffix}.txt").write_text(text)
     if args.interiors:
         seeds = 2 if args.seeds is None else args.seeds

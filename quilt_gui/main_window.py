@@ -434,6 +434,7 @@ class MainWindow(QMainWindow):
         doc = self.doc
         self.pipeline.message.connect(self.show_message)
         self.wang_runner.message.connect(self.show_message)
+        self.wang_runner.advice.connect(self.show_message)
         self.wang_view.export_requested.connect(partial(self.export_dialog, wang=True))
         self.heal_tool.message.connect(self.show_message)
         self.files.message.connect(self.show_message)

@@ -303,8 +303,9 @@ def ui_words(text: str) -> str:
 
 #: the command line's hints in the engine's notes -> the editor's words (the notes name both)
 _CLI_HINTS = (
-    # "(a larger tile size: --tile-max, or Tile size in the editor)" -> "(Tile size)"
-    (re.compile(r"\([^()]*?--[\w-]+(?: N)?, or ([^()]+?) in the editor\)"), r"(\1)"),
+    # "(a larger tile size: --tile-max, or Tile size in the editor)" -> "(Tile size)", also
+    # "(--tile-size 144, or ...)"
+    (re.compile(r"\([^()]*?--[\w-]+(?: N| \d+)?, or ([^()]+?) in the editor\)"), r"(\1)"),
     # "--no-flatten, or Flatten lighting: Off in the editor, keeps" -> "Flatten lighting: Off keeps"
     (re.compile(r"--[\w-]+, or ([^()]+?) in the editor,?"), r"\1"),
     # "try Flatten lighting (tileset --flatten)" -> "... (Parameters ▸ Advanced ▸ Tile)"

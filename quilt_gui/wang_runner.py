@@ -21,6 +21,8 @@ class WangRunner(QObject):
     """Starts the Wang jobs for ``doc`` (a :class:`quilt_gui.document.Document`)."""
 
     message = Signal(str, str)  # level, text
+    #: level, text, actions ((label, callable) buttons): a message the banner offers a fix for
+    advice = Signal(str, str, object)
 
     def __init__(self, doc, pipeline, manager: jobs.JobManager | None = None, parent=None):
         super().__init__(parent)
@@ -94,8 +96,15 @@ class WangRunner(QObject):
         w = self.doc.wang
         w.notes = tuple(result.notes)
         w.parameters = dict(result.parameters)
+        size = getattr(result, "suggested_size", None)
         for note in result.notes:
+            if size and f"{size} px" in note:
+                continue  # last, with its button (a later message would replace it)
             self.message.emit("warning", f"Wang set: {note}")
+        for note in result.notes:
+            if size and f"{size} px" in note:
+                use = lambda: self.generate({"tile_size": size})  # noqa: E731
+                self.advice.emit("warning", f"Wang set: {note}", [(f"Use {size} px tiles", use)])
         if w.complete and w.layout is None:
             seed = int(w.options["seed"])
             w.apply_layout(self._layout(seed), seed)

@@ -16,7 +16,9 @@ from pathlib import Path
 
 from engine.cli._args import int_at_least, non_negative_float
 
-__all__ = ["add_wang_options", "check_wang_args", "run_wang", "wang_changes"]
+__all__ = ["AUTO", "add_wang_options", "check_wang_args", "run_wang", "wang_changes"]
+
+AUTO = "auto"  # --tile-size auto: engine.tiles.wang_size.auto_tile_size
 
 
 def add_wang_options(p, size) -> None:
@@ -32,10 +34,12 @@ def add_wang_options(p, size) -> None:
     )
     g.add_argument(
         "--tile-size",
-        type=size,
-        metavar="N",
+        type=lambda text: AUTO if text.strip().lower() == AUTO else size(text),
+        metavar="N|auto",
         help="the tile size (square; sets --tile-min and --tile-max; default: a quarter of the "
-        "source's shorter side)",
+        "source's shorter side); auto (--wang sets): that size moved to the nearest one within "
+        "25%% that holds whole periods of a periodic texture (boards, courses), so the pattern "
+        "continues across the tile lines; a line says which",
     )
     g.add_argument(
         "--variants", type=int_at_least(1), metavar="V", help="tiles per edge signature (1)"
@@ -100,6 +104,13 @@ def wang_changes(args) -> dict:
     if args.tile_size is not None:
         if args.tile_min is not None or args.tile_max is not None:
             raise ValueError("--tile-size is one size: give it or --tile-min/--tile-max, not both")
+        if args.tile_size == AUTO:
+            if args.wang is None and changes.get("wang") is None:
+                raise ValueError(
+                    "--tile-size auto is for --wang sets (the template search's range keeps "
+                    "whole periods by itself: --whole-structures)"
+                )
+            return changes  # resolved on the source: run_wang
         changes["tile_min"] = changes["tile_max"] = args.tile_size
     return changes
 
@@ -154,6 +165,15 @@ def run_wang(args, settings, rect=None) -> int:
     say = Reporter()
     S, depth, maps, weights, excluded = load_inputs(args, settings, say)
     s = resolve_wang(settings, S.shape[:2])
+    auto = None
+    if getattr(args, "tile_size", None) == AUTO:
+        from engine.tiles.wang_size import auto_tile_size
+
+        n, what = auto_tile_size(S, s.tile_min[0], band=s.wang_band, seam=s.seam)
+        say(f"tile size (auto): {what}")
+        auto = {"asked": AUTO, "from": s.tile_min[0], "used": n, "why": what}
+        settings = settings.replace(tile_min=(n, n), tile_max=(n, n))
+        s = resolve_wang(settings, S.shape[:2])
     count = s.wang_variants * s.wang**4
     settings = check_sizes(args, settings, S, s.tile_min, maps, tiles=count)
     s = s.replace(preview=settings.preview)  # a default preview may have shrunk to fit
@@ -207,6 +227,7 @@ def run_wang(args, settings, rect=None) -> int:
             "seed": s.seed,
             "settings": settings.to_dict(),
             "resolved": s.to_dict(),
+            **({"tile_size_auto": auto} if auto else {}),
             "wang": ws.record(),
             "tiles": tiles,
             "layout": {"csv": "layout.csv", "json": "layout.json"},

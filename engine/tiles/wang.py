@@ -329,6 +329,7 @@ def _result(setup: WangSetup, samples, tiles, extra) -> WangSet:
         tiles=tuple(tiles),
         parameters={**setup.parameters(), **extra},
         notes=tuple(dict.fromkeys(setup.notes)),
+        suggested_size=setup.suggested_size,
     )
 
 

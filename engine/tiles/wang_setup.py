@@ -124,6 +124,8 @@ class WangSetup:
         self._corner: tuple | None = None
         self._phase: tuple | None = None
         self._periodic = (False, False)
+        #: a tile size near T that holds whole periods where T does not (:meth:`phase`)
+        self.suggested_size: int | None = None
         step = np.diff(colour_channels(self.S), axis=1)
         #: mean squared colour step between horizontally adjacent source pixels
         self.natural_step = float(np.einsum("yxc,yxc->", step, step, dtype=np.float64)) / (
@@ -330,6 +332,7 @@ class WangSetup:
         if self._phase is None:
             from engine.reference_crops import phase_axes
             from engine.tiles.scale import structure_scale
+            from engine.tiles.wang_size import source_fits, whole_period_size
 
             scale = structure_scale(self.S)
             self._periodic = (bool(scale.periodic[0]), bool(scale.periodic[1]))
@@ -337,7 +340,9 @@ class WangSetup:
             self._phase = tuple(
                 self.T / round(self.T / scale.size[i]) if axes[i] else None for i in range(2)
             )
-            note = broken_period_note(scale, self.T, axes)
+            fits = lambda n: source_fits(self.S.shape, n, seam=self.seam)  # noqa: E731
+            self.suggested_size = whole_period_size(scale, self.T, fits)
+            note = broken_period_note(scale, self.T, axes, self.suggested_size)
             if note:
                 self.notes.append(note)
         return self._phase
@@ -637,7 +642,7 @@ class WangSetup:
         }
 
 
-def broken_period_note(scale, T: int, whole) -> str | None:
+def broken_period_note(scale, T: int, whole, suggested: int | None = None) -> str | None:
     """A note when the texture is periodic along an axis (``scale``: a
     :class:`engine.tiles.scale.Scale`) whose period fits at least once in T but not a whole
     number of times (``whole``: :func:`engine.reference_crops.phase_axes`), else None.
@@ -645,7 +650,8 @@ def broken_period_note(scale, T: int, whole) -> str | None:
     Measured on the evaluation set's planks (boards every 48 px, 128 px tiles, 2.67 boards):
     a tile cannot continue the boards across both of its W and E edges, so every vertical tile
     line of a layout has a board of another width (31 px between gaps 15-16 px from the line
-    on both sides); at 96 or 144 px the boards run straight through the layout."""
+    on both sides); at 96 or 144 px the boards run straight through the layout. ``suggested``
+    (:func:`engine.tiles.wang_size.whole_period_size`) is named as the size to use."""
     parts = []
     for i, axis in enumerate(("tall", "wide")):
         p = float(scale.size[i])
@@ -663,6 +669,11 @@ def broken_period_note(scale, T: int, whole) -> str | None:
         f"{T} px Wang tiles do not hold whole periods, so no tile continues the pattern across "
         "two opposite edges and every tile line breaks it (a structure of another width at "
         "each line); a tile size that holds whole periods avoids it"
+        + (
+            f": {suggested} px (--tile-size {suggested}, or Tile size in the editor)"
+            if suggested
+            else ""
+        )
     )
 
 

@@ -268,6 +268,9 @@ class WangSet:
     tiles: tuple[WangTile, ...]
     parameters: dict = field(default_factory=dict)
     notes: tuple[str, ...] = ()
+    #: a tile size near ``tile_size`` that holds whole periods of the source where
+    #: ``tile_size`` does not (:func:`engine.tiles.wang_size.whole_period_size`; a note says so)
+    suggested_size: int | None = None
 
     @property
     def count(self) -> int:

@@ -153,3 +153,27 @@ def test_the_banner_does_not_cover_the_wang_layout(qtbot):
     qtbot.waitUntil(lambda: bottom() <= top, timeout=WAIT_MS)
     bar.dismiss()  # gone: the canvases take the room back
     qtbot.waitUntil(lambda: bottom() > top, timeout=WAIT_MS)
+
+
+def test_a_size_that_breaks_the_period_is_offered_a_whole_one_on_the_banner(qtbot, tmp_path):
+    from PIL import Image
+
+    from benchmarks.evalset import planks
+
+    path = tmp_path / "planks.png"
+    Image.fromarray(planks(256)).save(path)  # boards every 48 px
+    win = make_window(qtbot)
+    with qtbot.waitSignal(win.doc.source_changed, timeout=WAIT_MS):
+        win.files.open_path(str(path), confirm=False)
+    view = generate(qtbot, win, tile_size=64)  # 1.33 boards per tile
+    bar = win.message_bar
+    assert bar.level == "warning" and "48 px (Tile size)" in bar.label.text()
+    assert "--tile-size" not in bar.label.text()  # the editor's words
+    buttons = [bar._actions.itemAt(i).widget() for i in range(bar._actions.count())]
+    assert [b.text() for b in buttons] == ["Use 48 px tiles"]
+    before = len(win.messages)
+    buttons[0].click()
+    wait_wang(qtbot, win)
+    assert win.doc.wang.complete and win.doc.wang.options["tile_size"] == 48
+    assert view.tile_size.value() == 48 and view.tiles.array.shape[:2] == (4 * 48, 4 * 48)
+    assert not any("whole periods" in text for _, text in win.messages[before:])

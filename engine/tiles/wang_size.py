@@ -1,0 +1,108 @@
+"""A Wang tile size that holds whole periods of a periodic texture (``--tile-size auto``).
+
+A Wang tile whose W and E colours are equal continues the same edge sample across both of its
+vertical edges; on a texture periodic along x that is only possible when the tile holds a
+whole number of periods. Otherwise every vertical tile line of a layout breaks the pattern
+(measured on the evaluation set's planks, boards every 48 px: 128 px tiles hold 2.67 boards,
+so every vertical tile line has a board of another width, frame 1.21 over seeds 0-2; 144 px
+holds three and the boards run straight through the layout, frame 1.11; README, Wang).
+:func:`whole_period_size` moves a requested size to the nearest one within
+:data:`SNAP_RANGE` of it that holds whole periods along every periodic axis whose period it
+holds at least once (:func:`engine.reference_crops.phase_axes`' test, the one the set's phase
+and the benchmark use); :func:`auto_tile_size` does so for a source, within the sizes the
+source allows. [REC: our design; measured on the evaluation set, README]
+"""
+
+from __future__ import annotations
+
+import math
+
+__all__ = ["SNAP_RANGE", "auto_tile_size", "source_fits", "whole_period_size"]
+
+#: an automatic size stays within this fraction of the requested one (128 -> 96..160)
+SNAP_RANGE = 0.25
+
+
+def _whole_axes(scale, T: int) -> list[int]:
+    """Axes (0 = y, 1 = x) along which ``scale`` is periodic with a period T holds at least
+    once (within :func:`engine.reference_crops.phase_axes`' slack): the axes a T px tile must
+    hold whole."""
+    from engine.reference_crops import WHOLE_SLACK
+
+    top = T + max(1.0, WHOLE_SLACK * T)
+    return [i for i in range(2) if scale.periodic[i] and 0 < float(scale.size[i]) <= top]
+
+
+def whole_period_size(scale, T: int, fits=None) -> int | None:
+    """The tile size nearest to ``T`` (ties: the larger) within ``T`` ± :data:`SNAP_RANGE`
+    that holds a whole number of periods along every axis where ``scale`` (a
+    :class:`engine.tiles.scale.Scale`) is periodic with a period T holds at least once, and
+    that ``fits(size)`` accepts (every size when None); None when T already holds whole
+    periods (or there is no such axis) or no size in the range does.
+
+    >>> from engine.tiles.scale import Scale
+    >>> whole_period_size(Scale(25.6, 48.0, (False, True)), 128)  # planks: 3 boards
+    144
+    >>> whole_period_size(Scale(64.0, 32.0, (True, True)), 128) is None  # already whole
+    True
+    """
+    from engine.reference_crops import phase_axes
+
+    axes = _whole_axes(scale, T)
+
+    def whole(n: int) -> bool:
+        ok = phase_axes(scale, (n, n))
+        return all(ok[i] for i in axes)
+
+    if not axes or whole(T):
+        return None
+    lo, hi = max(8, math.ceil(T * (1 - SNAP_RANGE))), math.floor(T * (1 + SNAP_RANGE))
+    # the multiples themselves, not the edge of the test's slack (142 px for 48 px boards)
+    sizes = {round(k * float(scale.size[i])) for i in axes for k in range(1, hi + 1)}
+    for n in sorted((n for n in sizes if lo <= n <= hi), key=lambda n: (abs(n - T), -n)):
+        if whole(n) and (fits is None or fits(n)):
+            return n
+    return None
+
+
+def source_fits(shape, T: int, *, band=None, seam=None, patch_overlap=None) -> bool:
+    """Whether a source of ``shape`` (H, W[, C]) takes T px Wang tiles with these options
+    (the size checks of :class:`engine.tiles.wang_setup.WangSetup`, without its spectra)."""
+    from engine.seams.spec import as_seam_spec
+    from engine.stitch import PATCH_SEAM
+    from engine.tiles.candidates import default_patch_overlap
+    from engine.tiles.template import default_overlap
+    from engine.tiles.wang_cut import frame_reach, ramp_reach
+
+    b = max(2, default_overlap(T)) if band is None else int(band)
+    reach = frame_reach(T, b, ramp_reach(as_seam_spec(seam, default=PATCH_SEAM)))
+    ring = default_patch_overlap(default_overlap(T)) if patch_overlap is None else patch_overlap
+    return 4 * b <= T and 2 * ring <= T and min(shape[0], shape[1]) >= max(T, 2 * reach)
+
+
+def auto_tile_size(source, T: int, **options) -> tuple[int, str]:
+    """(size, what): ``T`` moved by :func:`whole_period_size` for ``source`` (H, W[, C],
+    values in [0, 1]) within the sizes it takes (:func:`source_fits` with ``options``:
+    band, seam, patch_overlap), and a sentence saying what was chosen and why."""
+    from engine.reference_crops import phase_axes
+    from engine.tiles.scale import structure_scale
+
+    scale = structure_scale(source)
+    shape = source.shape[:2]
+    n = whole_period_size(scale, T, lambda n: source_fits(shape, n, **options))
+    axes = _whole_axes(scale, T)
+    periods = " and ".join(f"{float(scale.size[i]):.0f} px {('tall', 'wide')[i]}" for i in axes)
+    if n is not None:
+        return n, (
+            f"{n} px instead of {T} px: the texture repeats about every {periods} (measured by "
+            f"autocorrelation) and {n} px holds whole periods, so the pattern continues across "
+            "the tile lines"
+        )
+    if not axes:
+        return T, f"{T} px (no period the tile holds: nothing to keep whole)"
+    if all(phase_axes(scale, (T, T))[i] for i in axes):
+        return T, f"{T} px (holds whole periods of {periods})"
+    return T, (
+        f"{T} px: the texture repeats about every {periods}, and no size within "
+        f"{SNAP_RANGE:.0%} of {T} px that the source takes holds whole periods"
+    )

@@ -1,0 +1,83 @@
+"""A Wang tile size that holds whole periods (``--tile-size auto``, the note's suggestion)."""
+
+import json
+import warnings
+
+import numpy as np
+import pytest
+
+from benchmarks.evalset import planks
+from engine.bitdepth import to_float
+from engine.tiles.scale import Scale
+from engine.tiles.wang_size import SNAP_RANGE, auto_tile_size, source_fits, whole_period_size
+
+
+def test_the_nearest_size_holding_whole_periods_on_every_periodic_axis():
+    boards = Scale(25.6, 48.0, (False, True))  # planks: 128 px holds 2.67 boards
+    assert whole_period_size(boards, 128) == 144  # 96 and 144 as near: the larger
+    assert whole_period_size(boards, 100) == 96
+    assert whole_period_size(boards, 144) is None  # already whole
+    assert whole_period_size(boards, 128, fits=lambda n: n < 140) == 96
+    grid = Scale(40.0, 40.0, (True, True))
+    assert whole_period_size(grid, 128) == 120
+    lids = Scale(116.0, 58.2, (True, True))  # one period tall, two wide
+    assert whole_period_size(lids, 128) == 116
+    # no square size near 128 holds 71 px rows and 60 px columns whole: left alone
+    assert whole_period_size(Scale(70.9, 60.0, (True, True)), 128) is None
+    assert whole_period_size(Scale(4.0, 4.0, (False, False)), 128) is None  # no period
+    far = whole_period_size(Scale(30.0, 90.0, (False, True)), 128)  # 90 or 180: too far
+    assert far is None and 128 * (1 - SNAP_RANGE) > 90 and 128 * (1 + SNAP_RANGE) < 180
+
+
+def test_source_fits_is_the_wang_setups_size_check():
+    from engine.tiles.wang import WangSetup
+
+    S = np.random.default_rng(0).random((100, 90, 3))
+    for T in (16, 40, 60, 70, 90, 100):
+        try:
+            WangSetup(S, tile_size=T)
+            ok = True
+        except ValueError:
+            ok = False
+        assert source_fits(S.shape, T) == ok, T
+
+
+def test_a_planks_set_names_the_size_to_use_and_auto_takes_it():
+    S = to_float(planks(256))  # boards every 48 px
+    n, what = auto_tile_size(S, 64)  # the default of a 256 px source: 1.33 boards
+    assert n == 48 and "48 px instead of 64 px" in what and "48 px wide" in what
+    assert auto_tile_size(S, 48) == (48, "48 px (holds whole periods of 48 px wide)")
+    from engine.tiles.wang import wang_set
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        ws = wang_set(S, tile_size=64, rng=0)
+    assert ws.suggested_size == 48
+    note = [str(w.message) for w in caught if "whole periods" in str(w.message)]
+    assert note and note[0].endswith(": 48 px (--tile-size 48, or Tile size in the editor)")
+    assert wang_set(S, tile_size=48, rng=0).suggested_size is None
+
+
+@pytest.fixture(scope="module")
+def planks_png(tmp_path_factory):
+    from PIL import Image
+
+    path = tmp_path_factory.mktemp("planks") / "planks.png"
+    Image.fromarray(planks(256)).save(path)
+    return path
+
+
+def test_cli_tile_size_auto(tmp_path, planks_png, capsys):
+    from engine.cli import main
+
+    out = tmp_path / "w"
+    argv = ["tileset", str(planks_png), "--out", str(out), "--wang", "2", "--tile-size", "auto"]
+    assert main(argv) == 0
+    man = json.loads((out / "manifest.json").read_text())
+    assert man["wang"]["tile_size"] == 48 and man["resolved"]["tile_min"] == [48, 48]
+    assert man["tile_size_auto"]["from"] == 64 and man["tile_size_auto"]["used"] == 48
+    assert not any("whole periods" in w for w in man["warnings"])
+    assert "tile size (auto): 48 px instead of 64 px" in capsys.readouterr().err
+    # a Somol set keeps whole periods by its range
+    assert main(["tileset", str(planks_png), "--out", str(tmp_path / "s"), "--tile-size", "auto"])
+    assert "--tile-size auto is for --wang sets" in capsys.readouterr().err
