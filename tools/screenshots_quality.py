@@ -14,7 +14,8 @@ Writes into docs/ (each PNG at most tools/screenshots.MAX_BYTES):
 - scale_warning.png: shelves every 64 px searched with 64 px tiles: the banner says the tile
   cuts the structures (issue 10 item 6);
 - wang_warned.png: the Wang tab, planks (boards every 48 px) with 128 px tiles: the banner
-  says the tiles do not hold whole periods, so every tile line breaks the boards.
+  says the tiles do not hold whole periods, so every tile line breaks the boards, and offers
+  "Use 144 px tiles" (three boards; session 11).
 """
 
 from __future__ import annotations

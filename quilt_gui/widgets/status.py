@@ -83,6 +83,9 @@ class MessageBar(QWidget):
             b.clicked.connect(fn)
             b.clicked.connect(self.dismiss)
             self._actions.addWidget(b)
+            # shown now, not when the event loop gets to it: place() measures the text's
+            # height beside the buttons (a hidden one takes no room: a line was cut off)
+            b.show()
         self.show()
         self.place()
         if level == "info" and not actions:

@@ -67,3 +67,27 @@ def test_closing_the_banner_takes_its_line_off_the_status_bar(qtbot):
     w.statusBar().showMessage("a newer line")
     w.message_bar.dismiss()
     assert w.statusBar().currentMessage() == "a newer line"  # only the banner's own text goes
+
+
+def test_a_banner_with_a_button_is_as_tall_as_its_text_beside_the_button(qtbot):
+    from PySide6.QtWidgets import QWidget
+
+    from quilt_gui.widgets.status import MessageBar
+
+    parent = QWidget()
+    qtbot.addWidget(parent)
+    parent.resize(700, 400)
+    parent.show()
+    bar = MessageBar(parent)
+    words = "a tile size that holds whole periods avoids it: 144 px"
+    bar.show_message("warning", words)
+    full = bar.label.width()
+    narrower = full - 180  # about a button's room
+    text = words
+    while bar.label.heightForWidth(narrower) <= bar.label.heightForWidth(full):
+        text += " " + words  # until the button's room costs a line
+        bar.label.setText(text)
+    bar.show_message("warning", text, [("Use 144 px tiles", lambda: None)])
+    need = bar.label.heightForWidth(bar.label.width())
+    qtbot.waitUntil(lambda: bar.label.width() < full, timeout=WAIT_MS)
+    assert bar.label.height() >= bar.label.heightForWidth(bar.label.width()) >= need
