@@ -31,6 +31,7 @@ from engine._jit import njit
 from engine._validate import as_image, as_rng, positive_int
 from engine.fft import default_backend, inverse, next_fast_len, spectra, transforms
 from engine.spectral import product_sum
+from engine.window_runs import mask_runs
 
 __all__ = [
     "ZERO_ERROR_FRACTION",
@@ -325,28 +326,10 @@ def _gather_ssd(sample, anchors, mask, target, out):  # pragma: no cover - compi
     The mask is read as runs of pixels along its rows, which are contiguous in the sample;
     four anchors share a pass, so their independent sums overlap in the pipeline instead of
     waiting on one another (the same additions in the same order, the same results)."""
-    h, w = mask.shape
     sw, c = sample.shape[1], sample.shape[2]
     flat = sample.ravel()
-    runs = np.empty((h * w, 3), np.int64)  # (offset in a sample window, length, first value)
-    values = np.empty(h * w * c, np.float64)
-    nr = nv = 0
-    for u in range(h):
-        v = 0
-        while v < w:
-            if not mask[u, v]:
-                v += 1
-                continue
-            v1 = v
-            while v1 < w and mask[u, v1]:
-                for ch in range(c):
-                    values[nv] = target[u, v1, ch]
-                    nv += 1
-                v1 += 1
-            runs[nr, 0], runs[nr, 1] = (u * sw + v) * c, (v1 - v) * c
-            runs[nr, 2] = nv - (v1 - v) * c
-            nr += 1
-            v = v1
+    runs, values = mask_runs(sample, target, mask)  # (offset in a window, length, first value)
+    nr = runs.shape[0]
     n = anchors.shape[0]
     for k0 in range(0, n, 4):
         ks = (k0, min(k0 + 1, n - 1), min(k0 + 2, n - 1), min(k0 + 3, n - 1))

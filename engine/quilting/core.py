@@ -16,6 +16,7 @@ import numpy as np
 
 from engine import _jit as jit
 from engine.cancel import check
+from engine.colour_bound import ColourBound
 from engine.errormap import colour_channels, error_map_of
 from engine.exclusion import valid_anchors
 from engine.matching import (
@@ -43,7 +44,11 @@ from engine.quilting.layout import arms_of, canvas_index
 from engine.quilting.records import EMPTY_PATH, BlockRecord, read_only
 from engine.stitch_numpy import SMALL_CUT_PIXELS, dp_l_cuts
 
-__all__ = ["BlockWork", "Quilter"]
+__all__ = ["BOUND_MAX_AREA", "BlockWork", "Quilter"]
+
+BOUND_MAX_AREA = 1024 * 1024
+"""Largest sample (pixels) whose exact search goes through the colour bound (its spectrum and
+rotated copy then take at most ~13 MB more; larger samples keep the full maps)."""
 
 
 @dataclass
@@ -96,6 +101,7 @@ class Quilter:
         self._spectrum = None
         self._pca = None
         self._pyramid = None
+        self._bound = None  # the exact search's colour bound (make_bound)
         self.origin = None  # (H, W, 2) int32: the sample pixel each canvas pixel came from
         self.fft_workers = 1 if threads > 1 else threads  # the pool already uses every thread
         self.stream = True  # False: no events (the benchmark's streaming-overhead reference)
@@ -116,6 +122,7 @@ class Quilter:
         _ = self.spectrum
         if self.plan.search == "pca":
             self.pca()
+        self._bound = self.make_bound()
 
     def run_batch(self, works: list[BlockWork]) -> list[tuple[BlockRecord, np.ndarray]]:
         """Load, search and place blocks of one level whose predecessors are placed (their
@@ -185,6 +192,21 @@ class Quilter:
             coarse_keep=coarse_keep,
             workers=self.threads,
         )
+
+    def make_bound(self) -> ColourBound | None:
+        """The exact search's colour bound (:mod:`engine.colour_bound`: the same candidates from
+        fewer transforms) for a colour sample of up to :data:`BOUND_MAX_AREA` pixels searched
+        by quilting's own exact search; used where each block is searched alone."""
+        h, w = self.match_sample.shape[:2]
+        if (
+            self.plan.search != "fft"
+            or type(self).search is not Quilter.search
+            or type(self).search_sample is not Quilter.search_sample
+            or h * w > BOUND_MAX_AREA
+            or type(self.tolerance) is not float
+        ):
+            return None
+        return ColourBound.build(self.match_sample, backend=self.plan.fft)
 
     def search_sample(self) -> tuple[np.ndarray, tuple | None]:
         """The channels the search matches and their groups (None: one group): the colours."""
@@ -313,13 +335,30 @@ class Quilter:
             groups.setdefault((wk.h, wk.w), []).append(wk)
         for (h, w), group in groups.items():
             check(self.cancel)
+            v, _ = self.valid(h, w)
+            if self._bound is not None and self.alone:
+                group = [wk for wk in group if not self._bounded(wk, v)]
             # alone: the same transforms however the blocks are batched
             maps = [self._ssd([wk])[0] for wk in group] if self.alone else self._ssd(group)
-            v, _ = self.valid(h, w)
             for wk, e in zip(group, maps, strict=True):
                 if v is not None:
                     e[~v] = np.inf
                 wk.found = ("map", e)
+
+    def _bounded(self, wk: BlockWork, valid) -> bool:
+        """Search ``wk`` through the colour bound; False when it should take the full map."""
+        got = self._bound.search(
+            wk.old,
+            wk.filled,
+            valid,
+            tolerance=self.tolerance,
+            zero_level=self.zero_level_for(wk),
+            workers=self.fft_workers,
+        )
+        if got is None:
+            return False
+        wk.found = ("scored", *got, self.match_sample.shape[1] - wk.w + 1)
+        return True
 
     def _ssd(self, group: list[BlockWork]) -> np.ndarray:
         """The exact search's error maps of blocks of one shape (their canvas loaded)."""
@@ -368,14 +407,17 @@ class Quilter:
             e = float(ssd_at(self.match_sample, np.array([[y, x]]), wk.old, wk.filled)[0])
             return (y, x), e, math.nan, 1
         zero = self.zero_level_for(wk)
-        if wk.found[0] == "map":
-            e = wk.found[1]
+        if wk.found[0] in ("map", "scored"):
+            # the error map, or the bound's scored anchors (flat indices, errors, anchor width)
+            e = wk.found[1] if wk.found[0] == "map" else wk.found[2]
             if isinstance(wk.rng, BlockRng):  # one compiled call
                 k, e_min, n = wk.rng.select(e, tolerance=self.tolerance, zero_level=zero)
             else:
                 k, e_min, n = select_within_tolerance(
                     e, tolerance=self.tolerance, zero_level=zero, rng=wk.rng
                 )
+            if wk.found[0] == "scored":
+                return divmod(int(wk.found[1][k]), wk.found[3]), float(e[k]), e_min, n
             return divmod(k, e.shape[1]), float(e.flat[k]), e_min, n
         _, anchors, errs = wk.found
         if self.select == "sampled":
