@@ -35,6 +35,7 @@ import numpy as np
 
 from engine import _jit as jit
 from engine._jit import njit
+from engine.fft import next_fast_len
 from engine.matching import SampleSpectrum
 from engine.spectral import product_sum
 from engine.window_runs import mask_runs
@@ -42,6 +43,7 @@ from engine.window_runs import mask_runs
 __all__ = [
     "CAP",
     "LANES",
+    "MAX_AREA",
     "RESIDUAL",
     "BoundSpectrum",
     "ColourBound",
@@ -49,11 +51,17 @@ __all__ = [
     "bounded_search",
     "bounded_search_numpy",
     "colour_axes",
+    "extra_bytes",
     "lane_sums_numpy",
     "margin",
     "rotate_content",
     "rotate_content_numpy",
 ]
+
+MAX_AREA = 1024 * 1024
+"""Largest sample (pixels) whose exact quilting search goes through the bound: its spectra,
+rotated copy and weight terms (:func:`extra_bytes`) stay small; larger samples keep the full
+maps."""
 
 RESIDUAL = 0.1
 """The bound takes the fewest leading colour axes that leave at most this fraction of the
@@ -90,6 +98,21 @@ def colour_axes(sample: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     total = lam.sum()
     share = lam / total if total > 0 else np.eye(c)[0]
     return np.ascontiguousarray(vec[:, order].T), share
+
+
+def extra_bytes(sample: np.ndarray) -> int:
+    """Memory the bound of ``sample`` holds besides the full search's (for the peak estimate):
+    the rotated copy and its spectra; 0 where :meth:`ColourBound.build` gives None. (Its
+    cached weight terms take the place of the full search's, which only the blocks that take
+    the full map add to.)"""
+    h, w, c = sample.shape
+    if c < 2:
+        return 0
+    m = bound_channels(colour_axes(sample)[1])
+    if m >= c:
+        return 0
+    plane = (next_fast_len(h) // 2 + 1) * next_fast_len(w) * 8
+    return h * w * m * 4 + (m + 1) * plane
 
 
 def bound_channels(share: np.ndarray) -> int:
@@ -147,10 +170,9 @@ class ColourBound:
             part = s[y : y + 256].astype(np.float64)
             rot[y : y + 256] = part @ self.lead.T
         self.spec = BoundSpectrum(rot, backend=backend)
-        r64 = rot.astype(np.float64)
-        self.norm_s = float(np.sqrt(np.sum(r64 * r64)))
-        q = np.sum(r64 * r64, axis=2)
-        self.norm_q = float(np.sqrt(np.sum(q * q)))
+        self.norm_s = math.sqrt(np.einsum("ijk,ijk->", rot, rot, dtype=np.float64))
+        q = np.einsum("ijk,ijk->ij", rot, rot)
+        self.norm_q = math.sqrt(np.einsum("ij,ij->", q, q, dtype=np.float64))
 
     @classmethod
     def build(cls, sample: np.ndarray, *, backend=None) -> ColourBound | None:

@@ -16,7 +16,7 @@ import numpy as np
 
 from engine import _jit as jit
 from engine.cancel import check
-from engine.colour_bound import ColourBound
+from engine.colour_bound import MAX_AREA, ColourBound
 from engine.errormap import colour_channels, error_map_of
 from engine.exclusion import valid_anchors
 from engine.matching import (
@@ -44,11 +44,7 @@ from engine.quilting.layout import arms_of, canvas_index
 from engine.quilting.records import EMPTY_PATH, BlockRecord, read_only
 from engine.stitch_numpy import SMALL_CUT_PIXELS, dp_l_cuts
 
-__all__ = ["BOUND_MAX_AREA", "BlockWork", "Quilter"]
-
-BOUND_MAX_AREA = 1024 * 1024
-"""Largest sample (pixels) whose exact search goes through the colour bound (its spectrum and
-rotated copy then take at most ~13 MB more; larger samples keep the full maps)."""
+__all__ = ["BlockWork", "Quilter"]
 
 
 @dataclass
@@ -195,14 +191,14 @@ class Quilter:
 
     def make_bound(self) -> ColourBound | None:
         """The exact search's colour bound (:mod:`engine.colour_bound`: the same candidates from
-        fewer transforms) for a colour sample of up to :data:`BOUND_MAX_AREA` pixels searched
-        by quilting's own exact search; used where each block is searched alone."""
+        fewer transforms) for a colour sample of up to ``MAX_AREA`` pixels searched by
+        quilting's own exact search; used where each block is searched alone."""
         h, w = self.match_sample.shape[:2]
         if (
             self.plan.search != "fft"
             or type(self).search is not Quilter.search
             or type(self).search_sample is not Quilter.search_sample
-            or h * w > BOUND_MAX_AREA
+            or h * w > MAX_AREA
             or type(self.tolerance) is not float
         ):
             return None

@@ -23,6 +23,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from engine import colour_bound
 from engine.budget import check_memory, format_bytes
 from engine.events import Item
 from engine.fft import BUFFER_BYTES, default_backend, next_fast_len
@@ -265,6 +266,8 @@ def plan(
     whole = spectra_bytes((H, W), cm + groups) + conc * exact_query_bytes((H, W), cm + groups)
     entry = spectra_bytes((H, W), 1)  # the cached weight term of one overlap mask
     whole += entry * min(10, WEIGHT_CACHE_BYTES // entry)  # up to ten masks, within the cap
+    if terms == "overlap" and not channels_extra and H * W <= colour_bound.MAX_AREA:
+        whole += colour_bound.extra_bytes(sample[:, :, :C])  # quilting's colour bound
     if whole + fixed <= SEARCH_BUDGET:
         exact = ("fft", n_blocks * _fft_query_seconds((H, W), cm + groups), whole)
     else:

@@ -188,3 +188,35 @@ def test_samples_the_bound_does_not_help_keep_the_full_maps():
     assert cb.ColourBound.build(grey) is None and cb.ColourBound.build(rgb) is None
     grey3 = np.repeat(grey, 3, axis=2)  # a grey photo stored as RGB: one axis
     assert cb.ColourBound.build(grey3).m == 1
+
+
+@pytest.mark.parametrize("axes", [1, 2])
+def test_the_memory_a_bound_holds_is_what_the_estimate_counts(axes):
+    """``extra_bytes`` (added to the peak estimate of a run that takes the bound) against the
+    memory a built bound holds (traced: rotated copy, spectra); and a whole run's traced peak
+    within 60-125 % of its estimate, as tests/engine/test_quilting_estimate.py asks."""
+    import tracemalloc
+
+    from engine.quilting import iter_quilt
+    from engine.quilting.estimate import Estimated
+
+    _jit.load()
+    s = coloured(50 + axes, axes, (600, 600))
+    cb.ColourBound.build(s[:300, :300])  # numpy's and ducc0's first calls allocate
+    tracemalloc.start()
+    try:
+        bound = cb.ColourBound.build(s)
+        held, _ = tracemalloc.get_traced_memory()
+        tracemalloc.reset_peak()
+        del bound
+        quilt(s[:300, :300], (100, 100), block=48, overlap=8, rng=0, threads=1)
+        tracemalloc.stop()
+        tracemalloc.start()
+        for ev in iter_quilt(s, (300, 300), block=48, overlap=8, mode="exact", rng=0, threads=1):
+            if isinstance(ev, Estimated):
+                plan = ev.plan
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    assert 0.8 * held <= cb.extra_bytes(s) <= 1.25 * held
+    assert 0.6 * plan.peak_bytes <= peak <= 1.25 * plan.peak_bytes
