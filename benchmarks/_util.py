@@ -82,3 +82,22 @@ class Tee:
     def flush(self) -> None:
         for s in self.streams:
             s.flush()
+
+
+def editor_tile_size(S, rule: str) -> int | None:
+    """The editor's default tile size (Tile size: Auto) for source ``S`` (H, W[, C]):
+    ``"auto"`` its rule (:func:`quilt_gui.params.auto_tile_size` with the source's structure
+    scale: a power of two about half the shorter side, kept to whole periods), ``"pow2"`` the
+    power of two alone (the editor's Auto before session 11)."""
+    from engine.tiles.scale import structure_scale
+    from quilt_gui.params import auto_tile_size
+
+    return auto_tile_size(S.shape[:2], structure_scale(S) if rule == "auto" else None)
+
+
+def scale_text(scale) -> str:
+    """A structure scale as 'h x w' with P marking a period (an autocorrelation peak)."""
+    if scale is None:
+        return "-"
+    mark = ["P" if p else "" for p in scale.periodic]
+    return f"{scale.height:.0f}{mark[0]} x {scale.width:.0f}{mark[1]}"

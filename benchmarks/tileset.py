@@ -53,7 +53,7 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import resources  # noqa: E402
-from benchmarks._util import format_table  # noqa: E402
+from benchmarks._util import editor_tile_size, format_table, scale_text  # noqa: E402
 from engine.events import drain  # noqa: E402
 from engine.io import load_image  # noqa: E402
 from engine.metrics import border_ratio, detail_ratio, grid_score, wrap_border_ratio  # noqa: E402
@@ -614,12 +614,14 @@ def save_layout(f: dict, path: Path, seed: int = 0) -> None:
     ).save(path)
 
 
-def evaluation(which: str, seed: int, layouts: Path | None, **changes) -> str:
+def evaluation(which: str, seed: int, layouts: Path | None, rule=None, **changes) -> str:
     from benchmarks import evalset
 
     rows = []
     for name in evalset.texture_names(which):
         S = load_image_array(evalset.load(name))
+        if rule is not None:  # the editor's Auto tile size (--tile-size)
+            changes["tile_size"] = editor_tile_size(S, rule)
         f = evaluate_texture(S, seed, **changes)
         if layouts is not None:
             save_layout(f, layouts / f"{name}.jpg", seed)
@@ -666,14 +668,6 @@ def evaluation(which: str, seed: int, layouts: Path | None, **changes) -> str:
         ],
         rows,
     )
-
-
-def scale_text(scale) -> str:
-    """A structure scale as 'h x w' with P marking a period (an autocorrelation peak)."""
-    if scale is None:
-        return "-"
-    mark = ["P" if p else "" for p in scale.periodic]
-    return f"{scale.height:.0f}{mark[0]} x {scale.width:.0f}{mark[1]}"
 
 
 def load_image_array(a: np.ndarray) -> np.ndarray:
@@ -742,6 +736,12 @@ def main(argv=None) -> int:
         help="with --evalset: the template search without the structure-scale preference "
         "(whole_structures=False), to measure what it changes",
     )
+    ap.add_argument(
+        "--tile-size",
+        choices=("auto", "pow2"),
+        help="with --evalset: the editor's default tile size (Auto) instead of the searched "
+        "range (pow2: its power of two alone, as before session 11; _util.editor_tile_size)",
+    )
     args = ap.parse_args(argv)
     unknown = set(args.patch_rings or ()) - set(RINGS)
     if unknown:
@@ -788,8 +788,10 @@ def main(argv=None) -> int:
     if args.evalset:
         changes = {"whole_structures": False} if args.cut_structures else {}
         what = ", whole_structures=False" if args.cut_structures else ""
+        what += f", the editor's Auto tile size ({args.tile_size})" if args.tile_size else ""
         print(f"\n## Evaluation set: {args.evalset} (tileset defaults{what}, 30 candidates)\n")
-        print(evaluation(args.evalset, args.seed, args.layouts, **changes), flush=True)
+        table = evaluation(args.evalset, args.seed, args.layouts, args.tile_size, **changes)
+        print(table, flush=True)
     return 0
 
 

@@ -121,7 +121,9 @@ PARAMS: tuple[Param, ...] = (
         AUTO,
         "Tile size",
         "Side of the square tile (px). Auto: a power of two about half the image's short "
-        "side. Any: the search also chooses the size, between Smallest and Largest tile.",
+        "side, moved to the nearest size that holds whole periods of a repeating texture "
+        "(boards, bricks). Any: the search also chooses the size, between Smallest and "
+        "Largest tile.",
         "Tile",
         basic=True,
         choices=(AUTO, *TILE_SIZES, ANY),

@@ -136,21 +136,35 @@ TILESET_KEYS = frozenset(k for k in BY_KEY if k in _FIELDS or k in _RENAMED or k
 }
 
 
-def auto_tile_size(shape) -> int | None:
+def auto_tile_size(shape, scale=None) -> int | None:
     """The "Auto" tile size for a source of ``shape`` (H, W): the largest power of two of
     64 … 2048 px that is at most half the shorter side; None (search a range) for a source
-    under 128 px."""
+    under 128 px. With the source's structure ``scale`` (:class:`engine.tiles.scale.Scale`),
+    that side moved to the nearest one within a quarter of it that holds whole periods of a
+    periodic texture and still fits the source (the Wang sets' rule,
+    :func:`engine.tiles.wang_size.whole_period_size`): 256 px cuts 48 px planks at every tile
+    line, 240 px holds five (README, issue 10 Session 11)."""
     half = min(int(shape[0]), int(shape[1])) // 2
     fits = [int(s) for s in TILE_SIZES if int(s) <= half]
-    return fits[-1] if fits else None
+    if not fits:
+        return None
+    if scale is None:
+        return fits[-1]
+    from engine.tiles.template import default_overlap
+    from engine.tiles.wang_size import whole_period_size
+
+    short = min(int(shape[0]), int(shape[1]))
+    side = whole_period_size(scale, fits[-1], lambda n: n + default_overlap(n) <= short)
+    return side or fits[-1]
 
 
-def tile_size(p: dict, shape=None) -> int | None:
-    """The square tile side the parameters ask for (None: the search chooses the size)."""
+def tile_size(p: dict, shape=None, scale=None) -> int | None:
+    """The square tile side the parameters ask for (None: the search chooses the size;
+    ``scale``: the source's structure scale, which the Auto size keeps whole periods of)."""
     if p["tile_size"] == ANY:
         return None
     if p["tile_size"] == AUTO:
-        return None if shape is None else auto_tile_size(shape)
+        return None if shape is None else auto_tile_size(shape, scale)
     return int(p["tile_size"])
 
 
@@ -198,16 +212,20 @@ KEPT = "tileset_kept"
 KEPT_FIELDS = _FIELDS - _SET_HERE - {_RENAMED.get(k, k) for k in BY_KEY}
 
 
-def tileset_settings(p: dict, shape=None) -> TilesetSettings:
+def tileset_settings(p: dict, shape=None, scale=None) -> TilesetSettings:
     """The :class:`engine.tiles.TilesetSettings` of the editor's parameters ``p`` (``shape``
-    (H, W) of the source settles the Auto tile size; without it Auto searches a range)."""
+    (H, W) of the source settles the Auto tile size; without it Auto searches a range;
+    ``scale``, the source's structure scale, moves it to whole periods unless the settings
+    turn ``whole_structures`` off)."""
     base = settings_from_parameters({"tileset": p.get(KEPT) or {}})
+    if not base.whole_structures:
+        scale = None
     values = {_RENAMED.get(k, k): p[k] for k in BY_KEY if _RENAMED.get(k, k) in _FIELDS}
     lo, hi = p["tile_min"] or None, p["tile_max"] or None
     if lo is not None and hi is not None:
         hi = max(lo, hi)
     values.update(
-        tile_size=tile_size(p, shape),
+        tile_size=tile_size(p, shape, scale),
         tile_min=lo,
         tile_max=hi,
         overlap=p["overlap"] or None,
@@ -261,11 +279,11 @@ def settings_params(s: TilesetSettings) -> dict:
     return out
 
 
-def project_parameters(p: dict, shape=None) -> dict:
-    """A project's ``parameters``: the tile set's settings (for a source of ``shape``) and the
-    editor's own parameters."""
+def project_parameters(p: dict, shape=None, scale=None) -> dict:
+    """A project's ``parameters``: the tile set's settings (for a source of ``shape`` and
+    structure ``scale``) and the editor's own parameters."""
     return {
-        "tileset": tileset_settings(p, shape).to_dict(),
+        "tileset": tileset_settings(p, shape, scale).to_dict(),
         "editor": {k: v for k, v in p.items() if k not in TILESET_KEYS and k != KEPT},
     }
 

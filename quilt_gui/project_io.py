@@ -47,7 +47,9 @@ def to_project(doc) -> Project:
         map_kinds=dict(doc.source.kinds),
         map_weights={k: v for k, v in ts.map_weights.items() if k in doc.source.maps},
         bit_depth=doc.source.bit_depth,
-        parameters=params.project_parameters(doc.params, doc.source.shape),
+        parameters=params.project_parameters(
+            doc.params, doc.source.shape, doc.tileset.source_scale()
+        ),
         seeds={"candidates": doc.params["seed"], "layout": doc.params["layout_seed"]},
         template_rect=ts.template_rect,
         template=template,

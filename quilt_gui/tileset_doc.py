@@ -48,6 +48,7 @@ class TileSetDocument(QObject):
         self.tone_note: str | None = None  # what Flatten lighting's Auto switched on
         self.auto_blend: str | None = None  # the seam blend Auto put in place of the chosen one
         self._tone = None  # (inputs, settings, note) of the last Auto decision
+        self._scale = None  # (source pixels, their structure scale): the Auto tile size
         self.candidates: list[CandidateTile] = []
         self.picks: list[int] = []
         self.layout: np.ndarray | None = None
@@ -113,7 +114,22 @@ class TileSetDocument(QObject):
     def settings(self):
         """The tile set's :class:`engine.settings.TilesetSettings` for the source at hand."""
         source = self.root.source
-        return params.tileset_settings(self.root.params, None if source is None else source.shape)
+        if source is None:
+            return params.tileset_settings(self.root.params)
+        return params.tileset_settings(self.root.params, source.shape, self.source_scale())
+
+    def source_scale(self):
+        """The source's structure scale (:func:`engine.tiles.scale.structure_scale`, measured
+        once per image), which the Auto tile size keeps whole periods of; None without a
+        source or when the tile size is not Auto."""
+        source = self.root.source
+        if source is None or self.root.params["tile_size"] != params.AUTO:
+            return None
+        if self._scale is None or self._scale[0] is not source.main:  # a new image
+            from engine.tiles.scale import structure_scale
+
+            self._scale = (source.main, structure_scale(source.main))
+        return self._scale[1]
 
     def working_settings(self):
         """:meth:`settings` with Flatten lighting's Auto decided for the source at hand

@@ -17,7 +17,8 @@ correlation:
 :func:`whole_structure_range` narrows the template search's range, along each periodic axis,
 to tiles that hold a whole number of periods, :data:`STRUCTURES_PER_TILE` of them where the
 requested range allows, and says in words when it cannot (the requested largest tile holds
-fewer). [REC: our design; measured on the evaluation set, README]
+fewer), or when the range holds no whole number of periods at all (a fixed tile of 160 px
+over 48 px planks). [REC: our design; measured on the evaluation set, README]
 """
 
 from __future__ import annotations
@@ -168,15 +169,33 @@ def _axis_range(period: float, lo: int, hi: int, per_tile: float) -> tuple[int, 
     return (a, b) if a <= b else (lo, hi)
 
 
+def _holds_whole(period: float, lo: int, hi: int) -> bool:
+    """Whether some size in [lo, hi] is within :data:`PERIOD_SLACK` (at least 1 px) of a
+    whole multiple of ``period`` (the search's own test, :func:`_axis_range`)."""
+    for k in range(max(1, math.floor(lo / period)), math.ceil(hi / period) + 1):
+        n = k * period
+        s = max(1.0, PERIOD_SLACK * n)
+        if max(lo, math.ceil(n - s)) <= min(hi, math.floor(n + s)):
+            return True
+    return False
+
+
+def _per_tile(p: float, lo: int, hi: int) -> str:
+    return f"{lo / p:.2f}" if lo == hi else f"{lo / p:.2f}-{hi / p:.2f}"
+
+
 def whole_structure_range(scale: Scale, lo, hi, *, per_tile: float = STRUCTURES_PER_TILE):
     """``(lo, hi, notes)``: the template search's range (h, w) narrowed, along each axis where
     the texture is periodic, to tiles that hold whole periods — about ``per_tile`` of them
     where ``hi`` allows (a structure cut at the tile edge continues in the next tile then, and
-    a tile holds three); ``notes`` says in words when the requested largest tile holds fewer.
+    a tile holds three); ``notes`` says in words when the requested largest tile holds fewer,
+    or when no tile of the range holds a whole number of periods (a fixed size between two
+    multiples: every tile line of a layout then breaks the pattern — planks at a fixed 160 px,
+    3.33 boards: frame 1.74, lattice +11.2 dB against 1.06, +2.1 at the searched 144 px).
     Axes without a period (a decorrelation length only: blobs, grain, but also one large
     landmark such as a fovea) keep the range: their measure is too unsure to act on."""
     new_lo, new_hi = list(lo), list(hi)
-    short = []
+    short, broken = [], []
     for i, axis in enumerate(("tall", "wide")):
         if not scale.periodic[i] or scale.size[i] <= 0:
             continue
@@ -184,7 +203,23 @@ def whole_structure_range(scale: Scale, lo, hi, *, per_tile: float = STRUCTURES_
         new_lo[i], new_hi[i] = _axis_range(p, lo[i], hi[i], per_tile)
         if hi[i] < per_tile * p * 0.95:
             short.append((axis, p, i))
+        elif not _holds_whole(p, lo[i], hi[i]):
+            broken.append((axis, p, i))
     notes = []
+    if broken:
+        what = " and ".join(
+            f"{p:.0f} px {axis} ({_per_tile(p, lo[i], hi[i])} per tile; "
+            f"{round(math.floor(lo[i] / p) * p)} "
+            f"or {round(math.ceil(hi[i] / p) * p)} px hold whole ones)"
+            for axis, p, i in broken
+        )
+        notes.append(
+            f"the texture repeats about every {what}, measured by autocorrelation: no tile of "
+            "the requested size holds a whole number of periods, so every tile cuts the pattern "
+            "and a layout breaks it at every tile line (a structure of another size there); "
+            "choose a tile size that holds whole periods (--tile-min/--tile-max, or Tile size "
+            "in the editor)"
+        )
     if short:
         what = " and ".join(f"{p:.0f} px {axis}" for axis, p, _ in short)
         need = list(hi)

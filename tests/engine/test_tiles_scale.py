@@ -114,3 +114,20 @@ def test_the_cli_reports_the_scale_and_warns_about_a_small_tile(tmp_path, capsys
     assert main([*args, "--tile-min", "40", "--cut-structures"]) == 0
     assert "structure scale" not in capsys.readouterr().err
     assert json.loads((out / "manifest.json").read_text())["scale"] is None
+
+
+def test_a_requested_size_between_whole_periods_is_warned_about():
+    planks = Scale(25.0, 48.0, (False, True))
+    lo, hi, notes = whole_structure_range(planks, (160, 160), (160, 160))
+    assert lo == hi == (160, 160) and len(notes) == 1  # the size is kept, and said
+    assert "48 px wide (3.33 per tile; 144 or 192 px hold whole ones)" in notes[0]
+    assert "(--tile-min/--tile-max, or Tile size in the editor)" in notes[0]
+    assert "3.12-3.54 per tile" in whole_structure_range(planks, (150, 150), (170, 170))[2][0]
+    for size in (144, 192):
+        assert whole_structure_range(planks, (size, size), (size, size))[2] == []
+    assert whole_structure_range(planks, (128, 128), (256, 256))[2] == []  # it narrows it
+    S = as_float(evalset.load("planks"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        t = find_template(S, tile_min=160, tile_max=160)
+    assert any("144 or 192 px hold whole ones" in w for w in t.warnings)  # the banner's

@@ -3,6 +3,8 @@
 from PIL import Image
 
 from benchmarks.evalset import shelves
+from engine.tiles.scale import Scale
+from quilt_gui import params
 from tests.gui.helpers import WAIT_MS, make_window, wait_idle
 
 
@@ -21,3 +23,40 @@ def test_a_tile_smaller_than_three_periods_is_warned_about_on_the_banner(qtbot, 
     assert "The texture repeats about every 64 px tall" in banner  # a sentence
     assert "Wang set" in banner and any("Best tile" in text for _, text in w.messages)
     assert "(Tile size)" in banner and "--tile-max" not in banner  # the editor's words
+
+
+def test_auto_keeps_whole_boards_and_a_size_between_them_is_warned_about(qtbot, tmp_path):
+    from benchmarks.evalset import planks
+
+    path = tmp_path / "planks.png"
+    Image.fromarray(planks(384)).save(path)  # boards every 48 px
+    w = make_window(qtbot)
+    with qtbot.waitSignal(w.doc.source_changed, timeout=WAIT_MS):
+        w.files.open_path(str(path), confirm=False)
+    assert w.doc.params["tile_size"] == "auto"  # the default: 128 px would hold 2.67 boards
+    w.act_find.trigger()
+    wait_idle(qtbot, w)
+    assert w.doc.tileset.template_rect[2:] == (144, 144)  # three boards
+    assert w.doc.tileset.settings().tile_size == (144, 144)  # what every job runs with
+    w.doc.set_params({"tile_size": "256"})  # 5.33 boards: kept as asked, and said
+    w.act_find.trigger()
+    wait_idle(qtbot, w)
+    assert w.doc.tileset.template_rect[2:] == (256, 256)
+    banner = w.message_bar.label.text()
+    assert "48 px wide (5.33 per tile; 240 or 288 px hold whole ones)" in banner
+    assert "(Tile size)" in banner and "--tile-min" not in banner  # the editor's words
+
+
+def test_the_auto_tile_size_moves_to_the_nearest_whole_number_of_periods():
+    planks, bricks = Scale(25.0, 48.0, (False, True)), Scale(32.0, 72.0, (True, True))
+    assert params.auto_tile_size((512, 512)) == 256  # without the scale: the power of two
+    assert params.auto_tile_size((512, 512), planks) == 240  # 5 boards, not 5.33
+    assert params.auto_tile_size((300, 300), planks) == 144  # 3 boards, not 2.67
+    assert params.auto_tile_size((512, 512), bricks) == 288  # 9 courses and 4 bricks
+    assert params.auto_tile_size((300, 300), bricks) == 128  # none within reach fits 300 px
+    assert params.auto_tile_size((512, 512), Scale(64.0, 32.0, (True, True))) == 256  # whole
+    assert params.auto_tile_size((512, 512), Scale(40.0, 50.0, (False, False))) == 256
+    p = dict(params.DEFAULTS, tile_size=params.AUTO)
+    assert params.tileset_settings(p, (512, 512), planks).tile_size == (240, 240)
+    p[params.KEPT] = {"whole_structures": False}  # --cut-structures: the size as it was
+    assert params.tileset_settings(p, (512, 512), planks).tile_size == (256, 256)
