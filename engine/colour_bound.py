@@ -44,6 +44,8 @@ __all__ = [
     "CAP",
     "LANES",
     "MAX_AREA",
+    "MAX_FALLBACK",
+    "PROBES",
     "RESIDUAL",
     "BoundSpectrum",
     "ColourBound",
@@ -77,6 +79,12 @@ LANES = 16
 
 SAFETY = 8.0
 """Factor on the transforms' round-off estimate in :func:`margin`."""
+
+PROBES = 9
+"""Probe blocks of :meth:`ColourBound.fallback_share` (a square number)."""
+
+MAX_FALLBACK = 0.25
+"""A sample whose probes take the full map more often than this keeps the full maps."""
 
 _EPS32 = float(np.finfo(np.float32).eps)
 _SUBSAMPLE = 1 << 16
@@ -181,6 +189,34 @@ class ColourBound:
         axes, share = colour_axes(sample)
         m = bound_channels(share)
         return None if m >= sample.shape[2] else cls(sample, axes, m, backend=backend)
+
+    def fallback_share(self, block, overlap: int, *, tolerance: float, zero_level: float) -> float:
+        """The share of :data:`PROBES` probe blocks that would take the full FFT map: windows of
+        the sample itself on a fixed grid (each has an exact copy, as many quilting blocks
+        do) with quilting's L overlap. A flat sample (most windows near copies of each other)
+        keeps too many anchors nearly everywhere, and the bound's transforms are then spent
+        on top of the full map's (job B with 90 % of its sample flat: 0.78 s against 0.49 s)."""
+        bh, bw = block
+        h, w = self.sample.shape[:2]
+        filled = np.zeros((bh, bw), np.bool_)
+        filled[:overlap] = True
+        filled[:, :overlap] = True
+        side = math.isqrt(PROBES)
+        ys = np.linspace(0, h - bh, side).astype(int)
+        xs = np.linspace(0, w - bw, side).astype(int)
+        full = sum(
+            self.search(
+                self.sample[y : y + bh, x : x + bw],
+                filled,
+                None,
+                tolerance=tolerance,
+                zero_level=zero_level,
+            )
+            is None
+            for y in ys
+            for x in xs
+        )
+        return full / (side * side)
 
     def search(self, old, filled, valid, *, tolerance: float, zero_level: float, workers=None):
         """The scored anchors of a block: (flat anchor indices ascending, their full SSDs

@@ -16,7 +16,7 @@ import numpy as np
 
 from engine import _jit as jit
 from engine.cancel import check
-from engine.colour_bound import MAX_AREA, ColourBound
+from engine.colour_bound import MAX_AREA, MAX_FALLBACK, ColourBound
 from engine.errormap import colour_channels, error_map_of
 from engine.exclusion import valid_anchors
 from engine.matching import (
@@ -202,7 +202,15 @@ class Quilter:
             or type(self.tolerance) is not float
         ):
             return None
-        return ColourBound.build(self.match_sample, backend=self.plan.fft)
+        bound = ColourBound.build(self.match_sample, backend=self.plan.fft)
+        if bound is None or min(self.block) > min(h, w):
+            return None
+        ov = self.overlap
+        count = self.block[0] * ov + self.block[1] * ov - ov * ov
+        share = bound.fallback_share(
+            self.block, ov, tolerance=self.tolerance, zero_level=self.zero_level(count)
+        )
+        return None if share > MAX_FALLBACK else bound  # a flat sample: the full maps
 
     def search_sample(self) -> tuple[np.ndarray, tuple | None]:
         """The channels the search matches and their groups (None: one group): the colours."""

@@ -230,3 +230,31 @@ def test_the_memory_a_bound_holds_is_what_the_estimate_counts(axes):
         tracemalloc.stop()
     assert 0.8 * held <= cb.extra_bytes(s) <= 1.25 * held
     assert 0.6 * plan.peak_bytes <= peak <= 1.25 * plan.peak_bytes
+
+
+def test_a_mostly_flat_sample_keeps_the_full_maps(monkeypatch):
+    """Its blocks would mostly take the full map after the bound's transforms (job B with 90 %
+    of its sample flat: 0.78 s against 0.49 s): its probes say so before the run, and the run
+    is the full maps' search, block for block."""
+    _jit.load()
+    textured = coloured(60, 1)
+    flat = textured.copy()
+    flat[:190] = np.array([0.55, 0.6, 0.7], np.float32)
+    flat[:190] += 0.002 * np.random.default_rng(0).standard_normal((190, 200, 3)).astype(np.float32)
+    bounds = []
+    real = Quilter.make_bound
+
+    def make_bound(self):
+        bounds.append(real(self))
+        return bounds[-1]
+
+    monkeypatch.setattr(Quilter, "make_bound", make_bound)
+    seen = _brute_choices(monkeypatch)
+    kw = dict(block=28, overlap=6, rng=4, threads=1)
+    quilt(flat, (120, 130), **kw)
+    assert bounds == [None] and seen["scored"] == 0 and seen["map"] > 20
+    quilt(textured, (120, 130), **kw)
+    assert bounds[1] is not None and seen["scored"] > 20
+    bound = cb.ColourBound.build(flat)
+    share = bound.fallback_share((28, 28), 6, tolerance=0.1, zero_level=0.05)
+    assert share > cb.MAX_FALLBACK
