@@ -158,6 +158,28 @@ def auto_tile_size(shape, scale=None) -> int | None:
     return side or fits[-1]
 
 
+def auto_size_note(shape, scale, size) -> str | None:
+    """What the Auto tile size did, in words, when it moved the power of two of a source of
+    ``shape`` to ``size`` to hold whole periods of its structure ``scale`` ("Auto tile size
+    240 px, not 256: the texture repeats about every 48 px wide and 240 px holds 5 whole
+    periods ..."); None when Auto kept the power of two (the size says it all)."""
+    pow2 = auto_tile_size(shape)
+    if scale is None or size is None or pow2 is None or size == pow2:
+        return None
+    from engine.tiles.wang_size import periods_held
+
+    held = periods_held(scale, size, pow2)
+    if not held:
+        return None
+    every = " and ".join(f"{p:.0f} px {axis}" for _, p, axis in held)
+    counts = " and ".join(str(k) for k, _, _ in held)
+    return (
+        f"Auto tile size {size} px, not {pow2}: the texture repeats about every {every} "
+        f"(measured) and {size} px holds {counts} whole periods, so the pattern continues "
+        "across the tile lines"
+    )
+
+
 def tile_size(p: dict, shape=None, scale=None) -> int | None:
     """The square tile side the parameters ask for (None: the search chooses the size;
     ``scale``: the source's structure scale, which the Auto size keeps whole periods of)."""

@@ -57,6 +57,7 @@ class Pipeline(QObject):
         self._seamless_pending = None
         self._template_old_rect = None
         self._auto_size: int | None = None  # the Auto tile size being searched
+        self._auto_note: tuple | None = None  # (size, why Auto chose it) when it moved it
         self._seamless_timer = _soon(self, self._start_seamless)
         doc.source_changed.connect(self._on_source_changed)
         doc.maps_changed.connect(self.schedule_seamless)
@@ -147,7 +148,10 @@ class Pipeline(QObject):
             s = s.replace(tile_size=size)
         auto = doc.params["tile_size"] == params.AUTO and s.tile_size is not None
         self._auto_size = s.tile_size[0] if auto else None
-        if size is None:
+        if size is None:  # a retry at half the side keeps the first search's rect and word
+            scale = doc.tileset.source_scale() if auto else None
+            note = params.auto_size_note(doc.source.shape, scale, self._auto_size)
+            self._auto_note = (self._auto_size, note) if note else None
             self._template_old_rect = doc.tileset.template_rect
         lo, hi = s.tile_range(doc.source.shape)
         self.template_searching.emit(True)
@@ -183,11 +187,13 @@ class Pipeline(QObject):
         self.doc.tileset.apply_template_rect(template.rect)
         self.doc.tileset.commit_template_rect(self._template_old_rect)
         x, y, w, h = template.rect
-        self.message.emit(
-            "info", f"Best tile: {w}x{h} at ({x}, {y}), border cost {template.cost:.4f}"
-        )
+        line = f"Best tile: {w}x{h} at ({x}, {y}), border cost {template.cost:.4f}"
+        auto = self._auto_note[1] if self._auto_note and (w, h) == (self._auto_note[0],) * 2 else ""
+        self.message.emit("info", f"{line}. {auto}." if auto else line)  # status and banner
         self.settings()  # the source's Auto tone note, said with the search's warnings
         notes = [self.doc.tileset.tone_note, *template.warnings]
+        if any(notes) and auto:  # the warning replaces the line on the banner: keep the word
+            notes.insert(0, auto)
         if any(notes):  # after the info line, so the banner keeps them, all at once
             self.message.emit("warning", "\n".join(params.sentence(n) for n in notes if n))
         self.template_searching.emit(False)

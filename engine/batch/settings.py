@@ -22,10 +22,13 @@ class BatchSettings:
     editor's), a Wang set when ``tileset.wang`` is set; its ``seed`` is the batch seed, mixed
     with each photo's content digest (:func:`engine.batch.inputs.photo_seed`).
     ``thumbnail``: the longer side of the 8x8 preview's thumbnail in px.
+    ``tile_size_auto``: a Wang set's tile size moved, per photo, to one that holds whole
+    periods of its texture (the ``tileset`` command's ``--tile-size auto``).
     """
 
     tileset: TilesetSettings = field(default_factory=TilesetSettings)
     thumbnail: int = 256
+    tile_size_auto: bool = False
 
     def for_photo(self, seed: int) -> TilesetSettings:
         """The tile-set settings of one photo: ``seed`` its own (the layout follows it unless
@@ -33,11 +36,18 @@ class BatchSettings:
         return self.tileset.replace(seed=seed)
 
     def to_dict(self) -> dict:
-        return {"tileset": self.tileset.to_dict(), "thumbnail": self.thumbnail}
+        d = {"tileset": self.tileset.to_dict(), "thumbnail": self.thumbnail}
+        if self.tile_size_auto:  # only when set: the libraries made before keep their hash
+            d["tile_size_auto"] = True
+        return d
 
     @classmethod
     def from_dict(cls, d: dict) -> BatchSettings:
-        return cls(TilesetSettings.from_dict(d["tileset"]), int(d.get("thumbnail", 256)))
+        return cls(
+            TilesetSettings.from_dict(d["tileset"]),
+            int(d.get("thumbnail", 256)),
+            bool(d.get("tile_size_auto", False)),
+        )
 
     def __reduce__(self):
         # sent to worker processes and Dask workers as plain data (a SeamSpec's options are a

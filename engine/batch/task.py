@@ -44,6 +44,7 @@ class PhotoRecord:
     seconds: float = 0.0
     warnings: tuple[str, ...] = ()
     metrics: dict = field(default_factory=dict)
+    notes: tuple[str, ...] = ()  # the tileset command's "tile size (auto): ..." line
 
     @property
     def failed(self) -> bool:
@@ -55,10 +56,11 @@ def project_name(key: str) -> str:
 
 
 # ---------------------------------------------------------------- the tile set
-def _make_tileset(src: Path, folder: Path, photo: Photo, settings, threads: int) -> list[str]:
-    """Run the ``tileset`` command (Somol-Haindl or Wang set, as ``settings`` say) on ``src``
-    into ``folder``, with the project; returns the engine's warnings. The manifest and the
-    project name ``photo.path`` as the source even when ``src`` is a temporary copy."""
+def _make_tileset(src: Path, folder: Path, photo: Photo, settings, threads: int, auto=False):
+    """Run the ``tileset`` command (Somol-Haindl or Wang set, as ``settings`` say; ``auto``:
+    ``--tile-size auto``, a Wang set's) on ``src`` into ``folder``, with the project; returns
+    the engine's warnings. The manifest and the project name ``photo.path`` as the source even
+    when ``src`` is a temporary copy."""
     from engine.cli import build_parser
 
     with tempfile.TemporaryDirectory(prefix="quilt-batch-") as d:
@@ -67,6 +69,8 @@ def _make_tileset(src: Path, folder: Path, photo: Photo, settings, threads: int)
         argv = ["tileset", str(src), "--out", str(folder), "--settings", str(given)]
         argv += ["--workers", str(threads), "--project", str(folder / project_name(photo.key))]
         argv += ["--source-name", photo.path]
+        if auto:
+            argv += ["--wang", str(settings.wang), "--tile-size", "auto"]
         args = build_parser(command="tileset").parse_args(argv)
         err = io.StringIO()
         with contextlib.redirect_stderr(err):
@@ -160,10 +164,14 @@ def fill_folder(
             raise PhotoError(
                 f"too small ({w}x{h}): a tile set needs at least {MIN_SIDE}x{MIN_SIDE} px"
             )
-        engine_warnings = _make_tileset(src, folder, photo, settings.for_photo(seed), threads)
+        engine_warnings = _make_tileset(
+            src, folder, photo, settings.for_photo(seed), threads, settings.tile_size_auto
+        )
     mpath = folder / MANIFEST
     manifest = json.loads(mpath.read_text(encoding="utf-8"))
     metrics, figure_warnings = _figures(folder, manifest, source)
+    auto = manifest.get("tile_size_auto")  # the tileset command's stderr line, as it said it
+    notes = [f"tile size (auto): {auto['why']}"] if auto else []
     metrics["spread"] = detail_spread(source)  # its warning is the template search's own
     warnings = list(
         dict.fromkeys([*manifest.get("warnings", []), *engine_warnings, *figure_warnings])
@@ -177,6 +185,7 @@ def fill_folder(
         round(time.perf_counter() - t0, 3),
         tuple(warnings),
         metrics,
+        tuple(notes),
     )
     project = folder / project_name(photo.key)
     manifest["batch"] = _batch_section(

@@ -41,7 +41,13 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--out", required=True, metavar="LIB", help="library folder (created)")
     size = p.add_argument_group("tile size (default: the tileset command's range per photo)")
     size.add_argument(
-        "--tile-size", type=int_at_least(8), default=None, metavar="N", help="tiles of N x N px"
+        "--tile-size",
+        type=_size_or_auto,
+        default=None,
+        metavar="N|auto",
+        help="tiles of N x N px; auto (--wang sets): the tileset command's --tile-size auto for "
+        "each photo (its default size moved to the nearest one within 25%% that holds whole "
+        "periods of a periodic texture; a line per photo says which)",
     )
     size.add_argument(
         "--tile-min", type=int_at_least(8), default=None, metavar="N", help="smallest tile side"
@@ -114,6 +120,12 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     return p
 
 
+def _size_or_auto(text: str):
+    from engine.cli.tileset_wang import AUTO
+
+    return AUTO if text.strip().lower() == AUTO else int_at_least(8)(text)
+
+
 def _settings(args, fail):
     """The batch's settings from the flags (and ``--settings``); a bad value fails with
     exit code 2."""
@@ -123,11 +135,13 @@ def _settings(args, fail):
 
     if args.tile_size is not None and (args.tile_min is not None or args.tile_max is not None):
         fail("--tile-size cannot be combined with --tile-min / --tile-max")
+    auto = args.tile_size == "auto"
+    fixed = None if auto else args.tile_size
     changes = {
         k: v
         for k, v in (
-            ("tile_min", args.tile_size or args.tile_min),
-            ("tile_max", args.tile_size or args.tile_max),
+            ("tile_min", fixed or args.tile_min),
+            ("tile_max", fixed or args.tile_max),
             ("candidates", args.candidates),
             ("wang", args.wang),
             ("seed", args.seed),
@@ -142,7 +156,14 @@ def _settings(args, fail):
         fail(str(exc))
     if settings.wang is not None and settings.flatten:
         fail("--flatten is not available for Wang sets (the Wang workflow does not flatten)")
-    return BatchSettings(settings)
+    if auto and settings.wang is None:
+        fail(
+            "--tile-size auto is for --wang sets (the template search's range keeps whole "
+            "periods by itself)"
+        )
+    if auto and (settings.tile_min is not None or settings.tile_max is not None):
+        fail("--tile-size auto moves the default size: --settings fixes one (tile_min/tile_max)")
+    return BatchSettings(settings, tile_size_auto=auto)
 
 
 class _Usage(Exception):
@@ -227,6 +248,8 @@ def _make(args, settings, lib, photos, dupes, plan) -> int:
                 made += 1
             bar.update(1)
             bar.set_postfix_str(f"done {made}, failed {len(failed)}", refresh=True)
+            for note in r.notes:  # the tileset command's own line, for each photo
+                bar.write(f"quilt-studio batch: {r.path}: {note}", file=sys.stderr)
             if args.verbose:
                 bar.write(_line(r), file=sys.stderr)
     except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM (Terminated)

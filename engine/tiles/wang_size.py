@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["SNAP_RANGE", "auto_tile_size", "source_fits", "whole_period_size"]
+__all__ = ["SNAP_RANGE", "auto_tile_size", "periods_held", "source_fits", "whole_period_size"]
 
 #: an automatic size stays within this fraction of the requested one (128 -> 96..160)
 SNAP_RANGE = 0.25
@@ -31,6 +31,18 @@ def _whole_axes(scale, T: int) -> list[int]:
 
     top = T + max(1.0, WHOLE_SLACK * T)
     return [i for i in range(2) if scale.periodic[i] and 0 < float(scale.size[i]) <= top]
+
+
+def periods_held(scale, n: int, T: int | None = None) -> list[tuple[int, float, str]]:
+    """(count, period px, "tall"/"wide") of the periods an ``n`` px tile holds along every axis
+    a ``T`` px tile (default ``n``) must hold whole (:func:`whole_period_size`'s axes; count
+    rounded): [(5, 48.0, "wide")] for 240 px over 48 px boards; [] when there is no such axis."""
+    axes = _whole_axes(scale, n if T is None else T)
+    out = []
+    for i in axes:
+        p = float(scale.size[i])
+        out.append((round(n / p), p, ("tall", "wide")[i]))
+    return out
 
 
 def whole_period_size(scale, T: int, fits=None) -> int | None:

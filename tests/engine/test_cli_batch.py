@@ -108,6 +108,30 @@ def test_bad_arguments_exit_2(tmp_path, capsys):
     assert exc.value.code == 2
 
 
+def test_wang_tile_size_auto_per_photo_says_which(tmp_path, capsys):
+    import json
+
+    from PIL import Image
+
+    from benchmarks.evalset import planks
+
+    p = tmp_path / "in" / "planks.png"
+    p.parent.mkdir()
+    Image.fromarray(planks(512)).save(p)  # boards every 48 px: the default 128 holds 2.67
+    lib = tmp_path / "lib"
+    assert batch(p, "--out", lib, "--tile-size", "auto", capsys=capsys)[0] == 2  # not --wang
+    code, err = batch(p, "--out", lib, "--wang", "2", "--tile-size", "auto", capsys=capsys)
+    assert code == 0 and summary(err) == (1, 1, 0, 0, 0)
+    assert "planks.png: tile size (auto): 144 px instead of 128 px: the texture repeats" in err
+    (folder,) = photo_folders(lib)
+    manifest = json.loads((lib / folder / "manifest.json").read_text())
+    assert manifest["tile_size_auto"]["used"] == 144
+    assert Image.open(lib / folder / manifest["tiles"][0]["file"]).size == (144, 144)
+    assert manifest["batch"]["settings"]["tile_size_auto"] is True
+    code, err = batch(p, "--out", lib, "--wang", "2", capsys=capsys)  # not auto: made again
+    assert code == 0 and summary(err) == (1, 1, 0, 0, 0) and "tile size (auto)" not in err
+
+
 def temporaries(lib: Path) -> list[str]:
     return [p.name for p in lib.iterdir() if p.name.startswith(".") and "tmp" in p.name]
 

@@ -60,3 +60,36 @@ def test_the_auto_tile_size_moves_to_the_nearest_whole_number_of_periods():
     assert params.tileset_settings(p, (512, 512), planks).tile_size == (240, 240)
     p[params.KEPT] = {"whole_structures": False}  # --cut-structures: the size as it was
     assert params.tileset_settings(p, (512, 512), planks).tile_size == (256, 256)
+
+
+def test_the_best_tile_line_says_in_words_when_auto_moved_the_tile_size(qtbot, tmp_path):
+    from benchmarks.evalset import planks
+
+    path = tmp_path / "planks.png"
+    Image.fromarray(planks(384)).save(path)  # boards every 48 px: Auto 128 -> 144
+    w = make_window(qtbot)
+    with qtbot.waitSignal(w.doc.source_changed, timeout=WAIT_MS):
+        w.files.open_path(str(path), confirm=False)
+    w.act_find.trigger()
+    wait_idle(qtbot, w)
+    said = "Auto tile size 144 px, not 128: the texture repeats about every 48 px wide"
+    line = next(text for _, text in reversed(w.messages) if text.startswith("Best tile"))
+    assert said in line and "144 px holds 3 whole periods" in line
+    shown = (w.statusBar().currentMessage(), w.message_bar.label.text())
+    assert all(said in text for text in shown)  # where the user looks, banner and status
+    w.doc.set_params({"tile_size": "128"})  # asked for: kept (and warned), Auto said nothing
+    w.act_find.trigger()
+    wait_idle(qtbot, w)
+    assert "Auto tile size" not in w.last_message()
+    assert "Auto tile size" not in w.statusBar().currentMessage()
+
+
+def test_the_auto_size_note_names_every_axis_it_keeps_whole():
+    planks, bricks = Scale(25.0, 48.0, (False, True)), Scale(32.0, 72.0, (True, True))
+    note = params.auto_size_note((512, 512), planks, 240)
+    assert note.startswith("Auto tile size 240 px, not 256: the texture repeats about every 48")
+    assert "240 px holds 5 whole periods" in note
+    note = params.auto_size_note((512, 512), bricks, 288)
+    assert "every 32 px tall and 72 px wide" in note and "holds 9 and 4 whole periods" in note
+    assert params.auto_size_note((512, 512), planks, 256) is None  # the power of two kept
+    assert params.auto_size_note((512, 512), None, 240) is None
