@@ -161,8 +161,8 @@ def auto_tile_size(shape, scale=None) -> int | None:
 def auto_size_note(shape, scale, size) -> str | None:
     """What the Auto tile size did, in words, when it moved the power of two of a source of
     ``shape`` to ``size`` to hold whole periods of its structure ``scale`` ("Auto tile size
-    240 px, not 256: the texture repeats about every 48 px wide and 240 px holds 5 whole
-    periods ..."); None when Auto kept the power of two (the size says it all)."""
+    240 px, not 256: it holds whole periods of the texture (5 × 48 px wide, measured) ...", the
+    facts first: the status bar cuts a long line); None when Auto kept the power of two."""
     pow2 = auto_tile_size(shape)
     if scale is None or size is None or pow2 is None or size == pow2:
         return None
@@ -171,12 +171,12 @@ def auto_size_note(shape, scale, size) -> str | None:
     held = periods_held(scale, size, pow2)
     if not held:
         return None
-    every = " and ".join(f"{p:.0f} px {axis}" for _, p, axis in held)
-    counts = " and ".join(str(k) for k, _, _ in held)
+    what = ", ".join(f"{k} × {p:.0f} px {axis}" for k, p, axis in held)
+    if len(held) == 2 and len({(k, f"{p:.0f}") for k, p, _ in held}) == 1:  # the weave, tiles
+        what = f"{held[0][0]} × {held[0][1]:.0f} px each way"
     return (
-        f"Auto tile size {size} px, not {pow2}: the texture repeats about every {every} "
-        f"(measured) and {size} px holds {counts} whole periods, so the pattern continues "
-        "across the tile lines"
+        f"Auto tile size {size} px, not {pow2}: it holds whole periods of the texture ({what}, "
+        "measured), so the pattern continues across the tile lines"
     )
 
 

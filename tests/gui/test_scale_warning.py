@@ -72,9 +72,9 @@ def test_the_best_tile_line_says_in_words_when_auto_moved_the_tile_size(qtbot, t
         w.files.open_path(str(path), confirm=False)
     w.act_find.trigger()
     wait_idle(qtbot, w)
-    said = "Auto tile size 144 px, not 128: the texture repeats about every 48 px wide"
+    said = "Auto tile size 144 px, not 128: it holds whole periods of the texture (3 × 48 px wide"
     line = next(text for _, text in reversed(w.messages) if text.startswith("Best tile"))
-    assert said in line and "144 px holds 3 whole periods" in line
+    assert said in line
     shown = (w.statusBar().currentMessage(), w.message_bar.label.text())
     assert all(said in text for text in shown)  # where the user looks, banner and status
     w.doc.set_params({"tile_size": "128"})  # asked for: kept (and warned), Auto said nothing
@@ -87,9 +87,11 @@ def test_the_best_tile_line_says_in_words_when_auto_moved_the_tile_size(qtbot, t
 def test_the_auto_size_note_names_every_axis_it_keeps_whole():
     planks, bricks = Scale(25.0, 48.0, (False, True)), Scale(32.0, 72.0, (True, True))
     note = params.auto_size_note((512, 512), planks, 240)
-    assert note.startswith("Auto tile size 240 px, not 256: the texture repeats about every 48")
-    assert "240 px holds 5 whole periods" in note
+    assert note.startswith("Auto tile size 240 px, not 256: it holds whole periods of the texture")
+    assert "(5 × 48 px wide, measured)" in note
     note = params.auto_size_note((512, 512), bricks, 288)
-    assert "every 32 px tall and 72 px wide" in note and "holds 9 and 4 whole periods" in note
+    assert "(9 × 32 px tall, 4 × 72 px wide, measured)" in note
+    note = params.auto_size_note((512, 512), Scale(48.0, 48.0, (True, True)), 240)  # weave
+    assert "(5 × 48 px each way, measured)" in note
     assert params.auto_size_note((512, 512), planks, 256) is None  # the power of two kept
     assert params.auto_size_note((512, 512), None, 240) is None
