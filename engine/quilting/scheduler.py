@@ -175,6 +175,7 @@ def run_levels(q: Quilter, rects, total_label: str):
             q.cancel,
             done=len(head),
             pack=workers.pack_records,
+            shared=(q.canvas, q.filled),
         )
         outcomes = itertools.chain(head, (placed.result(b) for b in range(len(head), len(batches))))
     elif q.threads > 1 and area >= POOL_MIN_SAMPLE_AREA:

@@ -547,3 +547,71 @@ def test_workers_collect_garbage_when_the_caller_has_automatic_collection_off(tm
         if was:
             gc.enable()
     assert marker.read_text() == "True"
+
+
+def _faults() -> int:
+    import resource
+
+    return resource.getrusage(resource.RUSAGE_SELF).ru_minflt
+
+
+PAGES = 2048  # 8 MB of 4 kB pages
+
+
+@pytest.mark.skipif(not workers._POPULATE, reason="MAP_POPULATE is Linux's")
+def test_shared_memory_is_mapped_when_made():
+    """The canvas, its mask and the rings are new in every run: mapped page by page on first
+    touch, they cost a fault per page in each process (~4 000 a job B run)."""
+    a = workers.share(np.zeros(PAGES * 4096, np.uint8))
+    before = _faults()
+    a[::4096] = 1  # one write per page
+    assert _faults() - before < PAGES // 4
+
+
+@pytest.mark.skipif(not workers._POPULATE, reason="MADV_POPULATE_WRITE is Linux's")
+def test_workers_map_the_shared_memory_at_their_start():
+    """A forked worker inherits no page table entries of shared mappings: without mapping the
+    pool's shared arrays at its start it faults on every page it touches."""
+    a = workers.share(np.zeros(PAGES * 4096, np.uint8))
+    parent = os.getpid()
+
+    def run(k):
+        before = _faults()
+        a[k::4096] = 1
+        return os.getpid(), _faults() - before
+
+    pool = workers.WorkerPool(run, lambda r: r, [[]], 2, shared=[a])
+    try:
+        _poll(lambda: pool.state[0] == workers.TAKEN)  # taken by the worker
+        pid, faults = pool.result(0)
+    finally:
+        pool.shutdown(kill=True)
+    assert pid != parent
+    assert faults < PAGES // 4
+    assert a[::4096].all()
+
+
+def test_the_heap_is_trimmed_before_the_workers_fork(monkeypatch):
+    """After the fork every page is shared copy-on-write: the heap's free pages are given back
+    first (a reused one would cost a fault and a copy in the process that writes it)."""
+    made, workers_then = [], []
+    real = workers._trim_heap
+
+    def trim():
+        workers_then.append(len(made[-1].procs))
+        real()
+
+    monkeypatch.setattr(workers, "_trim_heap", trim)
+
+    class Pool(workers.WorkerPool):
+        def __init__(self, *args, **kwargs):
+            made.append(self)
+            super().__init__(*args, **kwargs)
+
+    pool = Pool(lambda k: k, lambda k: k, [[] for _ in range(4)], 2)
+    try:
+        assert [pool.result(k) for k in range(4)] == [0, 1, 2, 3]
+        assert pool.procs
+    finally:
+        pool.shutdown()
+    assert workers_then == [0]  # once, before any worker
