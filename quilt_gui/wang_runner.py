@@ -97,14 +97,13 @@ class WangRunner(QObject):
         w.notes = tuple(result.notes)
         w.parameters = dict(result.parameters)
         size = getattr(result, "suggested_size", None)
+        advice = getattr(result, "suggested_note", None) if size else None
         for note in result.notes:
-            if size and f"{size} px" in note:
-                continue  # last, with its button (a later message would replace it)
-            self.message.emit("warning", f"Wang set: {note}")
-        for note in result.notes:
-            if size and f"{size} px" in note:
-                use = lambda: self.generate({"tile_size": size})  # noqa: E731
-                self.advice.emit("warning", f"Wang set: {note}", [(f"Use {size} px tiles", use)])
+            if note != advice:  # that one last, with its button (a later message replaces it)
+                self.message.emit("warning", f"Wang set: {note}")
+        if advice in result.notes:
+            use = lambda: self.generate({"tile_size": size})  # noqa: E731
+            self.advice.emit("warning", f"Wang set: {advice}", [(f"Use {size} px tiles", use)])
         if w.complete and w.layout is None:
             seed = int(w.options["seed"])
             w.apply_layout(self._layout(seed), seed)

@@ -321,7 +321,7 @@ def settings_from_args(args) -> TilesetSettings:
     changes = {f: getattr(args, a) for a, f in _FIELDS.items() if getattr(args, a) is not None}
     if args.tile_min is not None and args.tile_max is None:
         changes["tile_max"] = args.tile_min  # a fixed size unless a range is asked for
-    from engine.cli.tileset_wang import wang_changes
+    from engine.cli.tileset_wang import check_tile_size_auto, wang_changes
 
     changes.update(wang_changes(args))
     if args.equal_neighbours:
@@ -339,9 +339,11 @@ def settings_from_args(args) -> TilesetSettings:
     try:
         if seam:
             changes["seam"] = base.seam.replace(**seam)
-        return base.replace(**changes)
+        settings = base.replace(**changes)
     except TypeError as exc:  # a bad --seam-option, named by the settings
         raise ValueError(str(exc)) from None
+    check_tile_size_auto(args, settings)  # --wang or a Wang manifest's settings
+    return settings
 
 
 def read_settings(path) -> TilesetSettings:

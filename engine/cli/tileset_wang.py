@@ -16,7 +16,14 @@ from pathlib import Path
 
 from engine.cli._args import int_at_least, non_negative_float
 
-__all__ = ["AUTO", "add_wang_options", "check_wang_args", "run_wang", "wang_changes"]
+__all__ = [
+    "AUTO",
+    "add_wang_options",
+    "check_tile_size_auto",
+    "check_wang_args",
+    "run_wang",
+    "wang_changes",
+]
 
 AUTO = "auto"  # --tile-size auto: engine.tiles.wang_size.auto_tile_size
 
@@ -105,14 +112,19 @@ def wang_changes(args) -> dict:
         if args.tile_min is not None or args.tile_max is not None:
             raise ValueError("--tile-size is one size: give it or --tile-min/--tile-max, not both")
         if args.tile_size == AUTO:
-            if args.wang is None and changes.get("wang") is None:
-                raise ValueError(
-                    "--tile-size auto is for --wang sets (the template search's range keeps "
-                    "whole periods by itself: --whole-structures)"
-                )
-            return changes  # resolved on the source: run_wang
+            return changes  # resolved on the source (run_wang); checked by check_tile_size_auto
         changes["tile_min"] = changes["tile_max"] = args.tile_size
     return changes
+
+
+def check_tile_size_auto(args, settings) -> None:
+    """``--tile-size auto`` needs a Wang set: ``settings`` merged from --settings (a Wang
+    manifest) and the flags (--wang)."""
+    if getattr(args, "tile_size", None) == AUTO and settings.wang is None:
+        raise ValueError(
+            "--tile-size auto is for --wang sets (the template search's range keeps "
+            "whole periods by itself: --whole-structures)"
+        )
 
 
 def check_wang_args(args) -> None:
@@ -169,7 +181,9 @@ def run_wang(args, settings, rect=None) -> int:
     if getattr(args, "tile_size", None) == AUTO:
         from engine.tiles.wang_size import auto_tile_size
 
-        n, what = auto_tile_size(S, s.tile_min[0], band=s.wang_band, seam=s.seam)
+        n, what = auto_tile_size(
+            S, s.tile_min[0], band=s.wang_band, seam=s.seam, patch_overlap=s.patch_overlap
+        )
         say(f"tile size (auto): {what}")
         auto = {"asked": AUTO, "from": s.tile_min[0], "used": n, "why": what}
         settings = settings.replace(tile_min=(n, n), tile_max=(n, n))

@@ -330,6 +330,7 @@ def _result(setup: WangSetup, samples, tiles, extra) -> WangSet:
         parameters={**setup.parameters(), **extra},
         notes=tuple(dict.fromkeys(setup.notes)),
         suggested_size=setup.suggested_size,
+        suggested_note=setup.suggested_note,
     )
 
 

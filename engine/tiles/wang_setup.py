@@ -79,6 +79,8 @@ class WangSetup:
                 "signature would be the same tile)"
             )
         self.seam = as_seam_spec(seam, default=PATCH_SEAM)
+        #: the size checks' options as given (None where defaulted: they scale with the size)
+        self._fit_options = dict(band=band, patch_overlap=patch_overlap, seam=self.seam)
         self.interior_blend = choice(interior_blend, "interior_blend", INTERIOR_BLENDS)
         if self.interior_blend == "auto":
             blend = "none" if self.seam.blend == "none" else POISSON
@@ -126,6 +128,8 @@ class WangSetup:
         self._periodic = (False, False)
         #: a tile size near T that holds whole periods where T does not (:meth:`phase`)
         self.suggested_size: int | None = None
+        #: the note (in :attr:`notes`) that names :attr:`suggested_size`
+        self.suggested_note: str | None = None
         step = np.diff(colour_channels(self.S), axis=1)
         #: mean squared colour step between horizontally adjacent source pixels
         self.natural_step = float(np.einsum("yxc,yxc->", step, step, dtype=np.float64)) / (
@@ -340,11 +344,12 @@ class WangSetup:
             self._phase = tuple(
                 self.T / round(self.T / scale.size[i]) if axes[i] else None for i in range(2)
             )
-            fits = lambda n: source_fits(self.S.shape, n, seam=self.seam)  # noqa: E731
+            fits = lambda n: source_fits(self.S.shape, n, **self._fit_options)  # noqa: E731
             self.suggested_size = whole_period_size(scale, self.T, fits)
             note = broken_period_note(scale, self.T, axes, self.suggested_size)
             if note:
                 self.notes.append(note)
+                self.suggested_note = note if self.suggested_size else None
         return self._phase
 
     def periodic(self) -> tuple[bool, bool]:

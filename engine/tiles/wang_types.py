@@ -271,6 +271,8 @@ class WangSet:
     #: a tile size near ``tile_size`` that holds whole periods of the source where
     #: ``tile_size`` does not (:func:`engine.tiles.wang_size.whole_period_size`; a note says so)
     suggested_size: int | None = None
+    #: the one of ``notes`` that names ``suggested_size`` (None without a suggestion)
+    suggested_note: str | None = None
 
     @property
     def count(self) -> int:

@@ -55,7 +55,21 @@ def test_a_planks_set_names_the_size_to_use_and_auto_takes_it():
     assert ws.suggested_size == 48
     note = [str(w.message) for w in caught if "whole periods" in str(w.message)]
     assert note and note[0].endswith(": 48 px (--tile-size 48, or Tile size in the editor)")
+    assert ws.suggested_note == note[0] and ws.suggested_note in ws.notes
     assert wang_set(S, tile_size=48, rng=0).suggested_size is None
+
+
+def test_the_suggested_size_takes_the_runs_band_and_patch_overlap():
+    from engine.tiles.wang import WangSetup
+
+    S = to_float(planks(256))  # boards every 48 px; 64 px tiles suggest 48 by default
+    setup = WangSetup(S, tile_size=64, band=14)  # 4 x 14 > 48: 48 px tiles refuse band 14
+    setup.phase()
+    assert setup.suggested_size is None and setup.suggested_note is None
+    setup = WangSetup(S, tile_size=64, patch_overlap=30)  # 2 x 30 > 48
+    setup.phase()
+    assert setup.suggested_size is None
+    assert not source_fits(S.shape, 48, band=14) and not source_fits(S.shape, 48, patch_overlap=30)
 
 
 @pytest.fixture(scope="module")
@@ -81,3 +95,35 @@ def test_cli_tile_size_auto(tmp_path, planks_png, capsys):
     # a Somol set keeps whole periods by its range
     assert main(["tileset", str(planks_png), "--out", str(tmp_path / "s"), "--tile-size", "auto"])
     assert "--tile-size auto is for --wang sets" in capsys.readouterr().err
+
+
+def _stop_at_the_set(monkeypatch):
+    """Record the settings the tileset command's Wang run starts with, and stop it there."""
+    import engine.tiles.wang_pipeline as pipeline
+
+    seen = []
+
+    def stop(source, settings, **kwargs):
+        seen.append(settings)
+        raise ValueError("stopped before the set")
+
+    monkeypatch.setattr(pipeline, "iter_wang_tileset", stop)
+    return seen
+
+
+def test_cli_tile_size_auto_takes_a_wang_manifest_and_the_patch_overlap(
+    tmp_path, planks_png, capsys, monkeypatch
+):
+    from engine.cli import main
+
+    seen = _stop_at_the_set(monkeypatch)
+    manifest = tmp_path / "manifest.json"
+    manifest.write_text(json.dumps({"settings": {"wang": 2}}))  # a Wang manifest
+    argv = ["tileset", str(planks_png), "--settings", str(manifest), "--tile-size", "auto"]
+    assert main([*argv, "--out", str(tmp_path / "a")]) != 0
+    assert "stopped before the set" in capsys.readouterr().err  # not refused: a Wang set
+    assert seen[-1].wang == 2 and seen[-1].tile_min == (48, 48)
+    # 2 x 30 px of patch overlap does not fit 48 px tiles: auto keeps the 64 px default
+    assert main([*argv, "--patch-overlap", "30", "--out", str(tmp_path / "b")]) != 0
+    assert "tile size (auto): 64 px" in capsys.readouterr().err
+    assert seen[-1].tile_min == (64, 64)

@@ -177,3 +177,21 @@ def test_a_size_that_breaks_the_period_is_offered_a_whole_one_on_the_banner(qtbo
     assert win.doc.wang.complete and win.doc.wang.options["tile_size"] == 48
     assert view.tile_size.value() == 48 and view.tiles.array.shape[:2] == (4 * 48, 4 * 48)
     assert not any("whole periods" in text for _, text in win.messages[before:])
+
+
+def test_only_the_note_the_engine_names_carries_the_use_size_button(qtbot):
+    from types import SimpleNamespace
+
+    win = make_window(qtbot)
+    runner, messages, advice = win.wang_runner, [], []
+    runner.message.connect(lambda level, text: messages.append(text))
+    runner.advice.connect(lambda level, text, actions: advice.append((text, actions)))
+    other = "the texture repeats about every 148 px tall: a note that names 148 px"
+    named = "the texture repeats about every 32 px wide: 48 px (Tile size)"
+    result = SimpleNamespace(
+        notes=(other, named), parameters={}, suggested_size=48, suggested_note=named
+    )
+    runner._on_done(result)
+    assert [text for text, _ in advice] == [f"Wang set: {named}"]  # once, "148 px" not taken
+    assert [label for label, _ in advice[0][1]] == ["Use 48 px tiles"]
+    assert messages == [f"Wang set: {other}"]
