@@ -9,8 +9,8 @@ threads were no faster than one. So where ``fork`` exists,
 :func:`engine.quilting.scheduler.run_levels` places such blocks in worker processes instead:
 
 * the canvas and its ``filled`` mask move to shared memory (an anonymous ``MAP_SHARED``
-  mapping, its pages mapped at once in the caller and in each worker at its start: a fault per
-  page otherwise) before the fork; the workers inherit everything else (the sample's spectra,
+  mapping, its pages mapped at once by each worker at its start: a fault per page otherwise)
+  before the fork; the workers inherit everything else (the sample's spectra,
   the options) copy-on-write, the heap's free pages given back first (:func:`_trim_heap`);
 * the calling process and ``threads - 1`` forked workers each take the lowest ready task (the
   ready set, a lock and a semaphore live in shared memory), run exactly the task a thread would
@@ -94,33 +94,27 @@ def _shared_locks_work() -> bool:
 
 
 def share(a: np.ndarray) -> np.ndarray:
-    """A copy of ``a`` in anonymous shared memory (seen by processes forked after this), its
-    pages mapped at once (:func:`_mapped`)."""
-    buf = _mapped(max(1, a.nbytes))  # zero-filled
+    """A copy of ``a`` in anonymous shared memory (seen by processes forked after this)."""
+    buf = mmap.mmap(-1, max(1, a.nbytes))  # zero-filled
     out = np.frombuffer(buf, dtype=a.dtype, count=a.size).reshape(a.shape)
     if a.any():
         out[...] = a
     return out
 
 
-_POPULATE = getattr(mmap, "MAP_POPULATE", 0)
 _POPULATE_WRITE = 23  # madvise's MADV_POPULATE_WRITE (Linux 5.14; the mmap module lacks it)
-
-
-def _mapped(n: int) -> mmap.mmap:
-    """``n`` zero bytes of anonymous shared memory, every page mapped in this process at once
-    (``MAP_POPULATE``). Otherwise each process took a page fault on its first touch of every
-    page of the canvas, its mask and the rings, new in every run (~4 000 faults per job B run
-    on two workers, 12 MB of canvas, at several us each in this VM)."""
-    if _POPULATE:
-        return mmap.mmap(-1, n, flags=mmap.MAP_SHARED | _POPULATE)
-    return mmap.mmap(-1, n)
 
 
 def populate(a: np.ndarray) -> None:
     """Map every page of shared memory ``a`` (made by :func:`share`) into this process in one
-    call: a forked process inherits no page table entries of shared mappings and would fault
-    on each page it touches. Nothing where the system lacks ``MADV_POPULATE_WRITE``."""
+    call (allocating the pages no process has touched yet). A forked worker inherits no page
+    table entries of shared mappings, and the canvas, its mask and the rings are new in every
+    run: each process took a fault on its first touch of every page (job B on two workers:
+    ~4 000 faults a run, several us each in this VM). Each worker maps the pool's shared
+    arrays at its start, while the caller places the first blocks alone; the caller maps them
+    lazily (mapping them before the fork, 4 ms for job B's 12 MB canvas, lengthened the part of
+    the run before the workers start: 1.49-1.51x against 1.53-1.54x, 15 interleaved rounds
+    twice). Nothing where the system lacks ``MADV_POPULATE_WRITE``."""
     base = a
     while isinstance(base, np.ndarray):
         base = base.base
@@ -428,7 +422,7 @@ class _Mailbox:
     wrote); the ring needs no system call."""
 
     def __init__(self, ctx, conn, owner: int):
-        self.ring = np.frombuffer(_mapped(RING_BYTES), np.uint8)
+        self.ring = np.frombuffer(mmap.mmap(-1, RING_BYTES), np.uint8)
         self.counts = _shared(3, np.int64)  # written, read, piped
         self.lock = ctx.Lock()
         self.conn = conn
