@@ -38,10 +38,6 @@ __all__ = ["ReferenceCrops", "phase_axes", "random_origins", "structure_match"]
 REPEAT_LEVEL = 0.97
 REPEAT_PROBES = 32  # in-phase positions that test it
 
-#: a tile holds whole periods when it is within this fraction (at least 1 px) of a multiple
-#: (as the template search's PERIOD_SLACK, with room for the period's estimate)
-WHOLE_SLACK = 0.02
-
 
 def random_origins(shape, size, count: int, rng) -> np.ndarray:
     """(count, 2) uniformly random top-left corners (y, x) of ``size`` crops in ``shape``."""
@@ -56,14 +52,12 @@ def random_origins(shape, size, count: int, rng) -> np.ndarray:
 def phase_axes(scale, size) -> tuple[bool, bool]:
     """Per axis (y, x): whether the texture is periodic there (``scale``: a
     :class:`engine.tiles.scale.Scale`) and a tile of ``size`` (h, w) holds a whole number of
-    its periods — the axes along which a layout of aligned tiles is the texture itself."""
-    out = []
-    for i in range(2):
-        p, n = float(scale.size[i]), float(size[i])
-        k = round(n / p) if p > 0 else 0
-        ok = scale.periodic[i] and k >= 1 and abs(n - k * p) <= max(1.0, WHOLE_SLACK * n)
-        out.append(bool(ok))
-    return out[0], out[1]
+    its periods (:func:`engine.tiles.scale.holds_whole`) — the axes along which a layout of
+    aligned tiles is the texture itself."""
+    from engine.tiles.scale import holds_whole
+
+    y, x = (bool(scale.periodic[i] and holds_whole(scale.size[i], size[i])) for i in range(2))
+    return y, x
 
 
 def _smooth(Y: np.ndarray, sigma: float) -> np.ndarray:

@@ -27,7 +27,7 @@ def _whole_axes(scale, T: int) -> list[int]:
     """Axes (0 = y, 1 = x) along which ``scale`` is periodic with a period T holds at least
     once (within :func:`engine.reference_crops.phase_axes`' slack): the axes a T px tile must
     hold whole."""
-    from engine.reference_crops import WHOLE_SLACK
+    from engine.tiles.scale import WHOLE_SLACK
 
     top = T + max(1.0, WHOLE_SLACK * T)
     return [i for i in range(2) if scale.periodic[i] and 0 < float(scale.size[i]) <= top]

@@ -127,3 +127,22 @@ def test_cli_tile_size_auto_takes_a_wang_manifest_and_the_patch_overlap(
     assert main([*argv, "--patch-overlap", "30", "--out", str(tmp_path / "b")]) != 0
     assert "tile size (auto): 64 px" in capsys.readouterr().err
     assert seen[-1].tile_min == (64, 64)
+
+
+def test_auto_and_the_fixed_size_warning_judge_whole_periods_alike():
+    from engine.reference_crops import phase_axes
+    from engine.tiles.scale import STRUCTURES_PER_TILE, whole_structure_range
+
+    def warned(scale, n) -> bool:
+        notes = whole_structure_range(scale, (n, n), (n, n))[2]
+        return any("no tile of the requested size holds" in t for t in notes)
+
+    for T in (128, 256):
+        for p in np.arange(20.0, 130.0, 0.25):
+            scale = Scale(p, p, (True, True))
+            n = whole_period_size(scale, T) or T  # the editor's Auto
+            if n >= STRUCTURES_PER_TILE * p * 0.95:  # not "too few per tile" instead
+                assert warned(scale, n) != all(phase_axes(scale, (n, n))), (T, p, n)
+    # a 21 px period at 128 px: 6.10 per tile, 2 px from 126 (within 2 %): whole for both
+    assert whole_period_size(Scale(21.0, 21.0, (True, True)), 128) is None
+    assert not warned(Scale(21.0, 21.0, (True, True)), 128)
