@@ -192,10 +192,12 @@ class Quilter:
     def make_bound(self) -> ColourBound | None:
         """The exact search's colour bound (:mod:`engine.colour_bound`: the same candidates from
         fewer transforms) for a colour sample of up to ``MAX_AREA`` pixels searched by
-        quilting's own exact search; used where each block is searched alone."""
+        quilting's own exact search; only where each block is searched alone (``alone``, set
+        by the scheduler before :meth:`prepare`), the one search it serves."""
         h, w = self.match_sample.shape[:2]
         if (
-            self.plan.search != "fft"
+            not self.alone
+            or self.plan.search != "fft"
             or type(self).search is not Quilter.search
             or type(self).search_sample is not Quilter.search_sample
             or h * w > MAX_AREA
@@ -203,7 +205,7 @@ class Quilter:
         ):
             return None
         bound = ColourBound.build(self.match_sample, backend=self.plan.fft)
-        if bound is None or min(self.block) > min(h, w):
+        if bound is None:
             return None
         ov = self.overlap
         count = self.block[0] * ov + self.block[1] * ov - ov * ov

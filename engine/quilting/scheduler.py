@@ -126,16 +126,17 @@ def run_levels(q: Quilter, rects, total_label: str):
     and a block's search does not depend on the batch it is in: the result does not depend on
     the number of threads.
     """
+    area = q.sample.shape[0] * q.sample.shape[1]
+    # each block's search a query of its own: ducc0's batched transforms differ in the last
+    # bits with the batch, so only then may the batches depend on the threads (known before
+    # prepare: the colour bound serves only such searches)
+    q.alone = area >= POOL_MIN_SAMPLE_AREA
     q.prepare()  # shared search structures, built once before any thread reads them
     preds, levels = dependencies(rects, q.out_shape, q.tileable)
     order = sorted(range(len(rects)), key=lambda k: (levels[k], k))
-    area = q.sample.shape[0] * q.sample.shape[1]
     size = BATCH if area >= POOL_MIN_SAMPLE_AREA else BATCH_ONE_THREAD
     processes = q.threads > 1 and uses_processes(q)
     if area >= POOL_MIN_SAMPLE_AREA:
-        # each block's search a query of its own: ducc0's batched transforms differ in the last
-        # bits with the batch, so only then may the batches depend on the threads
-        q.alone = True
         if q.threads == 1 and q.plan.search != "pca":
             size = 1  # the fast search's batches share a pass over its index (BATCH)
         elif processes:

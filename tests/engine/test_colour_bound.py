@@ -13,6 +13,7 @@ from engine.matching import select_within_tolerance
 from engine.quilting import quilt
 from engine.quilting.block_rng import BlockRng
 from engine.quilting.core import Quilter
+from engine.quilting.scheduler import POOL_MIN_SAMPLE_AREA
 
 DIRECTIONS = np.array([[0.6, 0.6, 0.5], [0.7, -0.7, 0.1], [0.3, 0.3, -0.9]])
 
@@ -171,17 +172,111 @@ def test_quilting_through_the_bound_chooses_as_brute_force(axes, options, monkey
     assert seen["scored"] >= 20 and seen["map"] == 0
 
 
+def _bound_spies(monkeypatch):
+    """Spies on Quilter.make_bound and Quilter._bounded: ``built`` gets, per run, whether its
+    bound was built; ``bounded[i]`` counts run i's blocks searched through it (in this
+    process)."""
+    built, bounded = [], []
+    make, search = Quilter.make_bound, Quilter._bounded
+
+    def make_bound(self):
+        got = make(self)
+        built.append(got is not None)
+        bounded.append(0)
+        return got
+
+    def _bounded(self, wk, valid):
+        got = search(self, wk, valid)
+        bounded[-1] += got
+        return got
+
+    monkeypatch.setattr(Quilter, "make_bound", make_bound)
+    monkeypatch.setattr(Quilter, "_bounded", _bounded)
+    return built, bounded
+
+
+def test_the_bound_is_built_only_where_blocks_are_searched_alone(monkeypatch):
+    """Below scheduler.POOL_MIN_SAMPLE_AREA the blocks are searched in batches, never through
+    the bound: it (and its probe searches) is not built there (190² sample, 200² output,
+    block 32: 29.1 ms with the unused bound against 26.0 ms without); above, it is."""
+    _jit.load()
+    builds = []
+    real = cb.ColourBound.__init__
+
+    def init(self, *args, **kwargs):
+        builds.append(args[0].shape)
+        real(self, *args, **kwargs)
+
+    monkeypatch.setattr(cb.ColourBound, "__init__", init)
+    _, bounded = _bound_spies(monkeypatch)
+    kw = dict(block=28, overlap=6, rng=4, mode="exact")
+    small = coloured(80, 1, (190, 200))
+    assert small.shape[0] * small.shape[1] < POOL_MIN_SAMPLE_AREA
+    for threads in (1, 2):
+        quilt(small, (120, 130), threads=threads, **kw)
+    assert builds == [] and bounded == [0, 0]
+    large = coloured(80, 1, (200, 200))
+    assert large.shape[0] * large.shape[1] >= POOL_MIN_SAMPLE_AREA
+    quilt(large, (120, 130), threads=1, **kw)
+    assert builds == [(200, 200, 3)] and bounded[-1] >= 20
+
+
+@pytest.mark.parametrize("sample", ["one axis", "two axes", "bright, low contrast", "grey RGB"])
+@pytest.mark.parametrize("compiled", [True, False])
+def test_the_transforms_stay_within_the_round_off_margin(sample, compiled, monkeypatch):
+    """The bound's FFT values (``rows + const``, as the search takes them) against the bound
+    computed directly in float64 from the rotated float32 sample: within the margin ``δ``, and
+    well within it (measured: at most 0.4 % of ``δ``), so a margin of 0 or a wrong transform
+    fails."""
+    _jit.load()
+    size = (64, 72)
+    if sample == "one axis":
+        s = coloured(70, 1, size)
+    elif sample == "two axes":
+        s = coloured(71, 2, size)
+    elif sample == "bright, low contrast":  # the constant term's rounding counts
+        s = (0.92 + 0.02 * (coloured(72, 1, size) - 0.5)).astype(np.float32)
+    else:
+        s = np.repeat(np.random.default_rng(73).random((*size, 1), dtype=np.float32), 3, axis=2)
+    bound = cb.ColourBound.build(s)
+    assert bound is not None
+    rot = np.empty((*size, bound.m), np.float32)
+    rot[:] = s.astype(np.float64) @ bound.lead.T
+    monkeypatch.setattr(_jit, "loaded", lambda: compiled)
+    rng = np.random.default_rng(1)
+    for case in range(6):
+        bh, bw = [(20, 24), (17, 31), (32, 9)][case % 3]
+        y, x = rng.integers(0, size[0] - bh), rng.integers(0, size[1] - bw)
+        old = s[y : y + bh, x : x + bw] + 0.01 * rng.standard_normal((bh, bw, 3))
+        filled = np.zeros((bh, bw), bool)
+        filled[: rng.integers(1, 8)] = True
+        filled[:, : rng.integers(1, 8)] = True
+        k, wts, const, count = cb.rotate_content_numpy(old.astype(np.float32), filled, bound.lead)
+        got = np.array(bound.spec.rows(k, wts)[0], np.float64) + const
+        want = brute_force(rot, k[0].transpose(1, 2, 0), filled)
+        delta = cb.margin(
+            bound.norm_s, bound.norm_q, np.sqrt(const), count, const, bound.spec.padded
+        )
+        worst = np.abs(got - want).max()
+        assert worst <= delta / 10, (case, worst, delta)
+
+
 @pytest.mark.parametrize("options", [{}, dict(tileable=True)])
 def test_quilting_through_the_bound_is_the_same_on_any_thread_count_and_without_numba(
     options, monkeypatch
 ):
     _jit.load()
     sample = coloured(40, 1)
+    built, bounded = _bound_spies(monkeypatch)
     kw = dict(block=28, overlap=6, rng=3, mode="exact", **options)
     runs = [quilt(sample, (150, 170), threads=t, **kw) for t in (1, 2, 3)]
-    monkeypatch.setattr(_jit, "loaded", lambda: False)
-    runs.append(quilt(sample, (150, 170), threads=1, **kw))
-    monkeypatch.undo()
+    with monkeypatch.context() as m:
+        m.setattr(_jit, "loaded", lambda: False)
+        runs.append(quilt(sample, (150, 170), threads=1, **kw))
+    # every run went through the bound (worker processes' searches are not counted here: on
+    # 2 and 3 threads only the blocks placed before the fork)
+    assert built == [True] * 4 and bounded[0] >= 20 and bounded[3] >= 20, (built, bounded)
+    assert all(bounded[1:3]), bounded
     for run in runs[1:]:
         assert np.array_equal(run.image, runs[0].image)
         for a, b in zip(run.blocks, runs[0].blocks, strict=True):
