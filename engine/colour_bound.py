@@ -37,7 +37,6 @@ from engine import _jit as jit
 from engine._jit import njit
 from engine.fft import next_fast_len
 from engine.matching import SampleSpectrum
-from engine.spectral import product_sum
 from engine.window_runs import mask_runs
 
 __all__ = [
@@ -137,19 +136,9 @@ class BoundSpectrum(SampleSpectrum):
 
     def rows(self, k: np.ndarray, wts: np.ndarray, workers: int | None = None) -> np.ndarray:
         """``Σ_j −2 corr(S'_j, K_j) + corr(Σ_j S'_j², W)`` (n, rows, cols) float32 for kernels
-        ``k`` (n, m, bh, bw) and weights ``wts`` (n, 1, bh, bw), as :meth:`ssd_terms` computes
-        them before its constant (with numba: a view of the thread's kept buffer, valid until
-        its next query)."""
-        n, _, bh, bw = k.shape
-        h, w = self.shape
-        add = self._weight_terms(wts, workers)  # first: the kernels' spectra are a kept buffer
-        fk = self._conj_spectra(k, workers)
-        x = product_sum(fk, self._hs, add)
-        if not jit.loaded():
-            return self._inverse(x, h - bh + 1, w - bw + 1, workers)
-        hp, cols = self.padded[0], w - bw + 1
-        out = fk.reshape(n, -1).view(np.float32)[:, : hp * cols].reshape(n, hp, cols)
-        return self._inverse_rows(x, h - bh + 1, cols, workers, out)
+        ``k`` (n, m, bh, bw) and weights ``wts`` (n, 1, bh, bw): :meth:`SampleSpectrum.terms`
+        (with numba: a view of the thread's kept buffer, valid until its next query)."""
+        return self.terms(k, wts, workers, compiled=jit.loaded())
 
 
 def margin(norm_s: float, norm_q: float, norm_k: float, count: int, const: float, fft_size):

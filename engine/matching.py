@@ -218,22 +218,32 @@ class SampleSpectrum:
         if bh > h or bw > w:
             raise ValueError(f"block {bw}x{bh} is larger than the sample {w}x{h}")
         const = np.asarray(const, dtype=np.float64).astype(np.float32)
+        compiled = jit.loaded()
+        y = self.terms(k, wts, workers, compiled=compiled)
+        if not compiled:  # a small job without numba: the same values from numpy
+            y += const[:, None, None]
+            np.maximum(y, 0, out=y)
+            return y
+        e = np.empty((n, h - bh + 1, w - bw + 1), np.float32)
+        _add_clip(y, const, e)
+        return e
+
+    def terms(self, k, wts, workers=None, *, compiled: bool) -> np.ndarray:
+        """:meth:`ssd_terms` before its constant: ``Σ_c −2 corr(S_c, K_c) + Σ_g corr(Σ S_c²,
+        W_g)`` (n, rows, cols) float32 for validated float32 ``k`` and ``wts`` (``compiled``:
+        a view of the thread's kept buffer, valid until its next query)."""
+        n, _, bh, bw = k.shape
+        h, w = self.shape
         add = self._weight_terms(wts, workers)  # first: the kernels' spectra are a kept buffer
         fk = self._conj_spectra(k, workers)
         x = product_sum(fk, self._hs, add)
-        if not jit.loaded():  # a small job without numba: the same values from numpy
-            e = self._inverse(x, h - bh + 1, w - bw + 1, workers)
-            e += const[:, None, None]
-            np.maximum(e, 0, out=e)
-            return e
+        if not compiled:
+            return self._inverse(x, h - bh + 1, w - bw + 1, workers)
         # the inverse into the kernels' spectra, read by now (a thread's kept buffer, in cache;
         # each query's slab holds its (hp, w - bw + 1) real values)
         hp, cols = self.padded[0], w - bw + 1
         out = fk.reshape(n, -1).view(np.float32)[:, : hp * cols].reshape(n, hp, cols)
-        y = self._inverse_rows(x, h - bh + 1, cols, workers, out)
-        e = np.empty((n, h - bh + 1, w - bw + 1), np.float32)
-        _add_clip(y, const, e)
-        return e
+        return self._inverse_rows(x, h - bh + 1, cols, workers, out)
 
 
 class TiledSpectrum(SampleSpectrum):
