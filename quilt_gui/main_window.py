@@ -105,6 +105,9 @@ class MainWindow(QMainWindow):
         state = settings.get("window_state")
         if not state.isEmpty():
             self.restoreState(state)
+        # the state was saved with the tab in front then (the Wang or Quilting tab hides the
+        # tile set's docks); the window opens on the Source tab: show what it shows
+        self._on_tab_changed(self.tabs.currentIndex())
         self._update_title()
         self._update_actions()
 
