@@ -561,8 +561,10 @@ class MainWindow(QMainWindow):
 
         if wang is None:
             wang = self.tabs.currentWidget() is self.wang_view
-        if wang and not self.doc.wang.complete:
-            self.show_message("warning", "Nothing to export yet: generate the Wang set first.")
+        w = self.doc.wang
+        if wang and not w.complete:
+            made = f" ({len(w.tiles)} of {w.count} tiles made)" if w.tiles else ""
+            self.show_message("warning", f"Nothing to export yet: generate the Wang set{made}.")
             return
         if not wang and not self.doc.tileset.candidates:
             self.show_message(

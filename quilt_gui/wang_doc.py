@@ -1,7 +1,8 @@
 """The Wang workflow's part of the document: the set's options, edge samples, tiles, layout.
 
 A Wang set (:mod:`engine.tiles.wang`) is made by a job that streams its samples, then its
-tiles; they are applied here directly (not undo steps). Moving or re-rolling an edge sample is
+tiles; they are applied here directly (not undo steps), but *Generate* replacing a set is one
+(:class:`NewWangSet`: undo puts the last set back whole). Moving or re-rolling an edge sample is
 an undo step (:class:`SetWangSample`); the runner (:mod:`quilt_gui.wang_runner`) then rebuilds
 the tiles that use it. Re-rolling the preview's layout is one too (:class:`SetWangLayout`).
 """
@@ -20,7 +21,7 @@ from engine.tiles.wang import (
     wang_record,
 )
 
-__all__ = ["DEFAULT_OPTIONS", "SetWangLayout", "SetWangSample", "WangDocument"]
+__all__ = ["DEFAULT_OPTIONS", "NewWangSet", "SetWangLayout", "SetWangSample", "WangDocument"]
 
 #: the editor's Wang options (engine.tiles.wang.iter_wang_set names) and their defaults
 DEFAULT_OPTIONS = {"colours": 2, "tile_size": 128, "variants": 1, "interior": "patch", "seed": 0}
@@ -35,6 +36,7 @@ class WangDocument(QObject):
     tile_changed = Signal(int)  # tile index
     layout_changed = Signal()
     selection_changed = Signal()
+    superseded = Signal()  # undo / redo put another set back: drop the jobs of this one
 
     def __init__(self, root, undo_stack) -> None:
         super().__init__(root)
@@ -81,6 +83,14 @@ class WangDocument(QObject):
     def clear(self) -> None:
         self.start(self.options)
 
+    def new_set(self, options: dict) -> None:
+        """:meth:`start` as the user's *Generate*: one undo step when a set is replaced (undo
+        brings it back as it was, with its own history below it; a cancel leaves a part)."""
+        if self.samples is None and not self.tiles:
+            self.start(options)
+        else:
+            self.undo_stack.push(NewWangSet(self, options))
+
     def start(self, options: dict) -> None:
         """A new set with ``options``: samples, tiles and layout forgotten."""
         self.options = {**DEFAULT_OPTIONS, **options}
@@ -102,6 +112,27 @@ class WangDocument(QObject):
         if key != self.selected:
             self.selected = key
             self.selection_changed.emit()
+
+    def snapshot(self) -> tuple:
+        """The whole set as it is (tiles are replaced, never changed in place)."""
+        samples = None if self.samples is None else list(self.samples)
+        return (dict(self.options), samples, dict(self.tiles), self.layout, self.layout_seed,
+                self.notes, dict(self.parameters))  # fmt: skip
+
+    def restore(self, state: tuple) -> None:
+        """Back to a :meth:`snapshot`; the running jobs of the set it replaces are dropped
+        first (:attr:`superseded`)."""
+        self.superseded.emit()
+        options, samples, tiles, layout, seed, notes, parameters = state
+        self.start(options)
+        self.notes, self.parameters = notes, dict(parameters)
+        if samples is not None:
+            self.apply_samples(samples)
+        for k, t in sorted(tiles.items()):
+            self.tiles[k] = t
+            self.tile_changed.emit(k)
+        self.apply_layout(layout, seed)
+        self.root.mark_dirty()
 
     # ------------------------------------------------------------------ project files
     def to_project(self, names: list[str]) -> tuple[dict | None, list]:
@@ -159,6 +190,28 @@ class WangDocument(QObject):
         self.layout = None if layout is None else np.asarray(layout, dtype=np.int64)
         self.layout_seed = int(seed)
         self.layout_changed.emit()
+
+
+class NewWangSet(QUndoCommand):
+    """*Generate*: the set before it kept whole; the new one as it is when undone."""
+
+    TEXT = "Generate Wang set"
+
+    def __init__(self, doc: WangDocument, options: dict) -> None:
+        super().__init__(self.TEXT)
+        self.doc, self.options = doc, options
+        self.old = doc.snapshot()
+        self.new = None  # taken at the first undo (the job streams the set after the push)
+
+    def redo(self) -> None:
+        if self.new is None:
+            self.doc.start(self.options)
+        else:
+            self.doc.restore(self.new)
+
+    def undo(self) -> None:
+        self.new = self.doc.snapshot()
+        self.doc.restore(self.old)
 
 
 class SetWangSample(QUndoCommand):

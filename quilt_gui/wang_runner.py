@@ -11,6 +11,7 @@ from engine.tiles.wang_layout import wang_layout
 from quilt_gui import jobs, params
 from quilt_gui.jobs import error_text
 from quilt_gui.pipeline import excluding
+from quilt_gui.wang_doc import NewWangSet
 
 __all__ = ["WangRunner"]
 
@@ -31,7 +32,9 @@ class WangRunner(QObject):
         self.jobs = manager or jobs.manager()
         self.stale: set[int] = set()  # tiles whose samples moved since they were made
         self._reroll_seed = 1000
+        self._job: jobs.Job | None = None  # the last Generate's
         doc.wang.sample_moved.connect(self._on_sample_moved)
+        doc.wang.superseded.connect(self._drop_jobs)
         doc.source_changed.connect(self._on_source_changed)
 
     # ------------------------------------------------------------------ options
@@ -64,15 +67,14 @@ class WangRunner(QObject):
         if not self._ready():
             return None
         w = self.doc.wang
-        self.jobs.abort_matching("wang")
-        w.start({**w.options, **(options or {})})
-        self.stale = set()
+        self._drop_jobs()
+        w.new_set({**w.options, **(options or {})})
         try:
             opts = self.engine_options()
         except (TypeError, ValueError) as exc:
             self.message.emit("error", f"Wang set: {exc}")
             return None
-        return self.jobs.start(
+        self._job = self.jobs.start(
             "wang",
             excluding(iter_wang_set),
             self.doc.source.main,
@@ -84,6 +86,7 @@ class WangRunner(QObject):
             on_error=self._on_error,
             **opts,
         )
+        return self._job
 
     def _on_event(self, event) -> None:
         if isinstance(event, WangSamples):
@@ -107,6 +110,12 @@ class WangRunner(QObject):
         if w.complete and w.layout is None:
             seed = int(w.options["seed"])
             w.apply_layout(self._layout(seed), seed)
+        elif self._job is not None and self._job.token.cancelled and not w.complete:
+            # cancelled: the part made stays on screen, said in words
+            text = f"Wang set stopped: {len(w.tiles)} of {w.count} tiles made; Generate makes it"
+            if w.undo_stack.undoText() == NewWangSet.TEXT:
+                text += " (Edit ▸ Undo, Ctrl+Z, brings back the set before)"
+            self.message.emit("warning", text + ".")
 
     def _on_error(self, exc) -> None:
         self.message.emit("error", f"Wang set failed: {error_text(exc)}")
@@ -192,7 +201,12 @@ class WangRunner(QObject):
         w.set_layout(self._layout(seed), seed)
 
     @Slot()
-    def _on_source_changed(self) -> None:
+    def _drop_jobs(self) -> None:
+        """The running set's jobs end unheard (another set replaces it)."""
         self.jobs.abort_matching("wang")
         self.stale = set()
+
+    @Slot()
+    def _on_source_changed(self) -> None:
+        self._drop_jobs()
         self.doc.wang.clear()

@@ -1,0 +1,54 @@
+"""The Wang set's history (ux12): a new set is one undo step, a cancel says what it left."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from engine.tiles.wang import WangSample
+from tests.gui.helpers import make_window, open_sample
+from tests.gui.test_wang_view import generate, wait_wang
+
+
+def test_a_new_set_is_undone_to_the_last_one_with_its_edits(qtbot):
+    win = make_window(qtbot)
+    open_sample(qtbot, win, "cobblestones")
+    view = generate(qtbot, win, colours=2)
+    w = win.doc.wang
+    y, x = w.sample("v", 1).origin
+    w.set_sample(WangSample("v", 1, (y + 3, x + 2)))  # as a drag does
+    wait_wang(qtbot, win)
+    moved = w.sample("v", 1).origin
+    tiles = {k: t.tile.copy() for k, t in w.tiles.items()}
+    generate(qtbot, win, colours=1)  # the new set replaces it...
+    assert w.colours == 1 and w.complete and len(w.samples) == 2
+    win.doc.undo_stack.undo()  # ...and Ctrl+Z brings it back, as it was
+    wait_wang(qtbot, win)
+    assert w.colours == 2 and w.complete and w.sample("v", 1).origin == moved
+    assert view.colours.value() == 2
+    for k, t in w.tiles.items():
+        np.testing.assert_array_equal(t.tile, tiles[k])
+    win.doc.undo_stack.undo()  # the move before it
+    wait_wang(qtbot, win)
+    assert w.sample("v", 1).origin == (y, x) and w.complete
+    win.doc.undo_stack.redo()
+    win.doc.undo_stack.redo()
+    wait_wang(qtbot, win)
+    assert w.colours == 1 and w.complete and len(w.samples) == 2
+
+
+def test_cancelling_a_new_set_says_so_and_undo_brings_the_last_one_back(qtbot):
+    win = make_window(qtbot)
+    open_sample(qtbot, win, "cobblestones")
+    generate(qtbot, win, colours=2)
+    w = win.doc.wang
+    old = list(w.samples)
+    win.wang_view.colours.setValue(3)
+    win.wang_view.generate().stop()  # the status bar's Cancel, before the engine's first check
+    wait_wang(qtbot, win)
+    assert w.colours == 3 and not w.complete
+    level, text = win.messages[-1]
+    assert "stopped" in text and f"of {w.count} tiles" in text and "Ctrl+Z" in text
+    win.export_dialog()  # an incomplete set is not exported, and the message says why
+    assert win.messages[-1][1].startswith("Nothing to export yet: generate the Wang set")
+    win.doc.undo_stack.undo()
+    assert w.colours == 2 and w.complete and w.samples == old
