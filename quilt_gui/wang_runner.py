@@ -16,6 +16,7 @@ from quilt_gui.wang_doc import NewWangSet
 __all__ = ["WangRunner"]
 
 PREVIEW = (8, 8)  # the preview layout's cells (rows, cols)
+MIN_TILE = 8  # the smallest Wang tile the engine makes (a 2 px band on each side)
 
 
 class WangRunner(QObject):
@@ -61,12 +62,46 @@ class WangRunner(QObject):
             return False
         return True
 
+    def largest_tile(self, limit: int = 1024) -> int | None:
+        """The largest Wang tile size (at most ``limit``) the source takes with the
+        Parameters panel's cut (each edge sample needs about twice the tile), or None."""
+        from engine.tiles.wang_size import source_fits
+
+        if self.doc.source is None:
+            return None
+        shape = self.doc.source.main.shape
+        seam = params.tileset_settings(self.doc.params).seam
+        top = min(limit, *shape[:2])
+        return next(
+            (T for T in range(top, MIN_TILE - 1, -1) if source_fits(shape, T, seam=seam)), None
+        )
+
+    def _fits(self, size: int) -> bool:
+        """Whether the source takes ``size`` px tiles; else say which size it does take."""
+        from engine.tiles.wang_size import source_fits
+
+        src = self.doc.source.main
+        seam = params.tileset_settings(self.doc.params).seam
+        if size >= MIN_TILE and source_fits(src.shape, size, seam=seam):
+            return True
+        top = self.largest_tile()
+        H, W = src.shape[:2]
+        text = f"The {W}x{H} source is too small for {size} px Wang tiles"
+        if top is None:
+            text += f" (each edge sample needs twice the tile; {MIN_TILE} px is the smallest)"
+        else:
+            text += f": each edge sample needs about twice the tile; {top} px tiles fit (Tile size)"
+        self.message.emit("warning", text + ".")
+        return False
+
     # ------------------------------------------------------------------ the whole set
     def generate(self, options: dict | None = None) -> jobs.Job | None:
         """Make a new set with ``options`` (colours, tile_size, variants, interior, seed)."""
         if not self._ready():
             return None
         w = self.doc.wang
+        if not self._fits(int({**w.options, **(options or {})}["tile_size"])):
+            return None
         self._drop_jobs()
         w.new_set({**w.options, **(options or {})})
         try:

@@ -201,7 +201,7 @@ class WangView(QWidget):
     def _make_controls(self) -> None:
         o = self.doc.wang.options
         self.colours = self._spin(1, 4, o["colours"], "Colours per edge direction K: K⁴ tiles")
-        self.tile_size = self._spin(16, 1024, o["tile_size"], "Tile size in pixels (square)")
+        self.tile_size = self._spin(8, 1024, o["tile_size"], "Tile size in pixels (square)")
         self.tile_size.setSingleStep(8)
         self.variants = self._spin(1, 8, o["variants"], "Tiles per edge signature")
         self.interior = QComboBox()
@@ -283,10 +283,10 @@ class WangView(QWidget):
     def _on_source_changed(self) -> None:
         src = self.doc.source
         self.source.set_image(None if src is None else src.main, fit=True)
-        self.generate_button.setEnabled(src is not None)
-        if src is not None:
-            short = min(src.shape)
-            self.tile_size.setMaximum(max(16, short))
+        top = self.runner.largest_tile()
+        self.generate_button.setEnabled(top is not None)
+        if top is not None:
+            self.tile_size.setMaximum(top)  # a tiny source takes tiles below 16 px only
 
     @Slot()
     def _on_reset(self) -> None:
@@ -429,6 +429,9 @@ class WangView(QWidget):
         w = self.doc.wang
         if self.doc.source is None:
             self.info.setText("Open a source image to make a Wang tile set.")
+            return
+        if not self.generate_button.isEnabled():
+            self.info.setText("This source is too small for Wang tiles.")
             return
         if w.samples is None and not w.tiles:
             self.info.setText(

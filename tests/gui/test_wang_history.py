@@ -52,3 +52,26 @@ def test_cancelling_a_new_set_says_so_and_undo_brings_the_last_one_back(qtbot):
     assert win.messages[-1][1].startswith("Nothing to export yet: generate the Wang set")
     win.doc.undo_stack.undo()
     assert w.colours == 2 and w.complete and w.samples == old
+
+
+def test_a_tiny_source_takes_the_wang_tiles_that_fit_and_says_which(qtbot, tmp_path):
+    import imageio.v3 as iio
+
+    from resources import sample_path
+    from tests.gui.helpers import WAIT_MS
+
+    path = tmp_path / "tiny.png"
+    iio.imwrite(path, iio.imread(sample_path("lichen"))[:30, :40, :3])
+    win = make_window(qtbot)
+    with qtbot.waitSignal(win.doc.source_changed, timeout=WAIT_MS):
+        win.files.open_path(str(path), confirm=False)
+    view = win.wang_view
+    top = view.tile_size.maximum()
+    assert 8 <= top < 16  # 40x30: an edge sample needs about twice the tile
+    assert win.wang_runner.generate({"tile_size": top + 1}) is None
+    assert f"{top} px tiles fit" in win.messages[-1][1]
+    view.tile_size.setValue(128)  # clamped to what fits
+    assert view.tile_size.value() == top
+    view.generate_button.click()
+    wait_wang(qtbot, win)
+    assert win.doc.wang.complete and len(win.doc.wang.tiles) == 16
