@@ -162,8 +162,19 @@ class WangRunner(QObject):
 
         w = self.doc.wang
         size = int(w.options["tile_size"])
+        src = self.doc.source.main
         try:
-            origin = WangSetup(self.doc.source.main, tile_size=size).check_origin(axis, origin)
+            setup = WangSetup(
+                src, tile_size=size, seam=params.tileset_settings(self.doc.params).seam
+            )
+            try:
+                origin = setup.check_origin(axis, origin)
+            except ValueError:  # dragged past the border: the nearest place it fits
+                (wh, ww), (H, W) = setup.window_shape(axis), src.shape[:2]
+                y, x = (int(v) for v in origin)
+                y, x = (y - setup.reach, x) if axis == "h" else (y, x - setup.reach)
+                near = (min(max(y, 0), H - wh), min(max(x, 0), W - ww))
+                origin = setup.check_origin(axis, setup.anchor_to_origin(axis, *near))
         except (TypeError, ValueError) as exc:
             self.message.emit("warning", f"The edge sample cannot go there: {exc}")
             return False

@@ -75,3 +75,21 @@ def test_a_tiny_source_takes_the_wang_tiles_that_fit_and_says_which(qtbot, tmp_p
     view.generate_button.click()
     wait_wang(qtbot, win)
     assert win.doc.wang.complete and len(win.doc.wang.tiles) == 16
+
+
+def test_a_sample_dragged_past_the_border_stops_at_it(qtbot):
+    win = make_window(qtbot)
+    open_sample(qtbot, win, "cobblestones")
+    generate(qtbot, win, colours=2)
+    w = win.doc.wang
+    for axis in ("h", "v"):
+        old = w.sample(axis, 0).origin
+        assert win.wang_runner.move_sample(axis, 0, (-500, -500))  # as a drag off the corner
+        wait_wang(qtbot, win)
+        new = w.sample(axis, 0).origin
+        assert new != old and min(new) >= 0
+        # the corner: one pixel further up or left does not fit
+        for d in ((-1, 0), (0, -1)):
+            assert win.wang_runner.move_sample(axis, 0, (new[0] + d[0], new[1] + d[1]))
+            assert w.sample(axis, 0).origin == new
+    assert w.complete
