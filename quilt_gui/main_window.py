@@ -34,6 +34,7 @@ from quilt_gui.theme import apply_theme
 from quilt_gui.wang_runner import WangRunner
 from quilt_gui.widgets.candidate_dialog import CandidateDialog
 from quilt_gui.widgets.canvas import ImageCanvas
+from quilt_gui.widgets.flatten_compare import FlattenCompare
 from quilt_gui.widgets.gallery import CandidateView
 from quilt_gui.widgets.help import GettingStarted, ShortcutSheet
 from quilt_gui.widgets.library import LibraryView
@@ -287,6 +288,8 @@ class MainWindow(QMainWindow):
     def _make_views(self) -> None:
         doc = self.doc
         self.source_view = SourceView(doc, self.pipeline)
+        self.flatten_compare = FlattenCompare(doc, self.pipeline, self.source_view, self)
+        self.addAction(self.flatten_compare.action)  # its key F, and the shortcut sheet
         self.heal_tool = HealTool(doc, self.pipeline, self.source_view, self)
         self.act_heal_brush.toggled.connect(self.heal_tool.set_brush)
         self.act_heal.triggered.connect(self.heal_tool.run)
@@ -391,7 +394,7 @@ class MainWindow(QMainWindow):
         m = mb.addMenu("&View")
         m.addActions([self.act_fit, self.act_100, self.act_zoom_in, self.act_zoom_out])
         m.addSeparator()
-        m.addActions([self.act_heat, self.act_preview_grid])
+        m.addActions([self.act_heat, self.flatten_compare.action, self.act_preview_grid])
         m.addSeparator()
         m.addActions(list(self.act_repeats.values()))
         m.addSeparator()

@@ -197,7 +197,7 @@ PARAMS: tuple[Param, ...] = (
         "Divide out the photo's uneven lighting (a smooth light field at the tile's scale) "
         "before everything; the colour map only, never normal or height maps. Auto: on, with "
         "the gradient-domain seam blending, when the lighting varies across an otherwise even "
-        "photo (the banner says so).",
+        "photo (the banner says so). View ▸ Flattened lighting (F): before / after.",
         "Tile",
         paper="Issue 10: Flatten lighting (quilt-studio tileset --flatten / --no-flatten)",
         **_choices(("auto", "on", "off"), {"auto": "Auto", "on": "On", "off": "Off"}),

@@ -33,3 +33,33 @@ def test_uneven_lighting_is_flattened_said_on_the_banner_and_can_be_switched_off
     assert s.flatten is False and s.seam.blend == "adaptive"
     assert w.pipeline.flatten_scale() is None and w.doc.tileset.tone_note is None
     assert not hint.isVisibleTo(panel)
+
+
+def test_flattened_lighting_before_and_after_on_the_source_canvas(qtbot, tmp_path):
+    import numpy as np
+
+    from engine.tone import flatten_lighting
+
+    path = tmp_path / "bricks.png"
+    Image.fromarray(bricks(256, seed=3)).save(path)
+    w = make_window(qtbot)
+    with qtbot.waitSignal(w.doc.source_changed, timeout=WAIT_MS):
+        w.files.open_path(str(path), confirm=False)
+    w.doc.set_params({"tile_size": "64"})
+    photo, canvas, act = w.doc.source.main, w.source_view, w.flatten_compare.action
+    assert act in w.actions() and act.shortcut().toString() == "F"
+    act.trigger()  # after: the source as the tiles are made from it
+    qtbot.waitUntil(lambda: w.flatten_compare.shown is not None, timeout=WAIT_MS)
+    scale = w.pipeline.flatten_scale()
+    want = flatten_lighting(photo, scale=scale)
+    np.testing.assert_array_equal(canvas.image_item.array, want)
+    assert "lighting flattened" in w.messages[-1][1]
+    w.doc.set_params({"tile_size": "128"})  # another scale: flattened again
+    qtbot.waitUntil(lambda: w.flatten_compare.shown == w.pipeline.flatten_scale(), timeout=WAIT_MS)
+    assert w.flatten_compare.shown != scale
+    act.trigger()  # before: the photo
+    assert canvas.image_item.array is photo
+    w.doc.set_params({"flatten": "off"})
+    act.trigger()  # nothing to compare: said, and switched back
+    assert not act.isChecked() and canvas.image_item.array is photo
+    assert "Flatten lighting is off for this photo" in w.messages[-1][1]
