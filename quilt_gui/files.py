@@ -117,6 +117,7 @@ class ProjectFiles(QObject):
     #: (label, callable) buttons
     message = Signal(str, str, object)
     image_opened = Signal()  # a new source image is in the document
+    wang_opened = Signal()  # a project that holds a Wang set and no tile set: show its tab
 
     def __init__(self, doc, manager: jobs.JobManager, parent) -> None:
         super().__init__(parent)
@@ -282,7 +283,11 @@ class ProjectFiles(QObject):
     def _on_project_loaded(self, path: str, project) -> None:
         project_io.apply_project(self.doc, project, path)
         self._remember(path, "last_project_dir", True)
-        self._say("info", f"Opened project {Path(path).name}.")
+        w, ts = self.doc.wang, self.doc.tileset
+        wang = f": a Wang set of {len(w.tiles)} tiles (Wang tiles tab)" if w.tiles else ""
+        self._say("info", f"Opened project {Path(path).name}{wang}.")
+        if w.tiles and ts.template_rect is None and not ts.candidates:
+            self.wang_opened.emit()  # all it holds is on that tab
         rec = newer_recovery(path)
         if rec is not None:
             self.offer_recovery(rec)

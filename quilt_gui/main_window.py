@@ -445,6 +445,7 @@ class MainWindow(QMainWindow):
         self.heal_tool.message.connect(self.show_message)
         self.files.message.connect(self.show_message)
         self.files.image_opened.connect(self._on_image_opened)
+        self.files.wang_opened.connect(lambda: self.tabs.setCurrentWidget(self.wang_view))
         self.pipeline.seam_updated.connect(self._on_seam_updated)
         self.overlap_panel.watch.state_changed.connect(self._show_criteria)
         doc.modified_changed.connect(self._update_title)

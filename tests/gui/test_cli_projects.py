@@ -46,6 +46,20 @@ def test_cli_project_opens_in_the_editor(qtbot, tmp_path):
     assert w.gallery.model().rowCount() == 4 and d.seamless is not None
     assert np.array_equal(d.candidates[2].tile, cli.candidates[2].tile)
     assert d.preview is not None
+    assert w.tabs.currentWidget() is w.source_view
+
+
+def test_a_cli_wang_project_opens_on_the_wang_tab(qtbot, tmp_path):
+    proj = tmp_path / "wang.quiltproj"
+    src, out = str(sample_path("gravel")), str(tmp_path / "out")
+    argv = ["tileset", src, "--out", out, "--wang", "2", "--tile-size", "48", "--project"]
+    assert cli_main([*argv, str(proj)]) == 0
+    w = make_window(qtbot)
+    with qtbot.waitSignal(w.doc.path_changed, timeout=WAIT_MS):
+        w.files.open_path(str(proj), confirm=False)
+    wait_idle(qtbot, w)
+    assert w.doc.wang.complete and w.tabs.currentWidget() is w.wang_view
+    assert "a Wang set of 16 tiles (Wang tiles tab)" in w.messages[-1][1]
 
 
 def test_editor_project_exports_with_the_cli(qtbot, tmp_path):
