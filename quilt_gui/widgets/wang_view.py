@@ -22,6 +22,7 @@ from PySide6.QtWidgets import (
     QGraphicsLineItem,
     QGraphicsPathItem,
     QGraphicsPolygonItem,
+    QGraphicsRectItem,
     QGraphicsSimpleTextItem,
     QHBoxLayout,
     QLabel,
@@ -81,9 +82,18 @@ class SampleItem(QGraphicsPolygonItem):
         self.setZValue(40)
         self.setCursor(Qt.CursorShape.OpenHandCursor)
         self.setFlag(QGraphicsItem.GraphicsItemFlag.ItemIsFocusable, False)
-        self.label = QGraphicsSimpleTextItem(f"{axis}{colour}", self)
-        self.label.setBrush(QBrush(col))
+        # the name, white on a chip of the colour: readable on any texture (red on bricks was not)
+        self.label = QGraphicsRectItem(self)
         self.label.setFlag(QGraphicsItem.GraphicsItemFlag.ItemIgnoresTransformations, True)
+        chip = QColor(col)
+        chip.setAlpha(215)
+        self.label.setBrush(QBrush(chip))
+        self.label.setPen(Qt.PenStyle.NoPen)
+        text = QGraphicsSimpleTextItem(f"{axis}{colour}", self.label)
+        text.setBrush(QBrush(QColor("#ffffff")))
+        box = text.boundingRect()
+        text.setPos(3, 0)
+        self.label.setRect(0, 0, box.width() + 6, box.height())
         self._drag = None  # (press scene pos, origin at press)
         self.origin = (0, 0)
         self.tile = 1
@@ -408,8 +418,7 @@ class WangView(QWidget):
         if w.layout is not None and w.complete:
             img = assemble(w.tile_list(), w.layout)
         first = img is not None and (self.preview.array is None or self.preview.fitted)
-        self.preview.set_image(img, fit=first)
-        self.preview.setVisible(img is not None)
+        self.preview.set_image(img, fit=first)  # empty (not hidden: its title stays on top)
         self._draw_grid()
         self._update_info()
 

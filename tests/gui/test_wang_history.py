@@ -93,3 +93,25 @@ def test_a_sample_dragged_past_the_border_stops_at_it(qtbot):
             assert win.wang_runner.move_sample(axis, 0, (new[0] + d[0], new[1] + d[1]))
             assert w.sample(axis, 0).origin == new
     assert w.complete
+
+
+def test_the_layout_title_stays_above_its_empty_canvas_while_the_set_is_made(qtbot):
+    win = make_window(qtbot)
+    open_sample(qtbot, win, "cobblestones")
+    win.tabs.setCurrentWidget(win.wang_view)
+    view = win.wang_view
+    title = view.preview.parentWidget().layout().itemAt(0).widget()
+    assert view.preview.array is None and view.preview.isVisible()
+    assert title.geometry().bottom() < view.preview.geometry().top()
+
+
+def test_a_sample_is_named_in_white_on_a_chip_of_its_colour(qtbot):
+    from quilt_gui.widgets.wang_view import colour_of
+
+    win = make_window(qtbot)
+    open_sample(qtbot, win, "brick")
+    view = generate(qtbot, win, colours=2)
+    item = view.samples[("h", 0)]  # red: on red bricks its red name could not be read
+    assert item.label.brush().color().rgb() == colour_of(0).rgb()
+    (text,) = item.label.childItems()
+    assert text.text() == "h0" and text.brush().color().name() == "#ffffff"
