@@ -3,6 +3,8 @@ re-roll a sample or the preview's layout. Jobs stream into :attr:`Document.wang`
 
 from __future__ import annotations
 
+from functools import partial
+
 import numpy as np
 from PySide6.QtCore import QObject, Signal, Slot
 
@@ -34,6 +36,8 @@ class WangRunner(QObject):
         self.stale: set[int] = set()  # tiles whose samples moved since they were made
         self._reroll_seed = 1000
         self._job: jobs.Job | None = None  # the last Generate's
+        self._version = 0  # of the edge samples: one more at every move
+        self._outdated: dict[int, int] = {}  # tile -> the version its sample last moved at
         doc.wang.sample_moved.connect(self._on_sample_moved)
         doc.wang.superseded.connect(self._drop_jobs)
         doc.source_changed.connect(self._on_source_changed)
@@ -116,19 +120,32 @@ class WangRunner(QObject):
             label=f"Making {w.count} Wang tiles",
             rng=int(w.options["seed"]),
             workers=2,
-            on_event=self._on_event,
+            on_event=partial(self._on_event, self._version),
             on_done=self._on_done,
             on_error=self._on_error,
             **opts,
         )
         return self._job
 
-    def _on_event(self, event) -> None:
+    def _on_event(self, version: int, event) -> None:
+        """An event of a job started at samples ``version``: a tile made with a sample moved
+        since is dropped (the rebuild started by the move makes it again)."""
         if isinstance(event, WangSamples):
-            self.doc.wang.apply_samples(event.samples)
+            if version == self._version:
+                self.doc.wang.apply_samples(event.samples)
         elif isinstance(event, WangTile):
-            self.stale.discard(int(event.index))
+            k = int(event.index)
+            if version < self._outdated.get(k, 0):
+                return
+            self.stale.discard(k)
             self.doc.wang.set_tile(event)
+            self._first_layout()
+
+    def _first_layout(self) -> None:
+        w = self.doc.wang
+        if w.complete and w.layout is None and not self.stale:
+            seed = int(w.options["seed"])
+            w.apply_layout(self._layout(seed), seed)
 
     def _on_done(self, result) -> None:
         w = self.doc.wang
@@ -142,10 +159,8 @@ class WangRunner(QObject):
         if advice in result.notes:
             use = lambda: self.generate({"tile_size": size})  # noqa: E731
             self.advice.emit("warning", f"Wang set: {advice}", [(f"Use {size} px tiles", use)])
-        if w.complete and w.layout is None:
-            seed = int(w.options["seed"])
-            w.apply_layout(self._layout(seed), seed)
-        elif self._job is not None and self._job.token.cancelled and not w.complete:
+        self._first_layout()
+        if self._job is not None and self._job.token.cancelled and not w.complete:
             # cancelled: the part made stays on screen, said in words
             text = f"Wang set stopped: {len(w.tiles)} of {w.count} tiles made; Generate makes it"
             if w.undo_stack.undoText() == NewWangSet.TEXT:
@@ -207,6 +222,9 @@ class WangRunner(QObject):
 
     @Slot(str, int)
     def _on_sample_moved(self, axis: str, colour: int) -> None:
+        self._version += 1  # tiles of the jobs running now that show the sample are outdated
+        for k in self.doc.wang.users(axis, colour):
+            self._outdated[k] = self._version
         self.stale |= set(self.doc.wang.users(axis, colour))
         self.rebuild()
 
@@ -228,7 +246,7 @@ class WangRunner(QObject):
             avoid=[a for a in avoid if a is not None],
             rng=int(w.options["seed"]),
             workers=2,
-            on_event=self._on_event,
+            on_event=partial(self._on_event, self._version),
             on_error=self._on_error,
             **self.engine_options(),
         )
@@ -251,6 +269,7 @@ class WangRunner(QObject):
         """The running set's jobs end unheard (another set replaces it)."""
         self.jobs.abort_matching("wang")
         self.stale = set()
+        self._outdated = {}
 
     @Slot()
     def _on_source_changed(self) -> None:

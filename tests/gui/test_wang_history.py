@@ -115,3 +115,37 @@ def test_a_sample_is_named_in_white_on_a_chip_of_its_colour(qtbot):
     assert item.label.brush().color().rgb() == colour_of(0).rgb()
     (text,) = item.label.childItems()
     assert text.text() == "h0" and text.brush().color().name() == "#ffffff"
+
+
+def test_a_sample_moved_while_the_set_is_made_shows_on_every_tile_that_uses_it(qtbot):
+    win = make_window(qtbot)
+    open_sample(qtbot, win, "cobblestones")
+    win.tabs.setCurrentWidget(win.wang_view)
+    view, w, runner = win.wang_view, win.doc.wang, win.wang_runner
+    view.tile_size.setValue(48)
+    moved = []
+
+    def move_once():  # as a drag as soon as the diamonds show, the tiles still streaming
+        if not moved:
+            y, x = w.sample("h", 1).origin
+            moved.append((y + 5, x + 4))
+            w.set_sample(WangSample("h", 1, moved[0]))
+
+    w.samples_changed.connect(move_once)
+    view.generate_button.click()
+    wait_wang(qtbot, win)
+    w.samples_changed.disconnect(move_once)
+    assert w.complete and w.layout is not None and w.sample("h", 1).origin == moved[0]
+    y, x = moved[0]
+    row = win.doc.source.main[y, x : x + 48]
+    north = [k for k in w.users("h", 1) if w.tiles[k].signature[0] == 1]
+    for k in north:  # the moved sample's pixels on every north edge that shows it
+        np.testing.assert_array_equal(w.tiles[k].tile[0], row, err_msg=f"tile {k}")
+    # the same, whatever the timing: a tile of a job started before a move is dropped
+    old_version, k = runner._version, north[0]
+    late = w.tiles[k]
+    w.set_sample(WangSample("h", 1, (y + 2, x + 1)))
+    runner._on_event(old_version, late)  # it arrives after the move
+    assert w.tiles[k] is late and k in runner.stale  # not taken as made with the new sample
+    wait_wang(qtbot, win)
+    assert w.tiles[k] is not late and not runner.stale
