@@ -354,10 +354,21 @@ class ProjectFiles(QObject):
         except ValueError as exc:
             self._say("error", str(exc))
             return
-        self._say(
-            "info",
-            f"Attached {Path(path).name} as the “{name}” map ({kind}); it follows every cut.",
-        )
+        text = f"Attached {Path(path).name} as the “{name}” map ({kind}); it follows every cut."
+        made = [  # made before it, without it: the project keeps only what has every map
+            f"{n} {what}"
+            for n, what in (
+                (len(self.doc.tileset.candidates), "candidates"),
+                (len(self.doc.wang.tiles), "Wang tiles"),
+            )
+            if n
+        ]
+        if made:
+            text += (
+                f" The {' and the '.join(made)} made before lack it: generate them again "
+                "(a project saved until then leaves them out)."
+            )
+        self._say("warning" if made else "info", text)
 
     def target_dialog(self, *_args) -> None:
         path = self.ask_open_path("Load transfer target", IMAGE_FILTER, "last_open_dir")

@@ -149,3 +149,23 @@ def test_a_sample_moved_while_the_set_is_made_shows_on_every_tile_that_uses_it(q
     assert w.tiles[k] is late and k in runner.stale  # not taken as made with the new sample
     wait_wang(qtbot, win)
     assert w.tiles[k] is not late and not runner.stale
+
+
+def test_a_map_attached_after_the_set_says_the_set_lacks_it(qtbot, tmp_path):
+    import imageio.v3 as iio
+
+    from tests.gui.helpers import WAIT_MS
+
+    win = make_window(qtbot)
+    open_sample(qtbot, win, "cobblestones")
+    generate(qtbot, win, colours=2)
+    path = tmp_path / "cobblestones_roughness.png"
+    iio.imwrite(path, (win.doc.source.main.mean(axis=2) * 255).astype(np.uint8))
+    with qtbot.waitSignal(win.doc.maps_changed, timeout=WAIT_MS):
+        win.files.attach_map(str(path))
+    level, text = win.messages[-1]
+    assert level == "warning" and "The 16 Wang tiles made before lack it" in text
+    assert win.files.save_to(str(tmp_path / "p.quiltproj"), wait=True)
+    from engine.project import load_project
+
+    assert load_project(tmp_path / "p.quiltproj").wang is None  # what the message warns of
