@@ -112,6 +112,7 @@ class ExportDialog(QDialog):
         self.bit_depth.setToolTip("Bits per channel of the written images")
         self.dither = QCheckBox("Dither when reducing 16 → 8 bit")
         self.dither.setChecked(True)
+        self.bit_depth.currentIndexChanged.connect(self._update_dither)
         self.tile_format = QComboBox()
         self.tile_format.addItems(["png", "tif"])
         self.tile_format.setToolTip("Format of the per-tile and preview images (atlases are PNG)")
@@ -187,8 +188,14 @@ class ExportDialog(QDialog):
                 f"<b>{n}</b> tiles {what}{size}; maps: {', '.join(maps)}; source {depth}-bit{lay}."
             )
         self.normal.setEnabled("normal" in (doc.source.kinds.values() if doc.source else ()))
+        self._update_dither()
         self.status.setText("")
         self.export_button.setDefault(True)
+
+    def _update_dither(self, *_args) -> None:
+        """Dithering applies only where 16-bit pixels are written as 8 bits."""
+        sixteen = self.doc.source is not None and self.doc.source.bit_depth == 16
+        self.dither.setEnabled(sixteen and self.bit_depth.currentIndex() == 1)
 
     def options(self) -> dict:
         """Keyword options of :func:`engine.project.export_project` from the widgets."""

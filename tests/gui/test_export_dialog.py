@@ -32,3 +32,30 @@ def test_enter_in_the_reopened_export_dialog_exports(qtbot, tmp_path):
     with qtbot.waitSignal(dlg.exported, timeout=WAIT_MS):
         qtbot.keyClick(browse, Qt.Key.Key_Return)
     assert (tmp_path / "bundle2").is_dir()
+
+
+def test_dither_is_offered_only_where_16_bits_are_written_as_8(qtbot, tmp_path):
+    import imageio.v3 as iio
+    import numpy as np
+
+    from resources import sample_path
+
+    w = make_window(qtbot)
+    open_sample(qtbot, w)  # 8-bit: nothing to dither, whatever the bit depth chosen
+    generate(qtbot, w, n=2)
+    w.export_dialog()
+    dlg = w._export_dialog
+    for i in range(3):
+        dlg.bit_depth.setCurrentIndex(i)
+        assert not dlg.dither.isEnabled()
+    path = tmp_path / "brick16.png"
+    iio.imwrite(path, iio.imread(sample_path("brick")).astype(np.uint16) * 257)
+    with qtbot.waitSignal(w.doc.source_changed, timeout=WAIT_MS):
+        w.files.open_path(str(path), confirm=False)
+    generate(qtbot, w, n=2)
+    w.export_dialog()
+    assert [dlg.bit_depth.setCurrentIndex(i) or dlg.dither.isEnabled() for i in range(3)] == [
+        False,
+        True,
+        False,
+    ]
