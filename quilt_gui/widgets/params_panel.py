@@ -10,6 +10,7 @@ from __future__ import annotations
 from functools import partial
 
 from PySide6.QtCore import Qt, Signal, Slot
+from PySide6.QtGui import QPalette
 from PySide6.QtWidgets import (
     QButtonGroup,
     QCheckBox,
@@ -23,6 +24,9 @@ from PySide6.QtWidgets import (
     QScrollArea,
     QSizePolicy,
     QSpinBox,
+    QStyle,
+    QStyleOptionComboBox,
+    QStylePainter,
     QToolButton,
     QVBoxLayout,
     QWidget,
@@ -67,6 +71,30 @@ WANG_GROUPS = ("Seams", MATERIALS, "Seam options", "Exclusion")
 GROUP_TITLES = {"Exclusion": "Pixels never to use", "Heal": "Heal the source"}
 QUILT_GROUPS = ("Quilting", "Exclusion", "Seam options", "Transfer")
 VIEWS = (BASIC, ADVANCED)
+
+
+class ElidingComboBox(QComboBox):
+    """A choice box that ends a name too long for it with "…" (the narrow panel cut "Cut
+    across, row by row" to "Cut across, row by rov"); the list shows the whole names."""
+
+    def shown_text(self) -> str:
+        opt = QStyleOptionComboBox()
+        self.initStyleOption(opt)
+        field = self.style().subControlRect(
+            QStyle.ComplexControl.CC_ComboBox, opt, QStyle.SubControl.SC_ComboBoxEditField, self
+        )
+        return self.fontMetrics().elidedText(
+            self.currentText(), Qt.TextElideMode.ElideRight, max(0, field.width() - 2)
+        )
+
+    def paintEvent(self, _event) -> None:  # noqa: N802 - Qt API
+        painter = QStylePainter(self)
+        painter.setPen(self.palette().color(QPalette.ColorRole.Text))
+        opt = QStyleOptionComboBox()
+        self.initStyleOption(opt)
+        painter.drawComplexControl(QStyle.ComplexControl.CC_ComboBox, opt)
+        opt.currentText = self.shown_text()
+        painter.drawControl(QStyle.ControlElement.CE_ComboBoxLabel, opt)
 
 
 class ParamsPanel(QWidget):
@@ -260,7 +288,7 @@ class ParamsPanel(QWidget):
     def _make_widget(self, p: params.Param) -> QWidget:
         key = p.key
         if p.choices:
-            w = QComboBox()
+            w = ElidingComboBox()
             w.setSizeAdjustPolicy(QComboBox.SizeAdjustPolicy.AdjustToMinimumContentsLengthWithIcon)
             w.setMinimumContentsLength(12)  # long choice names must not widen the panel
             for c in p.choices:

@@ -110,3 +110,17 @@ def test_the_quilting_output_is_twice_the_source_by_default(qtbot, tmp_path):
     assert w.doc.quilting.output.shape[:2] == (80, 112)
     assert params.output_shape(params.DEFAULTS, (3000, 4000)) == (2048, 2048)  # capped
     assert params.output_shape({"out_height": 300, "out_width": 0}, (100, 100)) == (300, 200)
+
+
+def test_a_choice_name_too_long_for_its_box_ends_with_an_ellipsis(qtbot):
+    from quilt_gui.widgets.params_panel import ElidingComboBox
+
+    box = ElidingComboBox()
+    qtbot.addWidget(box)
+    box.addItem("Cut across, row by row")
+    box.resize(300, box.sizeHint().height())
+    assert box.shown_text() == "Cut across, row by row"
+    box.resize(90, box.sizeHint().height())  # the Advanced panel with its scroll bar
+    shown = box.shown_text()
+    assert shown.endswith("…") and "Cut across, row by row".startswith(shown[:-1])
+    box.grab()  # painted with it
