@@ -65,7 +65,18 @@ def continuing_margin(error: np.ndarray, margin: int, *, copy: bool = True) -> n
 
 
 def stitch_patch(
-    q, u, *, ring, margin, seam, weights, outward, depth, continue_margin=False, cancel=None
+    q,
+    u,
+    *,
+    ring,
+    margin,
+    seam,
+    weights,
+    outward,
+    depth,
+    continue_margin=False,
+    reach=POISSON_REACH,
+    cancel=None,
 ):
     """Window ``q`` ({map: image}) stitched into ``u`` along a closed cut in the ring (its
     error the maps' weighted error, drawn toward the outer margin by ``outward`` x the mean
@@ -73,7 +84,7 @@ def stitch_patch(
     ``({map: result}, PatchCut)``. Candidates and Wang interiors.
 
     ``seam.blend == "poisson"``: the hard cut blended in the gradient domain
-    (:func:`gradient_blend`)."""
+    (:func:`gradient_blend`, screened at ``reach`` x ``ring``)."""
     err = seam_error(q, u, weights, seam.metric)
     if continue_margin:
         err = continuing_margin(err, margin, copy=False)  # err is this call's own
@@ -83,12 +94,12 @@ def stitch_patch(
     )
     check(cancel)
     if seam.blend == POISSON:
-        return gradient_blend(q, u, cut, ring=ring, margin=margin), cut
+        return gradient_blend(q, u, cut, ring=ring, margin=margin, reach=reach), cut
     return apply_cut(q, u, cut.alpha), cut
 
 
-def gradient_blend(q, u, cut, *, ring, margin):
+def gradient_blend(q, u, cut, *, ring, margin, reach=POISSON_REACH):
     """Window ``q`` stitched into ``u`` along ``cut``'s hard cut, blended in the gradient domain
-    (:func:`engine.poisson.solve_maps`, screened at :data:`POISSON_REACH` x ``ring``), the outer
-    ``margin`` pixels (at least 1) kept bit for bit."""
-    return solve_maps(q, u, cut.mask, fixed=max(1, margin), reach=POISSON_REACH * ring)
+    (:func:`engine.poisson.solve_maps`, screened at ``reach`` x ``ring``, by default
+    :data:`POISSON_REACH`), the outer ``margin`` pixels (at least 1) kept bit for bit."""
+    return solve_maps(q, u, cut.mask, fixed=max(1, margin), reach=reach * ring)

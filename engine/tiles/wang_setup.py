@@ -29,6 +29,7 @@ from engine.tiles.wang_types import (
     DETAIL_QUANTILE,
     EDGE_BAND_QUANTILE,
     INTERIOR_BLENDS,
+    INTERIOR_REACH,
     INTERIORS,
     PATCH_LABEL,
     PHASE_SLACK,
@@ -605,6 +606,7 @@ class WangSetup:
                 weights=self.weights,
                 outward=self.outward,
                 depth=self.depth,
+                reach=INTERIOR_REACH,
                 cancel=cancel,
             )
             labels[cut.mask] = PATCH_LABEL

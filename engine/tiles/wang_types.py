@@ -56,6 +56,13 @@ PHASE_SLACK = 0.5
 #: samples of a texture periodic along x (planks 1.36 -> 1.52: beside one board gap, the next
 #: lies a period away in every tile; coins 1.18 -> 1.16-1.33 over four seed triples)
 EDGE_BAND_QUANTILE = 0.5
+#: the gradient-domain interior's correction is screened at this many rings' widths (32 px at
+#: 128 px tiles; the candidates' :data:`engine.tiles.patch_stitch.POISSON_REACH` is 2): the
+#: step between a window and the shared ring beside its cut (1-3 px from the edge) is spread
+#: over twice the depth, so the frame's peak at the cut falls (retina's pooled profile at 2 px
+#: 1.11 -> 1.06; its frame over four seed triples 1.116 / 1.115 / 1.097 / 1.138 -> 1.066 /
+#: 1.058 / 1.047 / 1.094, this change alone). README "Session 12"
+INTERIOR_REACH = 4.0
 
 #: How the interior patch is blended (``interior_blend``): "auto" = gradient domain unless the
 #: seam's blend is "none" (hard cuts asked for: every pixel stays a source copy), or one of
