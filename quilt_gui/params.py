@@ -360,6 +360,11 @@ _ENGINE_ONLY = (
         re.compile(r"a larger source, smaller tiles or a smaller minimum distance give more"),
         f"a larger source or a smaller “{BY_KEY['tile_size'].label}” gives more",
     ),
+    (  # a Wang set's samples kept apart by min_distance (half a tile; no control for it)
+        re.compile(r"at min_distance ([\d.]+): samples are ([\d.]+) px apart"),
+        r"with their edge samples \1 px (half a tile) apart: they are \2 px apart (fewer "
+        r"Colours, a smaller Tile size or a larger source give them room)",
+    ),
 )
 
 

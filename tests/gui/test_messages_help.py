@@ -65,6 +65,32 @@ def test_engine_notes_name_the_editors_controls_not_the_command_line(qtbot):
     assert w.last_message() == text
 
 
+def test_a_wang_note_on_a_small_source_names_what_to_change_not_min_distance(qtbot):
+    import warnings
+
+    import numpy as np
+
+    from engine.tiles.wang import iter_wang_set
+
+    rng = np.random.default_rng(0)
+    src = rng.random((30, 40, 3), dtype=np.float32)  # a 40x30 photo: samples crowd together
+    gen = iter_wang_set(src, tile_size=14, colours=2, rng=0)
+    with warnings.catch_warnings():  # the engine also warns it on its own
+        warnings.simplefilter("ignore")
+        while True:
+            try:
+                next(gen)
+            except StopIteration as end:
+                notes = end.value.notes
+                break
+    (note,) = [n for n in notes if "too small for 2 colours" in n]
+    assert "min_distance" in note  # the engine's word
+    w = make_window(qtbot)
+    w.show_message("warning", f"Wang set: {note}")
+    text = w.message_bar.label.text()
+    assert "min_distance" not in text and "fewer Colours, a smaller Tile size" in text
+
+
 def test_a_long_message_is_as_tall_as_its_wrapped_text(qtbot):
     w = make_window(qtbot)
     w.show_message("warning", "The lighting varies across the photo, try something. " * 10)
