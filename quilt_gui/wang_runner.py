@@ -41,6 +41,7 @@ class WangRunner(QObject):
         doc.wang.sample_moved.connect(self._on_sample_moved)
         doc.wang.superseded.connect(self._drop_jobs)
         doc.source_changed.connect(self._on_source_changed)
+        doc.pixels_changed.connect(self._on_pixels_changed)
 
     # ------------------------------------------------------------------ options
     def engine_options(self) -> dict:
@@ -270,6 +271,20 @@ class WangRunner(QObject):
         self.jobs.abort_matching("wang")
         self.stale = set()
         self._outdated = {}
+
+    @Slot()
+    def _on_pixels_changed(self) -> None:
+        """The source healed (or its heal undone): every tile made again from the new pixels
+        with the same edge samples (a tile left from the old pixels would not match a rebuilt
+        neighbour where the heal touched a sample)."""
+        w = self.doc.wang
+        if w.samples is None:
+            return
+        self._version += 1
+        self._outdated = dict.fromkeys(range(w.count), self._version)
+        self.stale = set(range(w.count))
+        self.message.emit("info", "Wang set: made again from the healed source, same edge samples.")
+        self.rebuild()
 
     @Slot()
     def _on_source_changed(self) -> None:

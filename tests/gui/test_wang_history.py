@@ -169,3 +169,19 @@ def test_a_map_attached_after_the_set_says_the_set_lacks_it(qtbot, tmp_path):
     from engine.project import load_project
 
     assert load_project(tmp_path / "p.quiltproj").wang is None  # what the message warns of
+
+
+def test_healing_the_source_makes_the_wang_set_again_from_the_healed_pixels(qtbot):
+    win = make_window(qtbot)
+    open_sample(qtbot, win, "cobblestones")
+    generate(qtbot, win, colours=2)
+    w = win.doc.wang
+    y, x = w.sample("h", 0).origin
+    healed = win.doc.source.main.copy()
+    healed[y - 2 : y + 3, x : x + 48] = 1 - healed[y - 2 : y + 3, x : x + 48]  # on the sample
+    win.doc.apply_source_maps({**win.doc.source.maps, win.doc.source.main_name: healed})
+    wait_wang(qtbot, win)
+    assert w.complete and "healed source" in win.messages[-1][1]
+    for k, t in w.tiles.items():  # every tile shows the healed pixels on its h0 edges
+        if t.signature[0] == 0:
+            np.testing.assert_array_equal(t.tile[0], healed[y, x : x + 48], err_msg=f"tile {k}")
