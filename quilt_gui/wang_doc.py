@@ -37,6 +37,7 @@ class WangDocument(QObject):
     layout_changed = Signal()
     selection_changed = Signal()
     superseded = Signal()  # undo / redo put another set back: drop the jobs of this one
+    restored = Signal(object)  # ...and these of its tiles still wait for a rebuild (a set)
 
     def __init__(self, root, undo_stack) -> None:
         super().__init__(root)
@@ -50,6 +51,8 @@ class WangDocument(QObject):
         self.selected: tuple[str, int] | None = None  # (axis, colour) of the chosen sample
         self.notes: tuple[str, ...] = ()
         self.parameters: dict = {}  # the engine's parameters of the last run
+        #: the tiles waiting for a rebuild (the runner's: a snapshot keeps them)
+        self.pending = lambda: set()
 
     # ------------------------------------------------------------------ state
     @property
@@ -117,13 +120,13 @@ class WangDocument(QObject):
         """The whole set as it is (tiles are replaced, never changed in place)."""
         samples = None if self.samples is None else list(self.samples)
         return (dict(self.options), samples, dict(self.tiles), self.layout, self.layout_seed,
-                self.notes, dict(self.parameters))  # fmt: skip
+                self.notes, dict(self.parameters), set(self.pending()))  # fmt: skip
 
     def restore(self, state: tuple) -> None:
         """Back to a :meth:`snapshot`; the running jobs of the set it replaces are dropped
         first (:attr:`superseded`)."""
         self.superseded.emit()
-        options, samples, tiles, layout, seed, notes, parameters = state
+        options, samples, tiles, layout, seed, notes, parameters, pending = state
         self.start(options)
         self.notes, self.parameters = notes, dict(parameters)
         if samples is not None:
@@ -133,6 +136,8 @@ class WangDocument(QObject):
             self.tile_changed.emit(k)
         self.apply_layout(layout, seed)
         self.root.mark_dirty()
+        if pending:
+            self.restored.emit(set(pending))
 
     # ------------------------------------------------------------------ project files
     def to_project(self, names: list[str]) -> tuple[dict | None, list]:

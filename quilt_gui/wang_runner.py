@@ -40,6 +40,8 @@ class WangRunner(QObject):
         self._outdated: dict[int, int] = {}  # tile -> the version its sample last moved at
         doc.wang.sample_moved.connect(self._on_sample_moved)
         doc.wang.superseded.connect(self._drop_jobs)
+        doc.wang.restored.connect(self._on_restored)
+        doc.wang.pending = lambda: set(self.stale)
         doc.source_changed.connect(self._on_source_changed)
         doc.pixels_changed.connect(self._on_pixels_changed)
 
@@ -107,8 +109,8 @@ class WangRunner(QObject):
         w = self.doc.wang
         if not self._fits(int({**w.options, **(options or {})}["tile_size"])):
             return None
+        w.new_set({**w.options, **(options or {})})  # first: its undo keeps the waiting tiles
         self._drop_jobs()
-        w.new_set({**w.options, **(options or {})})
         try:
             opts = self.engine_options()
         except (TypeError, ValueError) as exc:
@@ -271,6 +273,12 @@ class WangRunner(QObject):
         self.jobs.abort_matching("wang")
         self.stale = set()
         self._outdated = {}
+
+    @Slot(object)
+    def _on_restored(self, pending) -> None:
+        """A set put back by undo / redo with tiles whose sample had moved: rebuild them."""
+        self.stale = set(pending)
+        self.rebuild()
 
     @Slot()
     def _on_pixels_changed(self) -> None:

@@ -185,3 +185,24 @@ def test_healing_the_source_makes_the_wang_set_again_from_the_healed_pixels(qtbo
     for k, t in w.tiles.items():  # every tile shows the healed pixels on its h0 edges
         if t.signature[0] == 0:
             np.testing.assert_array_equal(t.tile[0], healed[y, x : x + 48], err_msg=f"tile {k}")
+
+
+def test_a_set_put_back_by_undo_rebuilds_the_tiles_its_last_move_left_waiting(qtbot):
+    win = make_window(qtbot)
+    open_sample(qtbot, win, "cobblestones")
+    view = generate(qtbot, win, colours=2)
+    w, runner = win.doc.wang, win.wang_runner
+    y, x = w.sample("h", 0).origin
+    w.set_sample(WangSample("h", 0, (y + 3, x + 3)))  # its rebuild starts...
+    users = set(w.users("h", 0))
+    assert runner.stale == users
+    view.colours.setValue(1)
+    view.generate()  # ...and a new set replaces it at once
+    wait_wang(qtbot, win)
+    win.doc.undo_stack.undo()  # the K = 2 set back: its waiting tiles are made again
+    wait_wang(qtbot, win)
+    assert w.colours == 2 and w.complete and not runner.stale
+    row = win.doc.source.main[y + 3, x + 3 : x + 3 + 48]
+    for k in users:
+        if w.tiles[k].signature[0] == 0:
+            np.testing.assert_array_equal(w.tiles[k].tile[0], row, err_msg=f"tile {k}")
