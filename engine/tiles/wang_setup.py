@@ -127,7 +127,8 @@ class WangSetup:
         self._corner: tuple | None = None
         self._phase: tuple | None = None
         self._periodic = (False, False)
-        #: a tile size near T that holds whole periods where T does not (:meth:`phase`)
+        #: a tile size near T that holds whole periods where T does not, or a larger one that
+        #: holds structures too large for T (:meth:`phase`)
         self.suggested_size: int | None = None
         #: the note (in :attr:`notes`) that names :attr:`suggested_size`
         self.suggested_note: str | None = None
@@ -337,7 +338,7 @@ class WangSetup:
         if self._phase is None:
             from engine.reference_crops import phase_axes
             from engine.tiles.scale import structure_scale
-            from engine.tiles.wang_size import source_fits, whole_period_size
+            from engine.tiles.wang_size import large_structure_note, source_fits, whole_period_size
 
             scale = structure_scale(self.S)
             self._periodic = (bool(scale.periodic[0]), bool(scale.periodic[1]))
@@ -351,6 +352,10 @@ class WangSetup:
             if note:
                 self.notes.append(note)
                 self.suggested_note = note if self.suggested_size else None
+            note, size = large_structure_note(scale, self.T, self.S.shape, fits)
+            if note:  # the larger fault: its size replaces a whole-period one
+                self.notes.append(note)
+                self.suggested_size, self.suggested_note = size, note if size else None
         return self._phase
 
     def periodic(self) -> tuple[bool, bool]:

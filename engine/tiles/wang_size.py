@@ -17,10 +17,27 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["SNAP_RANGE", "auto_tile_size", "periods_held", "source_fits", "whole_period_size"]
+__all__ = [
+    "SNAP_RANGE",
+    "STRUCTURE_FRACTION",
+    "auto_tile_size",
+    "large_structure_note",
+    "periods_held",
+    "source_fits",
+    "whole_period_size",
+]
 
 #: an automatic size stays within this fraction of the requested one (128 -> 96..160)
 SNAP_RANGE = 0.25
+#: a Wang set warns when a decorrelation length (no period) of
+#: :func:`engine.tiles.scale.structure_scale` exceeds this fraction of the tile: the blobs it
+#: measures are at least about 1.5 times as large (0.58-0.73 of the cell size on Voronoi blobs
+#: of 24-96 px; stones with grain of their own more: about 300 px stones at 89 px on a
+#: 4000x3000 upscale of the bundled cobblestones), so the tiles fall inside single structures
+#: (128 px there: a blurry layout without a whole stone). Not the tile set's third
+#: (:data:`engine.tiles.scale.STRUCTURES_PER_TILE`): the evaluation set's retina (54x63 px),
+#: cell (49x47) and coins (71x60 px periods) meet every line of the Wang table at 128 px
+STRUCTURE_FRACTION = 0.6
 
 
 def _whole_axes(scale, T: int) -> list[int]:
@@ -118,3 +135,63 @@ def auto_tile_size(source, T: int, **options) -> tuple[int, str]:
         f"{T} px: the texture repeats about every {periods}, and no size within "
         f"{SNAP_RANGE:.0%} of {T} px that the source takes holds whole periods"
     )
+
+
+def _structure_axes(scale, T: int) -> list[int]:
+    """Axes (0 = y, 1 = x) whose structures a T px Wang tile cannot hold: a period larger
+    than the tile (a shorter one is :func:`whole_period_size`'s), or a decorrelation length
+    above :data:`STRUCTURE_FRACTION` of it."""
+    from engine.tiles.scale import WHOLE_SLACK
+
+    top = T + max(1.0, WHOLE_SLACK * T)  # a period the tile holds once (as _whole_axes)
+    out = []
+    for i in range(2):
+        p = float(scale.size[i])
+        if p > (top if scale.periodic[i] else STRUCTURE_FRACTION * T):
+            out.append(i)
+    return out
+
+
+def large_structure_note(scale, T: int, shape, fits=None) -> tuple[str | None, int | None]:
+    """(note, size): a note when the structures of ``scale`` (a
+    :class:`engine.tiles.scale.Scale`, the tile set's estimate) are too large for T px Wang
+    tiles (:func:`_structure_axes`: a decorrelation length above :data:`STRUCTURE_FRACTION`
+    of T, or a period longer than T), naming the least size by the tile set's rule — the
+    structures at most a third of the tile (:data:`engine.tiles.scale.STRUCTURES_PER_TILE`;
+    a whole number of periods along a periodic axis) — or, when ``fits(size)`` refuses it, the
+    largest size it accepts that no longer warns, and a photo scaled down by the same factor;
+    (None, None) when the tile holds them. ``shape``: the source's (H, W). The least size: on
+    the 4000x3000 cobblestones (89 px) 267 px shows whole stones, still cut at the tile lines."""
+    from engine.tiles.scale import STRUCTURES_PER_TILE
+
+    axes = _structure_axes(scale, T)
+    if not axes:
+        return None, None
+    need = T
+    for i in axes:
+        p = float(scale.size[i])
+        k = math.ceil(STRUCTURES_PER_TILE - 1e-9)
+        need = max(need, round(k * p) if scale.periodic[i] else math.ceil(STRUCTURES_PER_TILE * p))
+    fits = fits or (lambda n: True)
+    size = next((n for n in range(need, T, -1) if fits(n) and not _structure_axes(scale, n)), None)
+    what = " and ".join(
+        f"{float(scale.size[i]):.0f} px {('tall', 'wide')[i]}"
+        f"{' (a period)' if scale.periodic[i] else ''}"
+        for i in axes
+    )
+    H, W = (int(v) for v in shape[:2])
+    f = need / T
+    smaller = f"a photo scaled down to about {W / f:.0f}x{H / f:.0f} or less (1/{f:.1f})"
+    if size is None:
+        todo = f"the source takes no tile that holds them: use {smaller}"
+    else:
+        held = f"of at least {size} px" if size >= need else f"of {size} px, the largest it takes,"
+        todo = f"use a tile size {held} (--tile-size {size}, or Tile size in the editor), or "
+        todo += smaller
+    note = (
+        f"the texture's structures measure about {what} (measured by autocorrelation), too "
+        f"large for "
+        f"{T} px Wang tiles: every tile falls inside single structures and a layout shows none "
+        f"whole (a blurry, even tone); {todo}"
+    )
+    return note, size

@@ -276,7 +276,9 @@ class WangSet:
     parameters: dict = field(default_factory=dict)
     notes: tuple[str, ...] = ()
     #: a tile size near ``tile_size`` that holds whole periods of the source where
-    #: ``tile_size`` does not (:func:`engine.tiles.wang_size.whole_period_size`; a note says so)
+    #: ``tile_size`` does not (:func:`engine.tiles.wang_size.whole_period_size`; a note says so),
+    #: or that holds its structures where they are too large for ``tile_size``
+    #: (:func:`engine.tiles.wang_size.large_structure_note`)
     suggested_size: int | None = None
     #: the one of ``notes`` that names ``suggested_size`` (None without a suggestion)
     suggested_note: str | None = None

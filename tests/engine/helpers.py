@@ -24,3 +24,12 @@ def smooth_texture(shape, channels=3, seed=0, sigma=2.0):
     rng = np.random.default_rng(seed)
     x = ndimage.gaussian_filter(rng.random(shape + (channels,)), (sigma, sigma, 0))
     return ((x - x.min()) / (x.max() - x.min())).astype(np.float32)
+
+
+def blob_texture(size=256, cell=64, seed=0):
+    """Voronoi blobs about ``cell`` px across (one tone each, fine grain on top): stones."""
+    rng = np.random.default_rng(seed)
+    seeds = rng.random((size, size)) < 1.2 / cell**2
+    _, (iy, ix) = ndimage.distance_transform_edt(~seeds, return_indices=True)
+    tone = rng.random((size, size, 3))[iy, ix]
+    return np.clip(0.2 + 0.6 * tone + 0.03 * rng.standard_normal((size, size, 3)), 0, 1)

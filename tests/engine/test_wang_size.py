@@ -10,6 +10,7 @@ from benchmarks.evalset import planks
 from engine.bitdepth import to_float
 from engine.tiles.scale import Scale
 from engine.tiles.wang_size import SNAP_RANGE, auto_tile_size, source_fits, whole_period_size
+from tests.engine.helpers import blob_texture
 
 
 def test_the_nearest_size_holding_whole_periods_on_every_periodic_axis():
@@ -146,3 +147,78 @@ def test_auto_and_the_fixed_size_warning_judge_whole_periods_alike():
     # a 21 px period at 128 px: 6.10 per tile, 2 px from 126 (within 2 %): whole for both
     assert whole_period_size(Scale(21.0, 21.0, (True, True)), 128) is None
     assert not warned(Scale(21.0, 21.0, (True, True)), 128)
+
+
+def test_large_structures_are_named_with_a_tile_size_that_holds_them():
+    from engine.tiles.wang_size import STRUCTURE_FRACTION, large_structure_note
+
+    assert large_structure_note(Scale(40.0, 40.0), 128, (512, 512)) == (None, None)
+    note, size = large_structure_note(Scale(30.0, 90.0), 128, (3000, 4000))
+    assert size == 270 and "90 px wide" in note and "tall" not in note
+    assert "--tile-size 270" in note and "a photo scaled down to about 1896x1422 or less" in note
+    # a period the tile holds (whole or not) is the whole-period note's; one larger warns
+    assert large_structure_note(Scale(100.0, 100.0, (True, True)), 128, (512, 512))[0] is None
+    note, size = large_structure_note(Scale(10.0, 150.0, (False, True)), 128, (1000, 1000))
+    assert size == 450 and "150 px wide (a period)" in note
+    # a source that takes no such tile: the largest that stops the warning, else a photo
+    fits = lambda n: n <= 200  # noqa: E731
+    _, size = large_structure_note(Scale(90.0, 90.0), 128, (300, 300), fits)
+    assert size == 200 and STRUCTURE_FRACTION * 200 >= 90
+    note, size = large_structure_note(Scale(90.0, 90.0), 128, (300, 300), lambda n: n < 150)
+    assert size is None and "takes no tile that holds them: use a photo scaled down" in note
+
+
+def test_a_set_of_tiles_smaller_than_its_blobs_warns_and_names_a_size():
+    from engine.tiles.scale import structure_scale
+    from engine.tiles.wang import WangSetup
+
+    S = blob_texture()
+    assert max(structure_scale(S).size) > 0.6 * 32  # the estimate of the tile set
+    setup = WangSetup(S, tile_size=32)
+    setup.phase()
+    [note] = [n for n in setup.notes if "too large for 32 px Wang tiles" in n]
+    assert setup.suggested_note == note and setup.suggested_size > 32
+    assert f"--tile-size {setup.suggested_size}" in note
+    assert source_fits(S.shape, setup.suggested_size)
+    setup = WangSetup(S, tile_size=setup.suggested_size)  # the named size: no warning
+    setup.phase()
+    assert not any("too large" in n for n in setup.notes)
+    assert setup.suggested_size is None
+
+
+@pytest.mark.parametrize("name", ["gravel", "grass"])
+def test_a_fine_texture_is_not_warned_about(name):
+    from benchmarks import evalset
+    from engine.tiles.wang import WangSetup
+
+    setup = WangSetup(to_float(evalset.load(name)), tile_size=128)
+    setup.phase()
+    assert not any("too large" in n for n in setup.notes)
+
+
+def test_no_public_evaluation_texture_is_warned_about_at_the_benchmarks_size():
+    """All 15 at 128 px (text and page: 96, the largest they take); 14 meet every line of the
+    Wang quality table and planks' fault is its period (the whole-period note), not its size."""
+    from benchmarks import evalset
+    from benchmarks.wang import tile_for
+    from engine.tiles.scale import structure_scale
+    from engine.tiles.wang_size import large_structure_note
+
+    for name in evalset.PUBLIC:
+        S = to_float(evalset.load(name))
+        assert large_structure_note(structure_scale(S), tile_for(S, 128), S.shape) == (None, None)
+
+
+def test_cli_wang_set_of_tiles_inside_blobs_warns(tmp_path, capsys):
+    from PIL import Image
+
+    from engine.cli import main
+
+    src = tmp_path / "stones.png"
+    Image.fromarray(np.round(blob_texture() * 255).astype(np.uint8)).save(src)
+    argv = ["tileset", str(src), "--out", str(tmp_path / "w"), "--wang", "2", "--tile-size", "32"]
+    assert main(argv) == 0
+    err = capsys.readouterr().err
+    assert "warning: the texture's structures measure about" in err
+    man = json.loads((tmp_path / "w" / "manifest.json").read_text())
+    assert any("too large for 32 px Wang tiles" in w for w in man["warnings"])

@@ -195,3 +195,25 @@ def test_only_the_note_the_engine_names_carries_the_use_size_button(qtbot):
     assert [text for text, _ in advice] == [f"Wang set: {named}"]  # once, "148 px" not taken
     assert [label for label, _ in advice[0][1]] == ["Use 48 px tiles"]
     assert messages == [f"Wang set: {other}"]
+
+
+def test_tiles_smaller_than_the_structures_are_offered_a_larger_size_on_the_banner(qtbot, tmp_path):
+    from PIL import Image
+
+    from tests.engine.helpers import blob_texture
+
+    path = tmp_path / "stones.png"
+    Image.fromarray(np.round(blob_texture() * 255).astype(np.uint8)).save(path)  # ~64 px blobs
+    win = make_window(qtbot)
+    with qtbot.waitSignal(win.doc.source_changed, timeout=WAIT_MS):
+        win.files.open_path(str(path), confirm=False)
+    generate(qtbot, win, tile_size=32)
+    text = win.message_bar.label.text()
+    assert win.message_bar.level == "warning" and "too large for 32 px Wang tiles" in text
+    assert "--tile-size" not in text and "a photo scaled down" in text
+    bar = win.message_bar
+    buttons = [bar._actions.itemAt(i).widget() for i in range(bar._actions.count())]
+    [label] = [b.text() for b in buttons]
+    size = int(label.split()[1])
+    assert label == f"Use {size} px tiles" and f"at least {size} px (Tile size)" in text
+    assert win.doc.wang.complete  # a warning only: the set is made
