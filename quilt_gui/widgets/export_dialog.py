@@ -206,7 +206,7 @@ class ExportDialog(QDialog):
             margin=self.margin.value(),
             extrude=self.extrude.value(),
             bit_depth=depth,
-            dither=self.dither.isChecked() if depth == 8 else None,
+            dither=self.dither.isChecked() if self.dither.isEnabledTo(self) else None,
             tile_format=self.tile_format.currentText(),
             overwrite=self.overwrite.isChecked(),
             normal_convention=self.normal.currentText(),

@@ -48,6 +48,8 @@ def test_dither_is_offered_only_where_16_bits_are_written_as_8(qtbot, tmp_path):
     for i in range(3):
         dlg.bit_depth.setCurrentIndex(i)
         assert not dlg.dither.isEnabled()
+        assert dlg.dither.isChecked()  # greyed out but checked, as it is by default
+        assert dlg.options()["dither"] is None  # ... and nothing is dithered
     path = tmp_path / "brick16.png"
     iio.imwrite(path, iio.imread(sample_path("brick")).astype(np.uint16) * 257)
     with qtbot.waitSignal(w.doc.source_changed, timeout=WAIT_MS):
@@ -59,3 +61,7 @@ def test_dither_is_offered_only_where_16_bits_are_written_as_8(qtbot, tmp_path):
         True,
         False,
     ]
+    dlg.bit_depth.setCurrentIndex(1)  # 16-bit source written as 8 bits: dithered if asked
+    assert dlg.options()["dither"] is True
+    dlg.dither.setChecked(False)
+    assert dlg.options()["dither"] is False
