@@ -35,6 +35,7 @@ class FlattenCompare(QObject):
         )
         self.action.toggled.connect(self._refresh)
         self.shown: int | None = None  # the scale of the flattened source on screen
+        self._asked = (None, None, None)  # (job, photo, scale) of the flatten job last started
         doc.source_changed.connect(self._new_pixels)
         doc.pixels_changed.connect(self._new_pixels)
         doc.tileset.tone_changed.connect(self._refresh)
@@ -72,7 +73,11 @@ class FlattenCompare(QObject):
             return
         if scale == self.shown:
             return
-        self.pipeline.jobs.start(
+        job, photo, asked = self._asked
+        if job is not None and job is self.pipeline.jobs.get("flatten-view"):
+            if photo is src.main and asked == scale:
+                return  # under way (asked again by flatten_scale's own tone_changed)
+        job = self.pipeline.jobs.start(
             "flatten-view",
             _flattened,
             src.main,
@@ -81,6 +86,7 @@ class FlattenCompare(QObject):
             pass_cancel=False,
             on_done=lambda img, s=scale: self._show(img, s),
         )
+        self._asked = (job, src.main, scale)
 
     def _show(self, image, scale: int) -> None:
         if not self.action.isChecked():

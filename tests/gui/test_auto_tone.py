@@ -63,3 +63,32 @@ def test_flattened_lighting_before_and_after_on_the_source_canvas(qtbot, tmp_pat
     act.trigger()  # nothing to compare: said, and switched back
     assert not act.isChecked() and canvas.image_item.array is photo
     assert "Flatten lighting is off for this photo" in w.messages[-1][1]
+
+
+def test_a_new_photo_with_flattened_lighting_shown_is_flattened_once(qtbot, tmp_path, monkeypatch):
+    """Deciding Auto for the new photo says so (tone_changed), which asked for the flattened view
+    again while it was being asked for: two flatten jobs, the first run to the end for nothing."""
+    w = make_window(qtbot)
+    paths = []
+    for seed in (3, 4):
+        paths.append(tmp_path / f"bricks{seed}.png")
+        Image.fromarray(bricks(256, seed=seed)).save(paths[-1])
+    with qtbot.waitSignal(w.doc.source_changed, timeout=WAIT_MS):
+        w.files.open_path(str(paths[0]), confirm=False)
+    w.doc.set_params({"tile_size": "64"})
+    w.flatten_compare.action.trigger()
+    qtbot.waitUntil(lambda: w.flatten_compare.shown is not None, timeout=WAIT_MS)
+    jobs, starts = w.pipeline.jobs, []
+    real_start = jobs.start
+
+    def spy(key, *args, **kwargs):
+        starts.append(key)
+        return real_start(key, *args, **kwargs)
+
+    monkeypatch.setattr(jobs, "start", spy)
+    with qtbot.waitSignal(w.doc.source_changed, timeout=WAIT_MS):
+        w.files.open_path(str(paths[1]), confirm=False)
+    qtbot.waitUntil(lambda: w.flatten_compare.shown is not None, timeout=WAIT_MS)
+    assert w.flatten_compare.action.isChecked()
+    assert starts.count("flatten-view") == 1
+    wait_idle(qtbot, w)
