@@ -96,6 +96,7 @@ class MainWindow(QMainWindow):
         self._dialogs: dict[int, CandidateDialog] = {}
         self._help: dict[str, QDialog] = {}
         self._criteria: dict[str, float] = {}
+        self._left_open: list[bool] | None = None  # tile set docks open, while a tab hides them
         self._make_actions()
         self._make_views()
         self._make_menus()
@@ -105,10 +106,7 @@ class MainWindow(QMainWindow):
         window_geometry.place(self, settings.get("window_geometry"))
         state = settings.get("window_state")
         if not state.isEmpty():
-            self.restoreState(state)
-        # the state was saved with the tab in front then (the Wang or Quilting tab hides the
-        # tile set's docks); the window opens on the Source tab: show what it shows
-        self._on_tab_changed(self.tabs.currentIndex())
+            self.restoreState(state)  # saved as the Source tab has it (see closeEvent)
         self._update_title()
         self._update_actions()
 
@@ -638,9 +636,19 @@ class MainWindow(QMainWindow):
         self.params_panel.show_groups(
             QUILT_GROUPS if quilting else WANG_GROUPS if wang else TILESET_GROUPS
         )
-        for key in ("overlaps", "tile", "gallery"):
-            self.docks[key].setVisible(not quilting and not wang)
+        self._show_tileset_docks(not quilting and not wang)
         self._show_criteria()
+
+    def _show_tileset_docks(self, shown: bool) -> None:
+        """The Wang and Quilting tabs hide the tile set's docks; back on the other tabs, the
+        ones the user had left open there come back (and closed ones stay closed)."""
+        docks = [self.docks[key] for key in ("overlaps", "tile", "gallery")]
+        if self._left_open is None and not shown:
+            self._left_open = [not dock.isHidden() for dock in docks]
+        for dock, was_open in zip(docks, self._left_open or [], strict=False):
+            dock.setVisible(shown and was_open)
+        if shown:
+            self._left_open = None
 
     # ------------------------------------------------------------------ view actions
     def current_canvas(self) -> ImageCanvas:
@@ -778,6 +786,7 @@ class MainWindow(QMainWindow):
         self.jobs.shutdown(3000)
         self.files.remove_recovery_file()
         settings.set("window_geometry", self.saveGeometry())
+        self._show_tileset_docks(True)  # the state saved as the Source tab has it (reopens there)
         settings.set("window_state", self.saveState())
         settings.set("parameters", self.doc.params)
         for dlg in self._dialogs.values():
