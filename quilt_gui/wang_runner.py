@@ -110,6 +110,11 @@ class WangRunner(QObject):
         if not self._fits(int({**w.options, **(options or {})}["tile_size"])):
             return None
         w.new_set({**w.options, **(options or {})})  # first: its undo keeps the waiting tiles
+        return self._start_set()
+
+    def _start_set(self) -> jobs.Job | None:
+        """Start the job making the whole set of the document's options."""
+        w = self.doc.wang
         self._drop_jobs()
         try:
             opts = self.engine_options()
@@ -284,9 +289,12 @@ class WangRunner(QObject):
     def _on_pixels_changed(self) -> None:
         """The source healed (or its heal undone): every tile made again from the new pixels
         with the same edge samples (a tile left from the old pixels would not match a rebuilt
-        neighbour where the heal touched a sample)."""
+        neighbour where the heal touched a sample); a set still choosing its samples starts
+        again (same options, no undo step)."""
         w = self.doc.wang
         if w.samples is None:
+            if self._job is not None and self._job.alive and self._job.running:
+                self._start_set()  # still choosing samples: again from the new pixels
             return
         self._version += 1
         self._outdated = dict.fromkeys(range(w.count), self._version)

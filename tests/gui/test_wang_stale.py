@@ -1,0 +1,40 @@
+"""Wang tiles never left from old pixels or old samples (issue 11, mend13): a heal while
+Generate chooses its samples, Ctrl+Z to a set made before a heal, a save during a rebuild;
+and the Wang history keeps a bounded number of whole sets."""
+
+from __future__ import annotations
+
+from tests.gui.helpers import make_window, open_sample
+from tests.gui.test_wang_view import wait_wang
+
+
+def mismatched(win) -> list[int]:
+    """Tiles whose north row is not the row of their h sample in the current source."""
+    w, src = win.doc.wang, win.doc.source.main
+    T = int(w.options["tile_size"])
+    bad = []
+    for k, t in sorted(w.tiles.items()):
+        y, x = w.sample("h", t.signature[0]).origin
+        if not (t.tile[0] == src[y, x : x + T]).all():
+            bad.append(k)
+    return bad
+
+
+def heal(win):
+    """New pixels for the source, as a heal gives (every pixel moved a little)."""
+    healed = 1 - win.doc.source.main
+    win.doc.apply_source_maps({**win.doc.source.maps, win.doc.source.main_name: healed})
+
+
+def test_a_heal_while_generate_chooses_its_samples_makes_the_set_from_the_new_pixels(qtbot):
+    win = make_window(qtbot)
+    open_sample(qtbot, win, "cobblestones")
+    win.tabs.setCurrentWidget(win.wang_view)
+    win.wang_view.tile_size.setValue(48)
+    win.wang_view.generate_button.click()
+    assert win.doc.wang.samples is None  # still choosing them
+    heal(win)
+    wait_wang(qtbot, win)
+    w = win.doc.wang
+    assert w.complete and mismatched(win) == []
+    assert win.doc.wang.undo_stack.count() == 0  # the restart is no undo step
