@@ -53,6 +53,8 @@ class WangDocument(QObject):
         self.parameters: dict = {}  # the engine's parameters of the last run
         #: the tiles waiting for a rebuild (the runner's: a snapshot keeps them)
         self.pending = lambda: set()
+        self.pixels = 0  # the source's pixels generation: one more at every heal (or its undo)
+        root.pixels_changed.connect(self._on_pixels_changed)
 
     # ------------------------------------------------------------------ state
     @property
@@ -111,23 +113,29 @@ class WangDocument(QObject):
         self.tile_changed.emit(int(tile.index))
         self.root.mark_dirty()
 
+    def _on_pixels_changed(self) -> None:
+        self.pixels += 1
+
     def select(self, key: tuple[str, int] | None) -> None:
         if key != self.selected:
             self.selected = key
             self.selection_changed.emit()
 
     def snapshot(self) -> tuple:
-        """The whole set as it is (tiles are replaced, never changed in place)."""
+        """The whole set as it is (tiles are replaced, never changed in place), with the
+        pixels generation its tiles were made from."""
         samples = None if self.samples is None else list(self.samples)
         return (dict(self.options), samples, dict(self.tiles), self.layout, self.layout_seed,
-                self.notes, dict(self.parameters), set(self.pending()))  # fmt: skip
+                self.notes, dict(self.parameters), set(self.pending()), self.pixels)  # fmt: skip
 
     def restore(self, state: tuple) -> None:
         """Back to a :meth:`snapshot`; the running jobs of the set it replaces are dropped
-        first (:attr:`superseded`)."""
+        first (:attr:`superseded`). Tiles made from pixels healed since wait, all of them."""
         self.superseded.emit()
-        options, samples, tiles, layout, seed, notes, parameters, pending = state
+        options, samples, tiles, layout, seed, notes, parameters, pending, pixels = state
         self.start(options)
+        if pixels != self.pixels and samples is not None:  # healed since: all of them
+            pending = set(range(self.count))
         self.notes, self.parameters = notes, dict(parameters)
         if samples is not None:
             self.apply_samples(samples)

@@ -5,7 +5,7 @@ and the Wang history keeps a bounded number of whole sets."""
 from __future__ import annotations
 
 from tests.gui.helpers import make_window, open_sample
-from tests.gui.test_wang_view import wait_wang
+from tests.gui.test_wang_view import generate, wait_wang
 
 
 def mismatched(win) -> list[int]:
@@ -38,3 +38,18 @@ def test_a_heal_while_generate_chooses_its_samples_makes_the_set_from_the_new_pi
     w = win.doc.wang
     assert w.complete and mismatched(win) == []
     assert win.doc.wang.undo_stack.count() == 0  # the restart is no undo step
+
+
+def test_undo_to_a_set_made_before_a_heal_rebuilds_it_from_the_healed_pixels(qtbot):
+    win = make_window(qtbot)
+    open_sample(qtbot, win, "cobblestones")
+    generate(qtbot, win, tile_size=48)
+    samples = list(win.doc.wang.samples)
+    generate(qtbot, win, tile_size=40)
+    heal(win)
+    wait_wang(qtbot, win)
+    win.doc.undo_stack.undo()  # the 48 px set back...
+    wait_wang(qtbot, win)
+    w = win.doc.wang
+    assert w.options["tile_size"] == 48 and w.samples == samples  # ...with its samples
+    assert w.complete and mismatched(win) == []  # and tiles of the healed pixels
