@@ -163,11 +163,13 @@ class WangDocument(QObject):
             options=dict(self.options),
             layout=None if self.layout is None else self.layout.tolist(),
             layout_seed=self.layout_seed,
+            pending=sorted(self.pending()),  # tiles still to rebuild: made again on opening
         )
         return record, [t.to_candidate() for t in tiles]
 
     def apply_project(self, record: dict | None, tiles) -> None:
-        """Take the Wang set a project kept (as :meth:`to_project` wrote it, or the CLI)."""
+        """Take the Wang set a project kept (as :meth:`to_project` wrote it, or the CLI); the
+        tiles it saved while they waited for a rebuild are made again (:attr:`restored`)."""
         if record is None:
             self.start(self.options)
             return
@@ -184,6 +186,9 @@ class WangDocument(QObject):
             self.tile_changed.emit(t.index)
         layout = record.get("layout")
         self.apply_layout(layout, int(record.get("layout_seed", 0)))
+        pending = {int(k) for k in record.get("pending", ())}  # none in older projects
+        if pending:
+            self.restored.emit(pending)
 
     # ------------------------------------------------------------------ user edits (undoable)
     def set_sample(self, sample, *, text: str = "Move edge sample") -> None:

@@ -4,7 +4,8 @@ and the Wang history keeps a bounded number of whole sets."""
 
 from __future__ import annotations
 
-from tests.gui.helpers import make_window, open_sample
+from engine.tiles.wang import WangSample
+from tests.gui.helpers import WAIT_MS, make_window, open_sample
 from tests.gui.test_wang_view import generate, wait_wang
 
 
@@ -53,3 +54,21 @@ def test_undo_to_a_set_made_before_a_heal_rebuilds_it_from_the_healed_pixels(qtb
     w = win.doc.wang
     assert w.options["tile_size"] == 48 and w.samples == samples  # ...with its samples
     assert w.complete and mismatched(win) == []  # and tiles of the healed pixels
+
+
+def test_a_set_saved_during_a_rebuild_is_rebuilt_when_reopened(qtbot, tmp_path):
+    win = make_window(qtbot)
+    open_sample(qtbot, win, "cobblestones")
+    generate(qtbot, win, tile_size=48)
+    w = win.doc.wang
+    y, x = w.sample("h", 1).origin
+    w.set_sample(WangSample("h", 1, (y + 3, x + 2)))  # its tiles are rebuilt...
+    path = str(tmp_path / "p.quiltproj")
+    assert win.files.save_to(path, wait=True)  # ...and the project saved at once
+    wait_wang(qtbot, win)
+    other = make_window(qtbot)
+    with qtbot.waitSignal(other.doc.path_changed, timeout=WAIT_MS):
+        other.files.open_path(path, confirm=False)
+    wait_wang(qtbot, other)
+    assert other.doc.wang.complete and mismatched(other) == []
+    assert other.doc.wang.sample("h", 1).origin == (y + 3, x + 2)
