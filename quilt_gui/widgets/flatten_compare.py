@@ -1,6 +1,7 @@
 """Flatten lighting, before / after: the Source canvas shows the photo or the source as the
-tiles are made from it (its lighting flattened, :func:`engine.tone.flatten_lighting` at the
-scale the tile set uses). View ▸ *Flattened lighting* (key F) switches; the overlays stay."""
+tile set's tiles are made from it (its lighting flattened, :func:`engine.tone.flatten_lighting`
+at the scale the tile set uses; a Wang set is made from the photo as it is). View ▸ *Flattened
+lighting* (key F) switches; the overlays stay."""
 
 from __future__ import annotations
 
@@ -30,8 +31,9 @@ class FlattenCompare(QObject):
         self.action.setShortcut("F")
         self.action.setShortcutContext(Qt.ShortcutContext.WindowShortcut)
         self.action.setToolTip(
-            "Show the source as the tiles are made from it, its lighting flattened (Flatten "
-            "lighting: On, or Auto where the lighting varies); again: the photo as it is (F)"
+            "Show the source as the tile set's tiles are made from it, its lighting flattened "
+            "(Flatten lighting: On, or Auto where the lighting varies; a Wang set uses the photo "
+            "as it is); again: the photo as it is (F)"
         )
         self.action.toggled.connect(self._refresh)
         self.shown: int | None = None  # the scale of the flattened source on screen
@@ -95,6 +97,6 @@ class FlattenCompare(QObject):
         self.shown = scale
         self.pipeline.message.emit(
             "info",
-            f"The source with its lighting flattened (at {scale:g} px), as the tiles are made "
-            "from it; F shows the photo as it is.",
+            f"The source with its lighting flattened (at {scale:g} px), as the tile set's tiles "
+            "are made from it (a Wang set uses the photo as it is); F shows the photo as it is.",
         )

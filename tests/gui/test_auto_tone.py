@@ -54,6 +54,9 @@ def test_flattened_lighting_before_and_after_on_the_source_canvas(qtbot, tmp_pat
     want = flatten_lighting(photo, scale=scale)
     np.testing.assert_array_equal(canvas.image_item.array, want)
     assert "lighting flattened" in w.messages[-1][1]
+    for said in (w.messages[-1][1], act.toolTip()):  # true on the Wang tab too
+        assert "the tile set's tiles are made from it" in said
+        assert "a Wang set uses the photo as it is" in said
     w.doc.set_params({"tile_size": "128"})  # another scale: flattened again
     qtbot.waitUntil(lambda: w.flatten_compare.shown == w.pipeline.flatten_scale(), timeout=WAIT_MS)
     assert w.flatten_compare.shown != scale
