@@ -10,6 +10,7 @@ the tiles that use it. Re-rolling the preview's layout is one too (:class:`SetWa
 from __future__ import annotations
 
 import numpy as np
+import shiboken6
 from PySide6.QtCore import QObject, Signal
 from PySide6.QtGui import QUndoCommand
 
@@ -21,7 +22,18 @@ from engine.tiles.wang import (
     wang_record,
 )
 
-__all__ = ["DEFAULT_OPTIONS", "NewWangSet", "SetWangLayout", "SetWangSample", "WangDocument"]
+__all__ = [
+    "DEFAULT_OPTIONS",
+    "KEPT_SETS",
+    "NewWangSet",
+    "SetWangLayout",
+    "SetWangSample",
+    "WangDocument",
+]
+
+#: Generate steps of the Wang history that keep their sets' tiles (a 4-colour set of 256 px
+#: tiles is ~230 MB); an older one keeps options, samples and layout, its tiles made again
+KEPT_SETS = 3
 
 #: the editor's Wang options (engine.tiles.wang.iter_wang_set names) and their defaults
 DEFAULT_OPTIONS = {"colours": 2, "tile_size": 128, "variants": 1, "interior": "patch", "seed": 0}
@@ -55,6 +67,7 @@ class WangDocument(QObject):
         self.pending = lambda: set()
         self.pixels = 0  # the source's pixels generation: one more at every heal (or its undo)
         root.pixels_changed.connect(self._on_pixels_changed)
+        undo_stack.indexChanged.connect(self._lighten_history)
 
     # ------------------------------------------------------------------ state
     @property
@@ -96,6 +109,17 @@ class WangDocument(QObject):
         else:
             self.undo_stack.push(NewWangSet(self, options))
 
+    def _lighten_history(self) -> None:
+        """Only the :data:`KEPT_SETS` Generate steps nearest the present keep the tiles of
+        the set an undo (or redo) puts back; the others are made again when put back."""
+        if not shiboken6.isValid(self.undo_stack):  # the stack clears as it is deleted
+            return
+        stack, now = self.undo_stack, self.undo_stack.index()
+        steps = [(i, stack.command(i)) for i in range(stack.count())]
+        steps = [(abs(now - 0.5 - i), i < now, c) for i, c in steps if isinstance(c, NewWangSet)]
+        for rank, (_, done, c) in enumerate(sorted(steps, key=lambda s: s[0])):
+            c.lighten(old=rank >= KEPT_SETS, new=rank >= KEPT_SETS or done)  # undo retakes new
+
     def start(self, options: dict) -> None:
         """A new set with ``options``: samples, tiles and layout forgotten."""
         self.options = {**DEFAULT_OPTIONS, **options}
@@ -127,6 +151,16 @@ class WangDocument(QObject):
         samples = None if self.samples is None else list(self.samples)
         return (dict(self.options), samples, dict(self.tiles), self.layout, self.layout_seed,
                 self.notes, dict(self.parameters), set(self.pending()), self.pixels)  # fmt: skip
+
+    @staticmethod
+    def light(state: tuple) -> tuple:
+        """A :meth:`snapshot` without its tiles: every tile waits (made again on restore)."""
+        options, samples, tiles, *rest, pending, pixels = state
+        if samples is None:
+            return state
+        o = {**DEFAULT_OPTIONS, **options}
+        every = set(range(int(o["variants"]) * int(o["colours"]) ** 4))
+        return (options, samples, {}, *rest, every, pixels)
 
     def restore(self, state: tuple) -> None:
         """Back to a :meth:`snapshot`; the running jobs of the set it replaces are dropped
@@ -230,6 +264,14 @@ class NewWangSet(QUndoCommand):
     def undo(self) -> None:
         self.new = self.doc.snapshot()
         self.doc.restore(self.old)
+
+    def lighten(self, *, old: bool, new: bool) -> None:
+        """Forget the tiles of the set before (``old``) and / or after (``new``): they are
+        made again when it is put back."""
+        if old:
+            self.old = WangDocument.light(self.old)
+        if new and self.new is not None:
+            self.new = WangDocument.light(self.new)
 
 
 class SetWangSample(QUndoCommand):

@@ -5,6 +5,7 @@ and the Wang history keeps a bounded number of whole sets."""
 from __future__ import annotations
 
 from engine.tiles.wang import WangSample
+from quilt_gui.wang_doc import KEPT_SETS, NewWangSet
 from tests.gui.helpers import WAIT_MS, make_window, open_sample
 from tests.gui.test_wang_view import generate, wait_wang
 
@@ -72,3 +73,30 @@ def test_a_set_saved_during_a_rebuild_is_rebuilt_when_reopened(qtbot, tmp_path):
     wait_wang(qtbot, other)
     assert other.doc.wang.complete and mismatched(other) == []
     assert other.doc.wang.sample("h", 1).origin == (y + 3, x + 2)
+
+
+def test_the_wang_history_keeps_a_bounded_number_of_whole_sets(qtbot):
+    win = make_window(qtbot)
+    open_sample(qtbot, win, "cobblestones")
+    w = win.doc.wang
+    for seed in range(KEPT_SETS + 3):
+        win.wang_view.seed.setValue(seed)
+        generate(qtbot, win, tile_size=16, colours=1)
+        if seed == 0:  # the first set: its samples, then a sample move (an undo step)
+            first = list(w.samples)
+            y, x = w.sample("h", 0).origin
+            assert win.wang_runner.move_sample("h", 0, (y + 1, x + 1))
+            wait_wang(qtbot, win)
+            moved = list(w.samples)
+    stack = w.undo_stack
+    sets = [stack.command(i) for i in range(stack.count())]
+    sets = [c for c in sets if isinstance(c, NewWangSet)]
+    assert len(sets) == KEPT_SETS + 2 == stack.count() - 1
+    assert sum(bool(c.old[2]) for c in sets) == KEPT_SETS  # tiles kept only in the last ones
+    while stack.index() > 1:  # back to the first set after its move: its tiles made again
+        stack.undo()
+        wait_wang(qtbot, win)
+    assert w.samples == moved and moved != first and w.complete and mismatched(win) == []
+    stack.undo()  # the move, undone on the rebuilt set
+    wait_wang(qtbot, win)
+    assert w.samples == first and w.complete and mismatched(win) == []
