@@ -63,8 +63,9 @@ class WangDocument(QObject):
         self.selected: tuple[str, int] | None = None  # (axis, colour) of the chosen sample
         self.notes: tuple[str, ...] = ()
         self.parameters: dict = {}  # the engine's parameters of the last run
-        #: the tiles waiting for a rebuild (the runner's: a snapshot keeps them)
-        self.pending = lambda: set()
+        #: the tiles waiting for a rebuild (their sample moved, or the pixels changed): the
+        #: runner's work list; a snapshot and a project keep them
+        self.stale: set[int] = set()
         self.pixels = 0  # the source's pixels generation: one more at every heal (or its undo)
         root.pixels_changed.connect(self._on_pixels_changed)
         undo_stack.indexChanged.connect(self._lighten_history)
@@ -150,7 +151,7 @@ class WangDocument(QObject):
         pixels generation its tiles were made from."""
         samples = None if self.samples is None else list(self.samples)
         return (dict(self.options), samples, dict(self.tiles), self.layout, self.layout_seed,
-                self.notes, dict(self.parameters), set(self.pending()), self.pixels)  # fmt: skip
+                self.notes, dict(self.parameters), set(self.stale), self.pixels)  # fmt: skip
 
     @staticmethod
     def light(state: tuple) -> tuple:
@@ -197,7 +198,7 @@ class WangDocument(QObject):
             options=dict(self.options),
             layout=None if self.layout is None else self.layout.tolist(),
             layout_seed=self.layout_seed,
-            pending=sorted(self.pending()),  # tiles still to rebuild: made again on opening
+            pending=sorted(self.stale),  # tiles still to rebuild: made again on opening
         )
         return record, [t.to_candidate() for t in tiles]
 

@@ -33,7 +33,6 @@ class WangRunner(QObject):
         self.doc = doc
         self.pipeline = pipeline
         self.jobs = manager or jobs.manager()
-        self.stale: set[int] = set()  # tiles whose samples moved since they were made
         self._reroll_seed = 1000
         self._job: jobs.Job | None = None  # the last Generate's
         self._version = 0  # of the edge samples: one more at every move
@@ -41,9 +40,17 @@ class WangRunner(QObject):
         doc.wang.sample_moved.connect(self._on_sample_moved)
         doc.wang.superseded.connect(self._drop_jobs)
         doc.wang.restored.connect(self._on_restored)
-        doc.wang.pending = lambda: set(self.stale)
         doc.source_changed.connect(self._on_source_changed)
         doc.pixels_changed.connect(self._on_pixels_changed)
+
+    @property
+    def stale(self) -> set[int]:
+        """The tiles waiting for a rebuild (:attr:`WangDocument.stale`)."""
+        return self.doc.wang.stale
+
+    @stale.setter
+    def stale(self, tiles) -> None:
+        self.doc.wang.stale = set(tiles)
 
     # ------------------------------------------------------------------ options
     def engine_options(self) -> dict:

@@ -100,3 +100,12 @@ def test_the_wang_history_keeps_a_bounded_number_of_whole_sets(qtbot):
     stack.undo()  # the move, undone on the rebuilt set
     wait_wang(qtbot, win)
     assert w.samples == first and w.complete and mismatched(win) == []
+
+
+def test_the_waiting_tiles_are_the_documents_own(qtbot):
+    """A snapshot keeps the Wang document's waiting tiles without a runner reaching in."""
+    from quilt_gui.document import Document
+
+    doc = Document()
+    doc.wang.stale = {1, 2}
+    assert doc.wang.snapshot()[7] == {1, 2}
