@@ -76,9 +76,9 @@ class FlattenCompare(QObject):
         if scale == self.shown:
             return
         job, photo, asked = self._asked
-        if job is not None and job is self.pipeline.jobs.get("flatten-view"):
-            if photo is src.main and asked == scale:
-                return  # under way (asked again by flatten_scale's own tone_changed)
+        under_way = job is not None and job is self.pipeline.jobs.get("flatten-view")
+        if under_way and photo is src.main and asked == scale:
+            return  # under way (asked again by flatten_scale's own tone_changed)
         job = self.pipeline.jobs.start(
             "flatten-view",
             _flattened,
