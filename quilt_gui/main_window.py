@@ -568,6 +568,9 @@ class MainWindow(QMainWindow):
             made = f" ({len(w.tiles)} of {w.count} tiles made)" if w.tiles else ""
             self.show_message("warning", f"Nothing to export yet: generate the Wang set{made}.")
             return
+        if wang and w.stale:  # a moved sample's or a heal's tiles are not made yet
+            self.show_message("warning", f"Wait for the rebuild of {len(w.stale)} Wang tiles.")
+            return
         if not wang and not self.doc.tileset.candidates:
             self.show_message(
                 "warning", "Nothing to export yet: generate candidates and pick the tiles to keep."

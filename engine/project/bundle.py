@@ -72,6 +72,12 @@ def _export_wang(project: Project, out_dir, options: dict) -> dict:
     if not project.wang_tiles:
         raise ValueError("the project has no Wang tiles to export")
     w = project.wang
+    if w.get("pending"):  # the editor saved it while a sample move or a heal was rebuilt
+        raise ValueError(
+            f"{len(w['pending'])} of the project's Wang tiles were saved while they waited for "
+            "a rebuild (their edges do not match their edge samples yet): open the project in "
+            "the editor, let it rebuild them, save, and export again"
+        )
     k = w["colours"]
     tiles = project.wang_tiles
     if options.get("columns") is None and len(tiles) % (k * k) == 0:

@@ -7,7 +7,7 @@ import pytest
 
 from engine.cli import main
 from engine.png import decode_png, encode_png
-from engine.project import load_project
+from engine.project import export_project, load_project
 from engine.tiles.wang_layout import layout_mismatches
 from tests.engine.helpers import smooth_texture
 
@@ -62,6 +62,11 @@ def test_wang_set_files_manifest_layout_and_project(tmp_path, src):
     assert bman["atlas"]["columns"] == 4  # the canonical 4x4 arrangement
     tsx = (bundle / "tileset.tsx").read_text()
     assert tsx.count("<wangtile ") == 16 and 'type="edge"' in tsx
+
+    p.wang["pending"] = [3, 7]  # saved by the editor while two tiles waited for a rebuild
+    with pytest.raises(ValueError, match="2 of the project's Wang tiles were saved while"):
+        export_project(p, tmp_path / "b2")
+    assert not (tmp_path / "b2").exists()
 
 
 def test_wang_flags_are_checked(tmp_path, src, capsys):

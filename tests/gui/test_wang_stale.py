@@ -64,6 +64,8 @@ def test_a_set_saved_during_a_rebuild_is_rebuilt_when_reopened(qtbot, tmp_path):
     w = win.doc.wang
     y, x = w.sample("h", 1).origin
     w.set_sample(WangSample("h", 1, (y + 3, x + 2)))  # its tiles are rebuilt...
+    win.export_dialog(wang=True)  # (not exported meanwhile: the message says why)
+    assert win.messages[-1][1] == f"Wait for the rebuild of {len(w.stale)} Wang tiles."
     path = str(tmp_path / "p.quiltproj")
     assert win.files.save_to(path, wait=True)  # ...and the project saved at once
     wait_wang(qtbot, win)
