@@ -127,10 +127,14 @@ def test_messages_through_a_small_ring_and_the_pipe(ring, pools, monkeypatch):
 
     monkeypatch.setattr(workers, "WorkerPool", Waiting)
     kw = dict(block=28, overlap=6, rng=4, mode="exact", adaptive_threshold=0.02)
-    mine, ref = (list(iter_quilt(SAMPLE, (200, 220), threads=t, **kw)) for t in (2, 1))
-    assert pools and pools[0].boxes
-    piped = sum(box.piped for box in pools[0].boxes)
-    through_ring = sum(box.read for box in pools[0].boxes)
+    ref = list(iter_quilt(SAMPLE, (200, 220), threads=1, **kw))
+    for _ in range(5):  # the ring's path needs a caller that keeps up: a loaded machine
+        mine = list(iter_quilt(SAMPLE, (200, 220), threads=2, **kw))  # (two suites at once)
+        assert pools and pools[-1].boxes  # once piped every message of a run
+        piped = sum(box.piped for box in pools[-1].boxes)
+        through_ring = sum(box.read for box in pools[-1].boxes)
+        if (piped if ring == 4096 else through_ring) > 0:
+            break
     assert piped > 0 if ring == 4096 else through_ring > 0  # the path this size takes
     placed = [[e for e in run if isinstance(e, BlockPlaced)] for run in (mine, ref)]
     assert len(placed[0]) == len(placed[1])
