@@ -192,19 +192,16 @@ class WangRunner(QObject):
 
         w = self.doc.wang
         size = int(w.options["tile_size"])
-        src = self.doc.source.main
         try:
             setup = WangSetup(
-                src, tile_size=size, seam=params.tileset_settings(self.doc.params).seam
+                self.doc.source.main,
+                tile_size=size,
+                seam=params.tileset_settings(self.doc.params).seam,
             )
             try:
                 origin = setup.check_origin(axis, origin)
             except ValueError:  # dragged past the border: the nearest place it fits
-                (wh, ww), (H, W) = setup.window_shape(axis), src.shape[:2]
-                y, x = (int(v) for v in origin)
-                y, x = (y - setup.reach, x) if axis == "h" else (y, x - setup.reach)
-                near = (min(max(y, 0), H - wh), min(max(x, 0), W - ww))
-                origin = setup.check_origin(axis, setup.anchor_to_origin(axis, *near))
+                origin = setup.check_origin(axis, setup.nearest_origin(axis, origin))
         except (TypeError, ValueError) as exc:
             self.message.emit("warning", f"The edge sample cannot go there: {exc}")
             return False
@@ -238,9 +235,9 @@ class WangRunner(QObject):
     @Slot(str, int)
     def _on_sample_moved(self, axis: str, colour: int) -> None:
         self._version += 1  # tiles of the jobs running now that show the sample are outdated
-        for k in self.doc.wang.users(axis, colour):
-            self._outdated[k] = self._version
-        self.stale |= set(self.doc.wang.users(axis, colour))
+        users = set(self.doc.wang.users(axis, colour))
+        self._outdated.update(dict.fromkeys(users, self._version))
+        self.stale |= users
         self.rebuild()
 
     def rebuild(self) -> jobs.Job | None:

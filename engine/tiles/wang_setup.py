@@ -155,6 +155,17 @@ class WangSetup:
     def anchor_to_origin(self, axis: str, y: int, x: int) -> tuple[int, int]:
         return (y + self.reach, x) if axis == "h" else (y, x + self.reach)
 
+    def origin_to_anchor(self, axis: str, oy: int, ox: int) -> tuple[int, int]:
+        return (oy - self.reach, ox) if axis == "h" else (oy, ox - self.reach)
+
+    def nearest_origin(self, axis: str, origin) -> tuple[int, int]:
+        """The origin nearest ``origin`` whose window lies in the source (an edge sample
+        dragged past the border stops at it; :meth:`check_origin` still refuses a source
+        smaller than the window)."""
+        (wh, ww), (H, W) = self.window_shape(axis), self.S.shape[:2]
+        y, x = self.origin_to_anchor(axis, *(int(v) for v in origin))
+        return self.anchor_to_origin(axis, min(max(y, 0), H - wh), min(max(x, 0), W - ww))
+
     def check_origin(self, axis: str, origin) -> tuple[int, int]:
         try:
             oy, ox = (int(v) for v in origin)
@@ -162,7 +173,7 @@ class WangSetup:
             raise TypeError(f"a sample origin must be (row, col), got {origin!r}") from None
         H, W = self.S.shape[:2]
         wh, ww = self.window_shape(axis)
-        y, x = (oy - self.reach, ox) if axis == "h" else (oy, ox - self.reach)
+        y, x = self.origin_to_anchor(axis, oy, ox)
         if not (0 <= y <= H - wh and 0 <= x <= W - ww):
             raise ValueError(
                 f"an {axis!r} sample at origin {(oy, ox)} reads source pixels outside the "
