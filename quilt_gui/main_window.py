@@ -436,9 +436,9 @@ class MainWindow(QMainWindow):
 
     def _connect(self) -> None:
         doc = self.doc
-        self.pipeline.message.connect(self.show_message)
-        self.wang_runner.message.connect(self.show_message)
-        self.wang_runner.advice.connect(self.show_message)
+        for said in (self.pipeline.message, self.wang_runner.message, self.wang_runner.advice):
+            said.connect(self.show_message)
+        self.wang_runner.retracted.connect(self.message_bar.retract)
         self.wang_view.export_requested.connect(partial(self.export_dialog, wang=True))
         self.heal_tool.message.connect(self.show_message)
         self.files.message.connect(self.show_message)

@@ -49,7 +49,7 @@ class WangDocument(QObject):
     layout_changed = Signal()
     selection_changed = Signal()
     superseded = Signal()  # undo / redo put another set back: drop the jobs of this one
-    restored = Signal(object)  # ...and these of its tiles still wait for a rebuild (a set)
+    restored = Signal(object)  # ...put back: these of its tiles wait for a rebuild (a set)
 
     def __init__(self, root, undo_stack) -> None:
         super().__init__(root)
@@ -179,8 +179,7 @@ class WangDocument(QObject):
             self.tile_changed.emit(k)
         self.apply_layout(layout, seed)
         self.root.mark_dirty()
-        if pending:
-            self.restored.emit(set(pending))
+        self.restored.emit(set(pending))
 
     # ------------------------------------------------------------------ project files
     def to_project(self, names: list[str]) -> tuple[dict | None, list]:

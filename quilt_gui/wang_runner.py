@@ -19,6 +19,7 @@ __all__ = ["WangRunner"]
 
 PREVIEW = (8, 8)  # the preview layout's cells (rows, cols)
 MIN_TILE = 8  # the smallest Wang tile the engine makes (a 2 px band on each side)
+STOPPED = "Wang set stopped"  # the start of the message of a cancelled set
 
 
 class WangRunner(QObject):
@@ -27,6 +28,8 @@ class WangRunner(QObject):
     message = Signal(str, str)  # level, text
     #: level, text, actions ((label, callable) buttons): a message the banner offers a fix for
     advice = Signal(str, str, object)
+    #: the start of a message no longer true (the set it spoke of is not the one shown)
+    retracted = Signal(str)
 
     def __init__(self, doc, pipeline, manager: jobs.JobManager | None = None, parent=None):
         super().__init__(parent)
@@ -176,11 +179,14 @@ class WangRunner(QObject):
             self.advice.emit("warning", f"Wang set: {advice}", [(f"Use {size} px tiles", use)])
         self._first_layout()
         if self._job is not None and self._job.token.cancelled and not w.complete:
-            # cancelled: the part made stays on screen, said in words
-            text = f"Wang set stopped: {len(w.tiles)} of {w.count} tiles made; Generate makes it"
-            if w.undo_stack.undoText() == NewWangSet.TEXT:
-                text += " (Edit ▸ Undo, Ctrl+Z, brings back the set before)"
-            self.message.emit("warning", text + ".")
+            self._say_stopped()  # cancelled: the part made stays on screen, said in words
+
+    def _say_stopped(self) -> None:
+        w = self.doc.wang
+        text = f"{STOPPED}: {len(w.tiles)} of {w.count} tiles made; Generate makes it"
+        if w.undo_stack.undoText() == NewWangSet.TEXT:
+            text += " (Edit ▸ Undo, Ctrl+Z, brings back the set before)"
+        self.message.emit("warning", text + ".")
 
     def _on_error(self, exc) -> None:
         self.message.emit("error", f"Wang set failed: {error_text(exc)}")
@@ -278,16 +284,21 @@ class WangRunner(QObject):
 
     @Slot()
     def _drop_jobs(self) -> None:
-        """The running set's jobs end unheard (another set replaces it)."""
+        """The running set's jobs end unheard (another set replaces it): a stop said of the
+        set before is no longer true."""
         self.jobs.abort_matching("wang")
+        self.retracted.emit(STOPPED)
         self.stale = set()
         self._outdated = {}
 
     @Slot(object)
     def _on_restored(self, pending) -> None:
-        """A set put back by undo / redo with tiles whose sample had moved: rebuild them."""
+        """A set put back by undo / redo (or opened) with tiles whose sample had moved or
+        whose pixels changed: rebuild them; a set stopped before its end says so again."""
         self.stale = set(pending)
         self.rebuild()
+        if not self.stale and not self.doc.wang.complete:
+            self._say_stopped()
 
     @Slot()
     def _on_pixels_changed(self) -> None:

@@ -118,6 +118,12 @@ class MessageBar(QWidget):
         """True while a message with action buttons is shown (info must not replace it)."""
         return self.isVisibleTo(self.parentWidget()) and self._actions.count() > 0
 
+    @Slot(str)
+    def retract(self, start: str) -> None:
+        """Close the message shown if it starts with ``start`` (no longer true)."""
+        if self.text.startswith(start):
+            self.dismiss()
+
     @Slot()
     def dismiss(self) -> None:
         self._timer.stop()
