@@ -31,6 +31,8 @@ DEFAULTS: dict[str, Any] = {
     "tile_grid_lines": True,
     "heat_overlay": True,
     "preview_grid": False,
+    "wang_grid": False,  # the Wang tab's Grid box (tile borders over its layout)
+    "wang_seams": True,  # the Wang tab's Seams box (the tiles' cuts)
     "thumbnail_size": 112,
     "params_view": "Basic",  # the parameters panel's view: "Basic" or "Advanced"
     "parameters": {},  # the last used tile-set / quilting parameters (JSON-able dict)

@@ -11,6 +11,8 @@
 
 from __future__ import annotations
 
+from functools import partial
+
 import numpy as np
 from PySide6.QtCore import QLineF, QPointF, Qt, Signal, Slot
 from PySide6.QtGui import QBrush, QColor, QPainterPath, QPolygonF
@@ -35,6 +37,7 @@ from PySide6.QtWidgets import (
 )
 
 from engine.export.wang import PALETTE
+from quilt_gui import settings
 from quilt_gui.widgets.canvas import ImageCanvas, cosmetic_pen
 from quilt_gui.widgets.preview import grid_items
 
@@ -232,11 +235,14 @@ class WangView(QWidget):
         self.reroll_layout_button = QPushButton("Re-roll layout")
         self.reroll_layout_button.clicked.connect(self.runner.reroll_layout)
         self.seams_box = QCheckBox("Seams")
-        self.seams_box.setChecked(True)
+        self.seams_box.setChecked(settings.get("wang_seams"))
         self.seams_box.setToolTip("Draw the corner cuts (red) and the interiors' cuts (green)")
+        self.seams_box.toggled.connect(partial(settings.set, "wang_seams"))
         self.seams_box.toggled.connect(self._draw_tile_overlays)
         self.grid_box = QCheckBox("Grid")
+        self.grid_box.setChecked(settings.get("wang_grid"))
         self.grid_box.setToolTip("Draw the tile borders over the preview")
+        self.grid_box.toggled.connect(partial(settings.set, "wang_grid"))
         self.grid_box.toggled.connect(self._draw_grid)
         self.export_button = QPushButton("Export…")
         self.export_button.setToolTip("Write the set for Tiled (Wang set) and Godot (terrains)")

@@ -27,3 +27,14 @@ def test_the_stopped_banner_follows_the_set_undo_and_redo_show(qtbot):
     assert "stopped" not in bar.text
     wait_wang(qtbot, win)
     assert w.complete and "stopped" not in bar.text
+
+
+def test_the_grid_and_seams_boxes_are_remembered_at_the_next_start(qtbot):
+    win = make_window(qtbot)
+    view = win.wang_view
+    assert view.seams_box.isChecked() and not view.grid_box.isChecked()  # the defaults
+    view.seams_box.setChecked(False)
+    view.grid_box.setChecked(True)
+    win.close()
+    again = make_window(qtbot).wang_view
+    assert not again.seams_box.isChecked() and again.grid_box.isChecked()
