@@ -212,12 +212,18 @@ class SetHealMask(_Swap):
 
 
 class SetSourceMaps(_Swap):
-    """The source's pixels (every material map), e.g. healed."""
-
-    APPLY = "apply_source_maps"
+    """The source's pixels (every material map), e.g. healed, with their generation (undo
+    gives the old one back: a Wang set made from them is not made again)."""
 
     def __init__(self, doc, maps: dict, text: str) -> None:
-        super().__init__(doc, dict(maps), dict(doc.source.maps), text)
+        new, old = (dict(maps), doc.new_pixels()), (dict(doc.source.maps), doc.pixels)
+        super().__init__(doc, new, old, text)
+
+    def redo(self) -> None:
+        self.doc.apply_source_maps(*self.new)
+
+    def undo(self) -> None:
+        self.doc.apply_source_maps(*self.old)
 
 
 class SetMapWeights(_Swap):

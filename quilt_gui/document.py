@@ -55,6 +55,9 @@ class Document(QObject):
         # use (with the exclude_color range); saved in the project's extra["exclude_painted"]
         self.exclude_painted: np.ndarray | None = None
         self.heal_mask: np.ndarray | None = None  # (H, W) bool: the region to heal (not saved)
+        #: the source's pixels generation: a new one at every heal, the old one back at its undo
+        self.pixels = 0
+        self._generations = 0  # the generations handed out
         self._dirty = False  # changes that are not undo steps (streamed results)
         self._was_modified = False
         self.tileset = TileSetDocument(self, QUndoStack(self))
@@ -174,8 +177,15 @@ class Document(QObject):
         st.push(commands.SetHealMask(self, None, "Heal"))
         st.endMacro()
 
-    def apply_source_maps(self, maps: dict[str, np.ndarray]) -> None:
-        """New pixels for the source's maps (same names and size)."""
+    def new_pixels(self) -> int:
+        """A pixels generation not given before (:attr:`pixels`)."""
+        self._generations += 1
+        return self._generations
+
+    def apply_source_maps(self, maps: dict[str, np.ndarray], pixels: int | None = None) -> None:
+        """New pixels for the source's maps (same names and size), of generation ``pixels``
+        (a new one when None)."""
+        self.pixels = self.new_pixels() if pixels is None else int(pixels)
         self.source = replace(self.source, maps=dict(maps))
         self.pixels_changed.emit()
         self.maps_changed.emit()

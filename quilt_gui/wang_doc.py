@@ -66,8 +66,6 @@ class WangDocument(QObject):
         #: the tiles waiting for a rebuild (their sample moved, or the pixels changed): the
         #: runner's work list; a snapshot and a project keep them
         self.stale: set[int] = set()
-        self.pixels = 0  # the source's pixels generation: one more at every heal (or its undo)
-        root.pixels_changed.connect(self._on_pixels_changed)
         undo_stack.indexChanged.connect(self._lighten_history)
 
     # ------------------------------------------------------------------ state
@@ -138,8 +136,11 @@ class WangDocument(QObject):
         self.tile_changed.emit(int(tile.index))
         self.root.mark_dirty()
 
-    def _on_pixels_changed(self) -> None:
-        self.pixels += 1
+    @property
+    def pixels(self) -> int:
+        """The generation of the source's pixels (:attr:`Document.pixels`): a snapshot keeps
+        the one its tiles were made from."""
+        return self.root.pixels
 
     def select(self, key: tuple[str, int] | None) -> None:
         if key != self.selected:

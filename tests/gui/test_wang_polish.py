@@ -38,3 +38,23 @@ def test_the_grid_and_seams_boxes_are_remembered_at_the_next_start(qtbot):
     win.close()
     again = make_window(qtbot).wang_view
     assert not again.seams_box.isChecked() and again.grid_box.isChecked()
+
+
+def test_a_heal_undone_gives_the_pixels_back_and_an_older_set_is_not_made_again(qtbot):
+    win = make_window(qtbot)
+    open_sample(qtbot, win, "cobblestones")
+    generate(qtbot, win, tile_size=48)
+    w, doc = win.doc.wang, win.doc
+    tiles = dict(w.tiles)  # the 48 px set, made from the photo's pixels
+    generate(qtbot, win, tile_size=40)
+    win.tabs.setCurrentWidget(win.source_view)  # a heal is a Source tab edit
+    doc.heal({**doc.source.maps, doc.source.main_name: 1 - doc.source.main})
+    wait_wang(qtbot, win)  # the 40 px set made again from the healed pixels
+    doc.undo_stack.undo()  # the heal undone: the photo's pixels back...
+    wait_wang(qtbot, win)  # (the 40 px set made again from them)
+    win.tabs.setCurrentWidget(win.wang_view)
+    doc.undo_stack.undo()  # ...so the 48 px set comes back as it was, nothing to rebuild
+    assert w.options["tile_size"] == 48 and w.complete and not win.wang_runner.stale
+    assert all(w.tiles[k] is t for k, t in tiles.items())
+    doc.undo_stack.redo()  # the 40 px set, made again from the photo: back as it was too
+    assert w.options["tile_size"] == 40 and w.complete and not win.wang_runner.stale
