@@ -73,7 +73,8 @@ class FlattenCompare(QObject):
                         "flattens it).",
                     )
             return
-        if scale == self.shown:
+        if scale == self.shown:  # asked back: a job of another scale under way is not
+            self.pipeline.jobs.abort_matching("flatten-view")  # (its image would replace it)
             return
         job, photo, asked = self._asked
         under_way = job is not None and job is self.pipeline.jobs.get("flatten-view")

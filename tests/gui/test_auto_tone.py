@@ -95,3 +95,31 @@ def test_a_new_photo_with_flattened_lighting_shown_is_flattened_once(qtbot, tmp_
     assert w.flatten_compare.action.isChecked()
     assert starts.count("flatten-view") == 1
     wait_idle(qtbot, w)
+
+
+def test_a_tile_size_changed_and_back_while_flattening_shows_the_scale_asked(qtbot, tmp_path):
+    """The size changed back before the other scale's job ended: that job's image (at the scale
+    no longer asked) was shown over the right one, and said to be of that scale."""
+    import numpy as np
+
+    from engine.tone import flatten_lighting
+
+    path = tmp_path / "bricks.png"
+    Image.fromarray(bricks(256, seed=3)).save(path)
+    w = make_window(qtbot)
+    with qtbot.waitSignal(w.doc.source_changed, timeout=WAIT_MS):
+        w.files.open_path(str(path), confirm=False)
+    w.doc.set_params({"tile_size": "64"})
+    view, photo = w.flatten_compare, w.doc.source.main
+    view.action.trigger()
+    qtbot.waitUntil(lambda: view.shown is not None, timeout=WAIT_MS)
+    scale = view.shown
+    w.doc.set_params({"tile_size": "128"})  # another scale: its job starts...
+    other = w.jobs.get("flatten-view")
+    assert w.pipeline.flatten_scale() != scale and other is not None
+    w.doc.set_params({"tile_size": "64"})  # ...and the size is back before it ends
+    qtbot.waitUntil(lambda: other.state != "running", timeout=WAIT_MS)  # (its image delivered)
+    wait_idle(qtbot, w)
+    assert w.pipeline.flatten_scale() == scale and view.shown == scale
+    want = flatten_lighting(photo, scale=scale)
+    np.testing.assert_array_equal(w.source_view.image_item.array, want)
