@@ -40,7 +40,9 @@ RESULTS = Path(__file__).parent / "results" / "lattice_causes.txt"
 DEFAULT = ("brick", "retina", "cell", "cobblestones")
 
 
-def _with_margin(q: np.ndarray, T: np.ndarray, m: int) -> np.ndarray:
+def with_margin(q: np.ndarray, T: np.ndarray, m: int) -> np.ndarray:
+    """A copy of window ``q`` with its outer ``m`` px replaced by the template ``T``'s (a
+    window pasted whole inside the template's margin: no cut, no blend)."""
     q = q.copy()
     q[:m], q[-m:], q[:, :m], q[:, -m:] = T[:m], T[-m:], T[:, :m], T[:, -m:]
     return q
@@ -113,7 +115,7 @@ def stand_ins(res, S, seed: int = 5) -> dict:
     windows, ring = [], []
     for c in res.candidates:
         y, x = c.patch_origin
-        windows.append(_with_margin(S[y : y + h, x : x + w], T, m))
+        windows.append(with_margin(S[y : y + h, x : x + w], T, m))
         yy, xx = int(rng.integers(0, H - h + 1)), int(rng.integers(0, W - w + 1))
         ring.append(np.where(np.asarray(c.mask)[..., None], S[yy : yy + h, xx : xx + w], T))
     opts = dict(patch_overlap=s.patch_overlap, margin=m, seam=s.seam, rng=s.seed, scale=res.scale)

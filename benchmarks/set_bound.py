@@ -55,7 +55,7 @@ def _run(name: str):
 
 def where_frame(res, S) -> list[list[str]]:
     """Table 1: frame ratio by distance of the candidates and their stand-ins."""
-    from benchmarks.lattice_causes import _with_margin
+    from benchmarks.lattice_causes import with_margin
     from engine.metrics import frame
     from engine.tiles import candidates
 
@@ -66,7 +66,7 @@ def where_frame(res, S) -> list[list[str]]:
     windows = []
     for c in res.candidates:
         y, x = c.patch_origin
-        windows.append(_with_margin(S[y : y + h, x : x + w], T, m))
+        windows.append(with_margin(S[y : y + h, x : x + w], T, m))
     opts = dict(patch_overlap=wp, margin=m, seam=s.seam, rng=s.seed, scale=res.scale)
     sets = {
         "candidates": [c.tile for c in res.candidates],
@@ -84,21 +84,12 @@ def where_frame(res, S) -> list[list[str]]:
 
 def position_figures(res, S, stride: int) -> dict:
     """Every grid position made into a candidate: origins, frame ratio profiles, ring terms."""
-    from engine.metrics import edge_distance, luminance
-    from engine.tiles.candidates import _Setup
-    from engine.tileset_metrics import (
-        FRAME_SIGMA,
-        REFERENCE_CROPS,
-        _gradient_magnitude,
-        _profile,
-        _reference,
-        _ring_centre_steps,
-        frame,
-    )
+    from engine.tiles.candidates import CandidateSetup
+    from engine.tileset_metrics import frame, frame_profiles, ring_reference, ring_steps
 
     st, s = res.seamless, res.settings
     wp, m = s.patch_overlap, s.margin
-    setup = _Setup(
+    setup = CandidateSetup(
         S,
         st,
         patch_size=None,
@@ -112,14 +103,9 @@ def position_figures(res, S, stride: int) -> dict:
         scale=res.scale,
     )
     lim = 2 * wp
-    L = luminance(S)
     h, w = setup.ph, setup.pw
-    dist = edge_distance((h, w))
     ref = frame([st.tile], S, limit=lim, template=st.tile).reference  # the metric's crops
-    org = _reference(L, (h, w), st.tile, True).origins(REFERENCE_CROPS, 0)
-    ref_tone = float(
-        _ring_centre_steps(np.stack([L[y : y + h, x : x + w] for y, x in org]), wp).mean()
-    )
+    ref_tone = ring_reference(S, (h, w), width=wp, template=st.tile)  # ring_tone's crops
     H, W = S.shape[:2]
     ty, tx = setup.template_origin
     d = setup.min_distance
@@ -129,10 +115,9 @@ def position_figures(res, S, stride: int) -> dict:
         for x in range(0, W - w + 1, stride):
             if max(abs(y - ty), abs(x - tx)) < d:
                 continue
-            lum = luminance(np.asarray(setup.make(0, None, (y, x), 0, None).tile))
-            g = _gradient_magnitude(lum, FRAME_SIGMA, "wrap")
-            ratios.append(_profile(g[None], dist, lim) / ref)
-            terms.append(_ring_centre_steps(lum[None], wp)[0] / ref_tone)
+            tile = setup.make(0, None, (y, x), 0, None).tile
+            ratios.append(frame_profiles([tile], limit=lim)[0] / ref)
+            terms.append(ring_steps([tile], width=wp)[0] / ref_tone)
             origins.append((y, x))
     return {
         "origins": np.array(origins),

@@ -470,11 +470,11 @@ def stage_scaling(S: np.ndarray, tile: int, seed: int, calls: int = 20) -> list:
 
     from engine.materials import apply_cut
     from engine.stitch import PATCH_SEAM, patch_cut
-    from engine.tiles.candidates import _Setup
+    from engine.tiles.candidates import CandidateSetup
     from engine.tiles.seamless import MAIN, seam_error
 
     st = make_seamless(S, find_template(S, tile_min=tile, tile_max=tile))
-    setup = _Setup(
+    setup = CandidateSetup(
         S,
         st,
         patch_size=None,

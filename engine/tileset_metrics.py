@@ -46,6 +46,9 @@ __all__ = [
     "lattice_db",
     "luminance",
     "quality_warnings",
+    "frame_profiles",
+    "ring_reference",
+    "ring_steps",
     "ring_tone",
     "template_share",
     "tileset_quality",
@@ -250,12 +253,48 @@ def ring_tone(
     ring is no more set off than anywhere in the photo; crops in ``template``'s phase as in
     :func:`frame`). 1.0 when both are 0, ``inf`` when only the crops' is."""
     stack = _tile_stack(tiles)
-    S = luminance(source)
     wd = positive_int(width, "width")
-    h, w = stack.shape[1:]
+    opts = dict(crops=crops, template=template, in_phase=in_phase, rng=rng)
+    ref = ring_reference(source, stack.shape[1:], width=wd, **opts)
+    return _ratio(float(_ring_centre_steps(stack, wd).mean()), ref)
+
+
+def ring_steps(tiles, *, width: int) -> np.ndarray:
+    """(n,) float: per tile |mean luminance of the ring (pixels closer than ``width`` to the
+    tile edge) − mean luminance of the centre|; :func:`ring_tone` is their mean over
+    :func:`ring_reference`."""
+    return _ring_centre_steps(_tile_stack(tiles), positive_int(width, "width"))
+
+
+def ring_reference(
+    source,
+    size,
+    *,
+    width: int,
+    crops: int = REFERENCE_CROPS,
+    template=None,
+    in_phase: bool = True,
+    rng=0,
+) -> float:
+    """The mean :func:`ring_steps` of ``crops`` crops of ``size`` (h, w) of the source, in
+    ``template``'s phase as in :func:`frame`: the reference of :func:`ring_tone`."""
+    S = luminance(source)
+    h, w = _period(size, "size")
+    wd = positive_int(width, "width")
     org = _reference(S, (h, w), template, in_phase).origins(positive_int(crops, "crops"), rng)
-    ref = _ring_centre_steps(np.stack([S[y : y + h, x : x + w] for y, x in org]), wd)
-    return _ratio(float(_ring_centre_steps(stack, wd).mean()), float(ref.mean()))
+    return float(_ring_centre_steps(np.stack([S[y : y + h, x : x + w] for y, x in org]), wd).mean())
+
+
+def frame_profiles(tiles, *, limit: int, sigma: float = FRAME_SIGMA) -> np.ndarray:
+    """(n, limit) float: per tile (blurred and differentiated as repeated) its mean gradient
+    magnitude at each distance 0 .. ``limit`` - 1 from its edge (``limit`` at most half the
+    tile, as in :func:`frame`, whose ``profile`` with ``wrap`` is their mean)."""
+    stack = _tile_stack(tiles)
+    h, w = stack.shape[1:]
+    lim = min(positive_int(limit, "limit"), (min(h, w) + 1) // 2)
+    sig = non_negative_number(sigma, "sigma")
+    dist = edge_distance((h, w))
+    return np.stack([_profile(_gradient_magnitude(t, sig, "wrap")[None], dist, lim) for t in stack])
 
 
 @dataclass(frozen=True, slots=True)

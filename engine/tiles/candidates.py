@@ -72,6 +72,7 @@ from engine.tiles.template import as_size, excluded_mask, flat_warning
 
 __all__ = [
     "PATCH_SEARCHES",
+    "CandidateSetup",
     "CandidateTile",
     "CandidatesNotice",
     "candidate_seed",
@@ -191,8 +192,9 @@ def base_seed(rng) -> int:
 
 
 # --------------------------------------------------------------------------- setup
-class _Setup:
-    """Validated inputs shared by every candidate of one run."""
+class CandidateSetup:
+    """Validated inputs shared by every candidate of one run (:meth:`make` makes one at a
+    given position: the benchmarks measure every position this way)."""
 
     def __init__(
         self,
@@ -596,7 +598,7 @@ def iter_candidates(
     :class:`Progress` and, when fewer candidates than asked can be made, one
     :class:`CandidatesNotice` (also issued as a warning).
     """
-    setup = _Setup(
+    setup = CandidateSetup(
         source,
         template,
         patch_size=patch_size,
@@ -624,7 +626,7 @@ def iter_candidates(
     return _iter_candidates(setup, n, base, workers, cancel)
 
 
-def _iter_candidates(setup: _Setup, n: int, base: int, workers: int, cancel):
+def _iter_candidates(setup: CandidateSetup, n: int, base: int, workers: int, cancel):
     seeds = [candidate_seed(base, k) for k in range(n)]
     made: dict[int, CandidateTile] = {}
     yield Progress(0, n, "candidates")
@@ -727,7 +729,7 @@ def make_candidate(
     :class:`engine.cancel.Cancelled` when cancelled, ``ValueError`` when the global search
     finds no position.
     """
-    setup = _Setup(
+    setup = CandidateSetup(
         source,
         template,
         patch_size=patch_size,

@@ -1,10 +1,10 @@
 """Where the global search's patches come from (issue 10, item 2; the lattice).
 
 Every candidate's patch is drawn among the source windows whose ring band matches the
-template's (:meth:`engine.tiles.candidates._Setup.ring_costs`). On a texture whose structures
-are large against the tile (long mortar columns, smooth tone, big cells) a close band match
-also makes the window resemble the template well inside the band: mortar columns at the same
-distance from the edge, the same tone along it. The mean of the tiles then keeps the
+template's (:meth:`engine.tiles.candidates.CandidateSetup.ring_costs`). On a texture whose
+structures are large against the tile (long mortar columns, smooth tone, big cells) a close
+band match also makes the window resemble the template well inside the band: mortar columns
+at the same distance from the edge, the same tone along it. The mean of the tiles then keeps the
 template's structure near every edge, and a layout shows it at every tile period — the
 lattice. Measured on the public evaluation set (``python -m benchmarks.lattice_causes``): the
 chosen windows themselves, pasted whole with only the template's 1 px margin, read +5.3 dB
@@ -148,7 +148,7 @@ class Spread:
 def calm_windows(setup) -> np.ndarray | None:
     """Boolean map of the patch windows too calm for the template's wrap joint (module
     docstring, :data:`PAIR_SHOWS`, :data:`CALM`), or None when there are none.
-    ``setup``: the candidates' :class:`engine.tiles.candidates._Setup`."""
+    ``setup``: the candidates' :class:`engine.tiles.candidates.CandidateSetup`."""
     if CALM <= 0:
         return None
     T = setup.lum(setup.tmaps[MAIN])
@@ -169,7 +169,7 @@ def plan(setup, seeds, avoid=()) -> tuple[list[tuple[int, int]], str | None]:
     """Global search: the patch origins of candidates with these ``seeds`` (in order), each
     away from the template's position, from ``avoid`` and from the earlier ones; and a note
     when fewer than ``len(seeds)`` could be given. ``setup``: the candidates'
-    :class:`engine.tiles.candidates._Setup`."""
+    :class:`engine.tiles.candidates.CandidateSetup`."""
     # the ring costs (FFTs that release the GIL) on a second thread while this one measures
     # the phase class, the error floor and the calm windows: the same values, two cores busy
     with ThreadPoolExecutor(max_workers=1, thread_name_prefix="ring-costs") as ex:

@@ -175,3 +175,21 @@ def test_quality_warnings_suggest_flatten_lighting_only_while_it_is_off():
     ]
     assert all("although Flatten lighting is on: try" in w for w in on), on
     assert not any("try Flatten lighting" in w for w in on), on
+
+
+def test_the_per_tile_pieces_make_the_frame_and_the_ring_tone(source):
+    """What benchmarks/set_bound.py measures of each grid candidate: the tiles' own gradient
+    profiles (their mean is the frame's) and ring steps (their mean over the crops' is the
+    ring tone)."""
+    from engine.tileset_metrics import frame_profiles, ring_reference, ring_steps
+
+    tiles = crops(source, 6, 48, seed=5)
+    ring = edge_distance((48, 48)) < 4
+    tiles[0][ring] *= 0.5  # one tile's ring darkened: the tiles differ
+    f = frame(tiles, source, limit=8)
+    each = frame_profiles(tiles, limit=8)
+    assert each.shape == (6, 8) and not np.allclose(each[0], each[1])
+    np.testing.assert_allclose(each.mean(axis=0), f.profile, rtol=1e-12)
+    steps, ref = ring_steps(tiles, width=4), ring_reference(source, (48, 48), width=4)
+    assert steps.shape == (6,) and steps[0] > steps[1:].max()
+    assert ring_tone(tiles, source, width=4) == pytest.approx(steps.mean() / ref, rel=1e-12)

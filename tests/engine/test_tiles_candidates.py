@@ -21,7 +21,7 @@ from engine.tiles import (
     make_seamless,
     random_layout,
 )
-from engine.tiles.candidates import MARGIN, _Setup
+from engine.tiles.candidates import MARGIN, CandidateSetup
 from tests.engine.helpers import events_and_result, smooth_texture
 
 
@@ -138,7 +138,7 @@ def test_position_refinement_against_brute_force(small, channels):
     if channels == 1:
         S = texture(channels=1, seed=7)
         st = make_seamless(S, RECT, overlap=W_T)
-    setup = _Setup(
+    setup = CandidateSetup(
         S,
         st,
         patch_size=None,

@@ -88,9 +88,9 @@ def test_no_calm_windows_where_the_joint_is_clean(page):
 
 
 def res_setup(S, st):
-    from engine.tiles.candidates import _Setup  # noqa: PLC2701 - the setup under test
+    from engine.tiles.candidates import CandidateSetup  # the setup under test
 
-    return _Setup(
+    return CandidateSetup(
         S,
         st,
         patch_size=None,

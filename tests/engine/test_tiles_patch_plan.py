@@ -76,7 +76,7 @@ def test_periodic_textures_keep_the_band_match_alone():
     the same patches as with spread 0."""
     S = brick_wall()
     st = make_seamless(S, (20, 8, 96, 96), overlap=10)
-    setup = patch_candidates._Setup(
+    setup = patch_candidates.CandidateSetup(
         S, st, patch_size=None, patch_overlap=None, margin=1, neighbourhood=5, seam=None,
         excluded=None, maps=None, weights=None,
     )  # fmt: skip
