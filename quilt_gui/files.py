@@ -182,6 +182,11 @@ class ProjectFiles(QObject):
             path += ".png"
         return path
 
+    def may_replace_output(self) -> bool:
+        """True when a new quilting run may replace the output (none unsaved, or the user
+        discards it)."""
+        return not self.doc.quilting.unsaved or self.ask_discard_output()
+
     def ask_discard_output(self) -> bool:
         """True when the unsaved quilting output may be replaced (tests replace this)."""
         answer = QMessageBox.question(

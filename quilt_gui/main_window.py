@@ -617,15 +617,14 @@ class MainWindow(QMainWindow):
     # ------------------------------------------------------------------ quilting
     def run_quilt(self, *_args) -> None:
         self.tabs.setCurrentWidget(self.quilt_view)
-        if not self.doc.quilting.unsaved or self.files.ask_discard_output():
-            self.pipeline.run_quilt()
+        self.pipeline.run_quilt(may_replace=self.files.may_replace_output)
 
     def _clear_painted(self, *_args) -> None:
         self.source_view.painter.clear_painted()
 
     def run_transfer(self, *_args) -> None:
         self.tabs.setCurrentWidget(self.quilt_view)
-        if not self.doc.quilting.unsaved or self.files.ask_discard_output():
+        if self.files.may_replace_output():
             self.pipeline.run_transfer()
 
     @Slot(int)

@@ -382,6 +382,34 @@ def editor_words(text: str) -> str:
     return text
 
 
+def _choice_label(key: str, value: str) -> str:
+    par = BY_KEY[key]
+    return par.labels[par.choices.index(value)]
+
+
+#: the quilting engine's option names in its messages -> the labels on the Quilting panel
+_QUILT_WORDS = (
+    (
+        re.compile(r"select='bhatia' needs a cut: choose a seam method, e\.g\. 'resistance'"),
+        f"“{BY_KEY['select'].label}: {_choice_label('select', 'bhatia')}” needs a cut: choose "
+        f"a “{BY_KEY['q_method'].label}” other than “{_choice_label('q_method', 'straight')}”",
+    ),
+    (re.compile(r"with select='bhatia'"), f"with “{_choice_label('select', 'bhatia')}”"),
+    (re.compile(r"\bmin_block\b"), f"“{BY_KEY['min_block'].label}”"),
+    (re.compile(r"\ban overlap\b"), f"a “{BY_KEY['q_overlap'].label}”"),
+    (re.compile(r"^overlap\b|\boverlap(?= \d)"), f"“{BY_KEY['q_overlap'].label}”"),
+)
+
+
+def quilt_words(text: str) -> str:
+    """``text`` (a message of the quilting engine's option check) in the Quilting panel's
+    words: "select='bhatia' needs a cut ..." reads "“Block choice: Random with extensions”
+    needs a cut ..."."""
+    for pattern, repl in _QUILT_WORDS:
+        text = pattern.sub(repl, text)
+    return text
+
+
 def _option_key(option: str, method: str) -> str:
     """The parameter of seam ``option`` of ``method`` (each method's variant has its own)."""
     if option == "variant":

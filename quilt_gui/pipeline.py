@@ -523,11 +523,20 @@ class Pipeline(QObject):
         self.doc.tileset.apply_preview(image, score)
 
     # ------------------------------------------------------------------ quilting
-    def run_quilt(self) -> jobs.Job | None:
-        """Synthesize ``out_height`` x ``out_width`` from the source; blocks stream in."""
+    def run_quilt(self, may_replace=None) -> jobs.Job | None:
+        """Synthesize ``out_height`` x ``out_width`` from the source; blocks stream in.
+
+        The options are checked first: a run that cannot start leaves the shown output as
+        it is, and ``may_replace()`` (asks before an unsaved output goes) is asked only then."""
         doc = self.doc
         if doc.source is None:
             self.message.emit("warning", "Open a sample image first.")
+            return None
+        problem = self.quilt_problem()
+        if problem is not None:
+            self.message.emit("error", problem)
+            return None
+        if may_replace is not None and not may_replace():
             return None
         self._quilt_mode = "quilt"
         p = doc.params
@@ -542,10 +551,26 @@ class Pipeline(QObject):
             exclusion=self.exclusion(),
             on_event=self._on_quilt_event,
             on_done=self._on_quilt_done,
-            on_error=self._error,
+            on_error=self._on_quilt_error,
             on_cancel=self._on_quilt_cancel,
             **quilt_options(p),
         )
+
+    def quilt_problem(self) -> str | None:
+        """Why quilting cannot run with the parameters on this source (the editor's words),
+        or None. The engine's own check of the options, on the source's shape only (the
+        excluded pixels are checked in the job)."""
+        from engine.quilting.options import check_options
+
+        p, shape = self.doc.params, self.doc.source.main.shape
+        opts = quilt_options(p)
+        opts.pop("rng")
+        stand_in = np.broadcast_to(np.float32(0), shape)  # no copy of a large source
+        try:
+            check_options(stand_in, params.output_shape(p, shape), excluded=None, **opts)
+        except (ValueError, TypeError) as exc:
+            return params.quilt_words(str(exc))
+        return None
 
     def exclusion(self) -> tuple:
         """(colour, tolerance, painted mask): the arguments of :func:`excluded_mask` (the
@@ -581,7 +606,7 @@ class Pipeline(QObject):
             sigma=p["sigma"],
             on_event=self._on_quilt_event,
             on_done=self._on_quilt_done,
-            on_error=self._error,
+            on_error=self._on_quilt_error,
             on_cancel=self._on_quilt_cancel,
             **opts,
         )
@@ -613,6 +638,12 @@ class Pipeline(QObject):
             "info",
             f"Synthesized {w}×{h} {what}. Click a block to see its overlap, error map and seam.",
         )
+
+    def _on_quilt_error(self, exc: BaseException) -> None:
+        """A run that failed in its job (e.g. every block position excluded): its empty
+        output goes (the view does not say "quilting…" for ever), the message says why."""
+        self.doc.quilting.start(None)
+        self.message.emit("error", params.quilt_words(params.ui_words(error_text(exc))))
 
     def _on_quilt_cancel(self) -> None:
         what = "Texture transfer" if self._quilt_mode == "transfer" else "Quilting"

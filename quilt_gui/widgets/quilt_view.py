@@ -60,6 +60,10 @@ class RasterItem(QGraphicsItem):
             painter.drawImage(QRectF(0, 0, self.image.width(), self.image.height()), self.image)
 
 
+START_TEXT = "Press Synthesize (Ctrl+Return) to quilt the source into a larger texture."
+PICK_TEXT = "Click a block of the output to see its overlap, error map and cut."
+
+
 def wrapped_pieces(start: int, size: int, total: int) -> list[tuple[int, int]]:
     """(output start, length) of the pieces of a span that wraps around at ``total``."""
     first = min(size, total - start)
@@ -93,9 +97,7 @@ class QuiltView(QWidget):
             "The selected block: its sample window, the pixels placed, and "
             "the overlap error map, with the cut on each"
         )
-        self.info = QLabel(
-            "Press Synthesize (Ctrl+Return) to quilt the source into a larger texture."
-        )
+        self.info = QLabel(START_TEXT)
         self.info.setWordWrap(True)
         self.selected: int | None = None
         self.sample.setToolTip(f"Ctrl+click: exclude this colour · {HINT}")
@@ -277,6 +279,8 @@ class QuiltView(QWidget):
             self.selected = None
             self.inspector.clear()
             self.source_rect.hide()
+            self.block_rect.hide()  # no block's caption or frame left from an earlier output
+            self.info.setText(PICK_TEXT if self.doc.quilting.blocks else START_TEXT)
             self.selection_changed.emit()
             return
         rec = self.doc.quilting.blocks[index]

@@ -1,0 +1,57 @@
+"""A quilting run that cannot start (ux13): the finished output stays, nothing asks to
+discard it, the message uses the panel's words, and no stale "quilting…" or block remains."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from tests.gui.helpers import make_window, open_sample, wait_idle
+
+
+def test_options_that_cannot_run_keep_the_output_and_say_so_in_the_panels_words(qtbot):
+    w = make_window(qtbot)
+    open_sample(qtbot, w)
+    w.doc.set_params({"out_width": 128, "out_height": 128, "block": 32})
+    w.act_quilt.trigger()
+    wait_idle(qtbot, w)
+    kept = w.doc.quilting.output.copy()
+    assert w.doc.quilting.unsaved
+    asked = []
+    w.files.ask_discard_output = lambda: asked.append(1) or True
+    # Bhatia's random blocks with extensions need a cut: "No cut (straight)" cannot run; the
+    # parameter change itself restarts the shown output's run, then Synthesize is pressed
+    w.doc.set_params({"select": "bhatia", "q_method": "straight"})
+    wait_idle(qtbot, w)
+    w.act_quilt.trigger()
+    wait_idle(qtbot, w)
+    assert asked == []  # nothing to discard for a run that cannot start
+    assert w.doc.quilting.result is not None
+    assert np.array_equal(w.doc.quilting.output, kept)  # was a black, empty output
+    text = w.last_message("error")
+    assert "“Block choice: Random with extensions” needs a cut" in text
+    assert "“Cut between blocks”" in text and "select=" not in text
+    assert "quilting…" not in w.quilt_view.counter.text()
+    # a run the options allow replaces it after asking
+    w.doc.set_param("q_method", "resistance")
+    wait_idle(qtbot, w)
+    w.act_quilt.trigger()
+    wait_idle(qtbot, w)
+    assert asked == [1] and w.doc.quilting.result.select == "bhatia"
+
+
+def test_a_run_failing_in_its_job_leaves_no_empty_output_saying_quilting(qtbot):
+    w = make_window(qtbot)
+    open_sample(qtbot, w)
+    w.doc.set_params({"out_width": 128, "out_height": 128, "block": 32})
+    w.act_quilt.trigger()
+    wait_idle(qtbot, w)
+    w.quilt_view.select(len(w.doc.quilting.blocks) - 1)
+    assert w.quilt_view.block_rect.isVisible()
+    w.files.ask_discard_output = lambda: True
+    # every colour excluded: the job's mask check refuses (the option check cannot see it)
+    w.doc.set_params({"exclude_color": "#808080", "exclude_tolerance": 0.5})
+    wait_idle(qtbot, w)
+    assert "excluded" in w.last_message("error")
+    assert w.doc.quilting.output is None and w.quilt_view.counter.text() == ""
+    assert not w.quilt_view.block_rect.isVisible()
+    assert "Block #" not in w.quilt_view.info.text()  # no caption of a block now gone
