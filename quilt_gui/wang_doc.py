@@ -46,6 +46,7 @@ class WangDocument(QObject):
     samples_changed = Signal()
     sample_moved = Signal(str, int)  # axis, colour: a user edit, its tiles are stale
     tile_changed = Signal(int)  # tile index
+    tiles_replaced = Signal()  # every tile at once (a set put back or opened): one redraw
     layout_changed = Signal()
     selection_changed = Signal()
     superseded = Signal()  # undo / redo put another set back: drop the jobs of this one
@@ -136,6 +137,11 @@ class WangDocument(QObject):
         self.tile_changed.emit(int(tile.index))
         self.root.mark_dirty()
 
+    def _replace_tiles(self, tiles: dict) -> None:
+        """Every tile at once (one :attr:`tiles_replaced`, not one redraw per tile)."""
+        self.tiles = dict(tiles)
+        self.tiles_replaced.emit()
+
     @property
     def pixels(self) -> int:
         """The generation of the source's pixels (:attr:`Document.pixels`): a snapshot keeps
@@ -175,9 +181,7 @@ class WangDocument(QObject):
         self.notes, self.parameters = notes, dict(parameters)
         if samples is not None:
             self.apply_samples(samples)
-        for k, t in sorted(tiles.items()):
-            self.tiles[k] = t
-            self.tile_changed.emit(k)
+        self._replace_tiles(tiles)
         self.apply_layout(layout, seed)
         self.root.mark_dirty()
         self.restored.emit(set(pending))
@@ -215,10 +219,7 @@ class WangDocument(QObject):
         self.start(opts)
         self.parameters = dict(params)
         self.apply_samples(samples_from_record(record))
-        for c in tiles:
-            t = from_candidate(c)
-            self.tiles[t.index] = t
-            self.tile_changed.emit(t.index)
+        self._replace_tiles({t.index: t for t in map(from_candidate, tiles)})
         layout = record.get("layout")
         self.apply_layout(layout, int(record.get("layout_seed", 0)))
         pending = {int(k) for k in record.get("pending", ())}  # none in older projects

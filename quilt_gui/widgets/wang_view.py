@@ -147,7 +147,7 @@ class WangView(QWidget):
         super().__init__(parent)
         self.doc, self.runner = doc, runner
         self.samples: dict[tuple[str, int], SampleItem] = {}
-        self._tile_items: list = []
+        self._tile_items: dict[int, list] = {}  # tile index -> its edge bars and cuts
         self._grid_items: list = []
         self._shape = None
         self._make_controls()
@@ -181,6 +181,7 @@ class WangView(QWidget):
         w.reset.connect(self._on_reset)
         w.samples_changed.connect(self._draw_samples)
         w.tile_changed.connect(self._on_tile_changed)
+        w.tiles_replaced.connect(self._draw_tiles)
         w.layout_changed.connect(self._draw_preview)
         w.selection_changed.connect(self._on_selection_changed)
         self.sample_dropped.connect(runner.move_sample)
@@ -348,38 +349,48 @@ class WangView(QWidget):
         self._update_info()
 
     @Slot(int)
-    def _on_tile_changed(self, _index: int) -> None:
-        self._draw_tiles(fit=self.tiles.fitted)
+    def _on_tile_changed(self, index: int) -> None:
+        self._draw_tiles(fit=self.tiles.fitted, index=index)
         if self.doc.wang.layout is not None:
             self._draw_preview()
 
-    def _draw_tiles(self, *, fit: bool = False) -> None:
+    @Slot()
+    def _draw_tiles(self, *, fit: bool = False, index: int | None = None) -> None:
+        """The arrangement; the marks of tile ``index`` only when it is the one changed (each
+        tile streamed in redrew every tile's marks: quadratic, seconds for 81 tiles)."""
         img = arrangement(self.doc.wang)
-        fit = fit or img is None or self._shape != img.shape
-        self._shape = None if img is None else img.shape
+        shape = None if img is None else img.shape
+        fit = fit or img is None or self._shape != shape
+        every = index is None or self._shape != shape
+        self._shape = shape
         self.tiles.set_image(img, fit=fit)
-        self._draw_tile_overlays()
+        if every:
+            self._draw_tile_overlays()
+        else:
+            self._draw_tile_marks(index)
         self._update_info()
 
     @Slot()
     def _draw_tile_overlays(self, *_args) -> None:
+        """The marks of every tile."""
+        for k in set(self._tile_items) | set(self.doc.wang.tiles):
+            self._draw_tile_marks(k)
+
+    def _draw_tile_marks(self, k: int) -> None:
+        """Tile ``k``'s edge bars and (Seams) its corner cuts and interior's cut."""
         scene = self.tiles.scene()
-        for item in self._tile_items:
+        for item in self._tile_items.pop(k, ()):
             scene.removeItem(item)
-        self._tile_items = []
         w = self.doc.wang
-        if not w.tiles:
+        t = w.tiles.get(k)
+        if t is None:
             return
-        n = w.colours**2
-        T = next(iter(w.tiles.values())).tile.shape[0]
-        cuts = QPainterPath()
-        loops = QPainterPath()
-        for k, t in w.tiles.items():
-            r, c = divmod(k, n)
-            y0, x0 = r * T, c * T
-            self._edge_markers(t.signature, x0, y0, T)
-            if not self.seams_box.isChecked():
-                continue
+        T = t.tile.shape[0]
+        r, c = divmod(k, w.colours**2)
+        y0, x0 = r * T, c * T
+        items = self._edge_markers(t.signature, x0, y0, T)
+        if self.seams_box.isChecked():
+            cuts, loops = QPainterPath(), QPainterPath()
             for name, p in t.paths.items():
                 path = loops if name == "patch" else cuts
                 pts = np.asarray(p)
@@ -390,15 +401,17 @@ class WangView(QWidget):
                 path.moveTo(x0 + pts[0, 1] + 0.5, y0 + pts[0, 0] + 0.5)
                 for rr, cc in pts[1:]:
                     path.lineTo(x0 + cc + 0.5, y0 + rr + 0.5)
-        for path, color in ((cuts, CUT_COLOR), (loops, PATCH_COLOR)):
-            item = QGraphicsPathItem(path)
-            item.setPen(cosmetic_pen(color, 1))
-            item.setZValue(30)
-            scene.addItem(item)
-            self._tile_items.append(item)
+            for path, color in ((cuts, CUT_COLOR), (loops, PATCH_COLOR)):
+                item = QGraphicsPathItem(path)
+                item.setPen(cosmetic_pen(color, 1))
+                item.setZValue(30)
+                scene.addItem(item)
+                items.append(item)
+        self._tile_items[k] = items
 
-    def _edge_markers(self, signature, x0: int, y0: int, T: int) -> None:
-        """A thick bar in the edge's colour along the middle third of each edge."""
+    def _edge_markers(self, signature, x0: int, y0: int, T: int) -> list:
+        """A thick bar in the edge's colour along the middle third of each edge (the items)."""
+        items = []
         a, b = T / 3, 2 * T / 3
         inset = max(1.5, T / 40)
         lines = {
@@ -413,7 +426,8 @@ class WangView(QWidget):
             item.setPen(cosmetic_pen(colour_of(signature[side]), 4, style))
             item.setZValue(35)
             self.tiles.scene().addItem(item)
-            self._tile_items.append(item)
+            items.append(item)
+        return items
 
     @Slot()
     def _draw_preview(self) -> None:

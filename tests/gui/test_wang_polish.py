@@ -58,3 +58,34 @@ def test_a_heal_undone_gives_the_pixels_back_and_an_older_set_is_not_made_again(
     assert all(w.tiles[k] is t for k, t in tiles.items())
     doc.undo_stack.redo()  # the 40 px set, made again from the photo: back as it was too
     assert w.options["tile_size"] == 40 and w.complete and not win.wang_runner.stale
+
+
+def test_a_tile_made_again_redraws_its_own_marks_only(qtbot):
+    """Every tile streamed in redrew the marks of every tile made so far (a 3-colour set of
+    128 px tiles: about 10 s of the editor's time)."""
+    win = make_window(qtbot)
+    open_sample(qtbot, win, "cobblestones")
+    view = generate(qtbot, win, colours=2)
+    w, scene = win.doc.wang, view.tiles.scene()
+    view.seams_box.setChecked(True)
+    before = set(scene.items())
+    w.set_tile(w.tiles[5])  # tile 5 again, as a rebuild delivers it
+    after = set(scene.items())
+    assert len(after) == len(before)
+    assert 0 < len(after - before) <= 6  # tile 5's edge bars and cuts, the others kept
+
+
+def test_a_set_put_back_is_drawn_once(qtbot, monkeypatch):
+    """Ctrl+Z put a set back tile by tile, the whole arrangement drawn again for each (a
+    3-colour set of 128 px tiles froze the editor for 10-15 s)."""
+    win = make_window(qtbot)
+    open_sample(qtbot, win, "cobblestones")
+    view = generate(qtbot, win, colours=2)
+    generate(qtbot, win, colours=1)
+    drawn = []
+    real = view.tiles.set_image
+    monkeypatch.setattr(view.tiles, "set_image", lambda *a, **k: (drawn.append(1), real(*a, **k)))
+    win.doc.undo_stack.undo()  # the 16 tiles of the 2-colour set back
+    assert win.doc.wang.complete and len(win.doc.wang.tiles) == 16
+    assert view.tiles.array.shape[:2] == (4 * 48, 4 * 48)
+    assert len(drawn) <= 2  # cleared, then the set
