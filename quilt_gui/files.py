@@ -124,6 +124,8 @@ class ProjectFiles(QObject):
         self.doc = doc
         self.jobs = manager
         self.closing = False
+        #: sizes made smaller for the last image: key -> (the value before, the fitted one)
+        self._fitted: dict[str, tuple] = {}
         self.autosave_timer = QTimer(self)
         self.autosave_timer.setInterval(max(5, settings.get("autosave_seconds")) * 1000)
         self.autosave_timer.timeout.connect(self.autosave_now)
@@ -276,16 +278,35 @@ class ProjectFiles(QObject):
         self.image_opened.emit()
 
     def _fit_parameters(self, shape) -> str:
-        """Sizes left from a larger image go back to Auto (not an undo step: a new image
-        starts a new history); returns a sentence saying which, or ""."""
+        """Sizes left from a larger image go back to Auto, or (the block size, which has no
+        Auto) down to what fits; sizes made smaller for the last image and not changed since
+        come back first (a 40×30 photo must not leave 15 px blocks to the next one). Not an
+        undo step: a new image starts a new history. Returns a sentence saying what, or ""."""
+        p = self.doc.params
+        back = {k: old for k, (old, fitted) in self._fitted.items() if p.get(k) == fitted}
+        self._fitted = {}
+        if back:
+            self.doc.apply_params(back)
         changes = params.fit_to_source(self.doc.params, shape)
-        if not changes:
-            return ""
-        self.doc.apply_params(changes)
-        names = ", ".join(params.BY_KEY[k].label for k in changes)
-        return f"{names}: too large for this image, back to automatic. "
+        self._fitted = {k: (p[k], v) for k, v in changes.items()}
+        if changes:
+            self.doc.apply_params(changes)
+        label = params.BY_KEY
+        auto = [k for k, v in changes.items() if v in (0, params.AUTO)]
+        smaller = [f"{label[k].label} {p[k]} px" for k in changes if k not in auto]
+        again = [f"{label[k].label} {v}" for k, v in back.items() if k not in changes]
+        parts = []
+        if auto:
+            names = ", ".join(label[k].label for k in auto)
+            parts.append(f"{names}: too large for this image, back to automatic. ")
+        if smaller:
+            parts.append(f"{', '.join(smaller)}: the image is too small for more. ")
+        if again:
+            parts.append(f"{', '.join(again)} again (made smaller for the last image). ")
+        return "".join(parts)
 
     def _on_project_loaded(self, path: str, project) -> None:
+        self._fitted = {}  # the project's own sizes
         project_io.apply_project(self.doc, project, path)
         self._remember(path, "last_project_dir", True)
         w, ts = self.doc.wang, self.doc.tileset

@@ -8,6 +8,7 @@ import numpy as np
 from PIL import Image
 
 from quilt_gui import params
+from resources import sample_path
 from tests.gui.helpers import WAIT_MS, make_window, open_sample, wait_idle
 
 JARGON = re.compile(r"\b(w_T|w_P|rho|o_max|Max run|Tile min|Tile max|sigma|Alpha)\b|ρ")
@@ -141,3 +142,35 @@ def test_a_choice_name_too_long_for_its_box_ends_with_an_ellipsis(qtbot, monkeyp
     assert shown.endswith("…") and "Cut across, row by row".startswith(shown[:-1])
     box.grab()
     assert labels[-1] == shown  # painted with it
+
+
+def test_sizes_made_smaller_for_a_tiny_image_come_back_for_the_next(qtbot, tmp_path):
+    """ux13: a 40×30 photo set the block size to 15 px ("back to automatic", though it has no
+    automatic value) and the next 512 px photo was quilted with 15 px blocks."""
+    w = make_window(qtbot)
+    open_sample(qtbot, w)
+    w.doc.set_params({"tile_size": "256", "block": 48})
+    tiny = tmp_path / "tiny.png"
+    rng = np.random.default_rng(0)
+    Image.fromarray((rng.random((30, 40, 3)) * 255).astype(np.uint8)).save(tiny)
+    with qtbot.waitSignal(w.doc.source_changed, timeout=WAIT_MS):
+        w.files.open_path(str(tiny), confirm=False)
+    assert w.doc.params["block"] == 15 and w.doc.params["tile_size"] == "auto"
+    text = w.last_message()
+    assert "Tile size: too large for this image, back to automatic" in text
+    assert "Block size 15 px: the image is too small for more" in text
+    wait_idle(qtbot, w)
+    with qtbot.waitSignal(w.doc.source_changed, timeout=WAIT_MS):
+        w.files.open_path(str(sample_path("brick")), confirm=False)
+    assert w.doc.params["block"] == 48 and w.doc.params["tile_size"] == "256"
+    assert "Tile size 256, Block size 48 again" in w.last_message()
+    wait_idle(qtbot, w)
+    # a size changed by hand after the fit is the user's: it stays
+    with qtbot.waitSignal(w.doc.source_changed, timeout=WAIT_MS):
+        w.files.open_path(str(tiny), confirm=False)
+    w.doc.set_param("block", 12)
+    wait_idle(qtbot, w)
+    with qtbot.waitSignal(w.doc.source_changed, timeout=WAIT_MS):
+        w.files.open_path(str(sample_path("brick")), confirm=False)
+    assert w.doc.params["block"] == 12 and w.doc.params["tile_size"] == "256"
+    wait_idle(qtbot, w)
