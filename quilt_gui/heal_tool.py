@@ -10,6 +10,7 @@ use the healed source. Source pixels the exclusion marks are never copied from.
 
 from __future__ import annotations
 
+import numpy as np
 from PySide6.QtCore import QObject, Qt, Signal, Slot
 
 from engine.heal import HealBlock
@@ -111,11 +112,12 @@ class HealTool(QObject):
         names = list(self.doc.source.maps)
         maps = {names[0]: result.image, **{k: result.maps[k] for k in names[1:]}}
         n = int(self.doc.heal_mask.sum()) if self.doc.heal_mask is not None else 0
+        stale = unhealed_candidates(self.doc, result.image)
         self.doc.heal(maps)
         self.message.emit(
-            "info",
+            "warning" if stale else "info",
             f"Healed {n} pixels with {len(result.blocks)} blocks of {result.block} px; the "
-            "template search and the candidates use the healed source (Undo restores it).",
+            f"template search and the candidates use the healed source (Undo restores it).{stale}",
         )
 
     def _on_error(self, exc) -> None:
@@ -130,3 +132,33 @@ class HealTool(QObject):
     def _on_source_changed(self) -> None:
         self.jobs.abort("heal")
         self.live.reset(0, 0)
+
+
+def unhealed_candidates(doc, healed) -> str:
+    """What of the tile set still shows the pixels a heal replaces by ``healed`` (the main
+    map), in words ("" when nothing): the candidates whose patch was cut from them, or all
+    when the tile rectangle holds some (its seamless tile is made again)."""
+    ts = doc.tileset
+    if not ts.candidates:
+        return ""
+    changed = np.any(np.asarray(healed) != doc.source.main, axis=2)
+
+    def holds(rect) -> bool:
+        x, y, w, h = (int(v) for v in rect)
+        return bool(changed[max(y, 0) : y + h, max(x, 0) : x + w].any())
+
+    if ts.template_rect is not None and holds(ts.template_rect):
+        return (
+            " The tile rectangle holds healed pixels: its seamless tile is made again and the "
+            "candidates, made from the old one, show the unhealed pixels: Generate them again."
+        )
+    hit = [e.index for e in ts.candidates if e.patch_rect is not None and holds(e.patch_rect)]
+    if not hit:
+        return ""
+    picked = sum(i in ts.picks for i in hit)
+    names = ", ".join(f"#{i + 1}" for i in hit[:8]) + (", …" if len(hit) > 8 else "")
+    return (
+        f" {len(hit)} candidates ({picked} of them picked: {names}) still show the unhealed "
+        "pixels, their patches were cut from them: re-roll them (R in the gallery) or "
+        "Generate again."
+    )
