@@ -49,6 +49,12 @@ def _forget(key: int) -> None:
             del _cache[key]
 
 
+def forget_display(pixels: np.ndarray) -> None:
+    """Drop the remembered display copy of ``pixels`` (changed in place)."""
+    with _cache_lock:
+        _cache.pop(id(pixels), None)
+
+
 def prepare_display(pixels: np.ndarray) -> None:
     """Compute the display copy of ``pixels`` now (call it in a worker thread)."""
     display_uint8(pixels)

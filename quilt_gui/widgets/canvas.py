@@ -19,7 +19,7 @@ from PySide6.QtWidgets import (
     QGraphicsView,
 )
 
-from quilt_gui.imaging import heat_rgba, to_pixmap
+from quilt_gui.imaging import forget_display, heat_rgba, to_pixmap, to_qimage
 
 #: Zoom steps: integer factors above 100 % so that magnified pixels stay square.
 ZOOM_STEPS = (
@@ -108,6 +108,19 @@ class ImageItem(QGraphicsPixmapItem):
         self.setPixmap(to_pixmap(pixels))
         self.setPos(float(pos[0]), float(pos[1]))
         self.show()
+
+    def paste(self, pixels: np.ndarray, x: int, y: int) -> None:
+        """Put ``pixels`` into the shown array at column ``x``, row ``y`` and draw only them
+        (a part of a large image changed: no conversion of the whole)."""
+        h, w = pixels.shape[:2]
+        self.array[y : y + h, x : x + w] = pixels
+        forget_display(self.array)  # its remembered display copy is out of date
+        pm = self.pixmap()
+        p = QPainter(pm)
+        p.setCompositionMode(QPainter.CompositionMode.CompositionMode_Source)
+        p.drawImage(x, y, to_qimage(pixels))
+        p.end()
+        self.setPixmap(pm)
 
 
 class HeatItem(ImageItem):

@@ -1,7 +1,10 @@
 """The Wang tab's small gaps after session 12 (polish13): the stopped banner follows the set
-shown, the Grid and Seams boxes are remembered, a heal undone gives the pixels back."""
+shown, the Grid and Seams boxes are remembered, a heal undone gives the pixels back, and the
+tiles are drawn one at a time as they come (not the whole set again for each)."""
 
 from __future__ import annotations
+
+from PySide6.QtGui import QImage
 
 from tests.gui.helpers import make_window, open_sample
 from tests.gui.test_wang_view import generate, wait_wang
@@ -89,3 +92,32 @@ def test_a_set_put_back_is_drawn_once(qtbot, monkeypatch):
     assert win.doc.wang.complete and len(win.doc.wang.tiles) == 16
     assert view.tiles.array.shape[:2] == (4 * 48, 4 * 48)
     assert len(drawn) <= 2  # cleared, then the set
+
+
+def test_a_tile_streamed_in_is_drawn_alone_into_the_arrangement(qtbot, monkeypatch):
+    """Each tile streamed in converted the whole arrangement for the screen (a 4-colour set
+    of 128 px tiles: 2048 px square, 0.1 s per tile, most of the editor's time)."""
+    import dataclasses
+
+    import numpy as np
+
+    from quilt_gui.imaging import to_uint8
+    from quilt_gui.widgets import canvas
+
+    win = make_window(qtbot)
+    open_sample(qtbot, win, "cobblestones")
+    view = generate(qtbot, win, colours=2)
+    w = win.doc.wang
+    whole = []
+    real = canvas.to_pixmap
+    monkeypatch.setattr(canvas, "to_pixmap", lambda a: (whole.append(a.shape), real(a))[1])
+    new = dataclasses.replace(w.tiles[5], tile=np.ascontiguousarray(1 - w.tiles[5].tile))
+    w.set_tile(new)  # tile 5 made again (inverted here, to be seen)
+    assert not [s for s in whole if s[:2] == (4 * 48, 4 * 48)]  # not the whole arrangement
+    y, x = 1 * 48, 1 * 48  # tile 5: row 1, column 1 of 4
+    np.testing.assert_array_equal(view.tiles.array[y : y + 48, x : x + 48], new.tile)
+    img = view.tiles.image_item.pixmap().toImage().convertToFormat(QImage.Format.Format_RGB888)
+    shown = np.array(img.constBits(), np.uint8).reshape(img.height(), img.bytesPerLine())
+    shown = shown[:, : 3 * img.width()].reshape(img.height(), img.width(), 3)
+    np.testing.assert_array_equal(shown[y : y + 48, x : x + 48], to_uint8(new.tile))
+    np.testing.assert_array_equal(shown[:48, :48], to_uint8(w.tiles[0].tile))  # the others kept
