@@ -20,10 +20,14 @@ Run ``python -m benchmarks.wang`` (``--help`` for options). Tables:
      8x8 layouts without equal neighbours (as the previews) against crops carrying each
      tile's own outer margin; Somol over 16 random 8x8 layouts against crops carrying the
      template's margin;
-   * frame (:func:`engine.metrics.frame`, limit 2 w_P; Wang tiles reflected at their border,
-     Somol tiles wrapped; Wang: the seeds' ratio profiles pooled, :func:`pooled_frame`, over
-     what as many sets of genuine source crops score pooled alike, :func:`crop_frame` — the
-     oracle is :mod:`benchmarks.wang_frame_oracle`), detail (Wang: the tiles' median detail
+   * frame, limit 2 w_P: Wang (since session 13) the tiles inside the lattice's layouts with
+     their real neighbours (:func:`layout_wang_frame`, :func:`engine.metrics.layout_frame`),
+     the seeds' ratio profiles pooled, :func:`pooled_frame`, over what as many sets of
+     genuine source crops measured in place score pooled alike, :func:`crop_layout_frame`;
+     in square brackets the frame until session 12 (:func:`engine.metrics.frame`, Wang tiles
+     reflected at their border, over :func:`crop_frame`); the oracle of both is
+     :mod:`benchmarks.wang_frame_oracle`; Somol tiles wrapped (:func:`engine.metrics.frame`);
+     detail (Wang: the tiles' median detail
      ratio over the median of random source crops, :func:`crop_detail`, with the raw median
      in brackets; Somol: the median detail ratio of the tiles);
    * corners (Wang): :func:`engine.metrics.corner_border_ratio` within 2 px of the points where
@@ -69,10 +73,12 @@ from engine.metrics import (  # noqa: E402
     frame,
     grid_border_ratio,
     lattice,
+    layout_frame,
 )
 from engine.tiles.layout import assemble  # noqa: E402
 from engine.tiles.wang import WangTile, iter_wang_set, wang_set  # noqa: E402
 from engine.tiles.wang_layout import wang_layout  # noqa: E402
+from engine.tileset_metrics import FRAME_SIGMA  # noqa: E402
 
 RESULTS = Path(__file__).resolve().parent / "results"
 SAMPLES = ("brick", "cobblestones", "grass", "gravel", "lichen")
@@ -294,6 +300,57 @@ def crop_frame(S, T: int, limit: int, tiles: int = 16, sets: int = 1) -> float:
     return float(np.median(values))
 
 
+#: context a crop is measured in by :func:`context_frame` (the frame blur's reach + 1 px)
+CONTEXT = int(4 * FRAME_SIGMA + 0.5) + 1
+
+
+def layout_wang_frame(tiles, layouts, S, limit: int):
+    """:func:`engine.metrics.layout_frame` of a Wang set: its tiles inside the benchmark's
+    layouts (:func:`layouts_of`), every tile with its real neighbours, against reference crops
+    in the set's phase (its first tile's) as :func:`wang_frame`'s."""
+    T = np.shape(getattr(tiles[0], "tile", tiles[0]))[0]
+    images = (assemble(tiles, lay) for lay in layouts)
+    return layout_frame(images, S, tile=T, limit=limit, template=tiles[0])
+
+
+def context_windows(S, T: int, origins, pad: int = CONTEXT):
+    """The (T + 2 pad)-px windows of ``S`` around the T x T crops at ``origins``: each crop
+    with its real neighbours (the source reflected beyond its border, as the reference's
+    gradient is)."""
+    P = np.pad(S, ((pad, pad), (pad, pad), (0, 0)), mode="symmetric")
+    return [P[y : y + T + 2 * pad, x : x + T + 2 * pad] for y, x in origins]
+
+
+def context_frame(windows, S, T: int, limit: int, template, pad: int = CONTEXT):
+    """:func:`engine.metrics.layout_frame` of crops measured inside their windows
+    (:func:`context_windows`): what genuine source reads as a layout, crop by crop."""
+    return layout_frame(windows, S, tile=T, limit=limit, offset=(pad, pad), template=template)
+
+
+def crop_layout_frame(S, T: int, limit: int, tiles: int = 16, sets: int = 1) -> float:
+    """The floor of :func:`layout_wang_frame`, as :func:`crop_frame` is :func:`wang_frame`'s:
+    the median over :data:`FRAME_DRAWS` draws of ``sets`` sets of ``tiles`` genuine crops
+    (drawn as :func:`crop_frame` draws them, in the first crop's phase on periodic textures)
+    measured with their real neighbours (:func:`context_frame`), pooled (:func:`pooled_frame`).
+    A frame read this way is the crops' sampling noise alone: no tile edge is reflected."""
+    from engine.metrics import luminance
+    from engine.reference_crops import ReferenceCrops, random_origins
+
+    L = luminance(S)
+    values = []
+    for k in range(FRAME_DRAWS):
+        g = np.random.default_rng(k)
+        ratios = []
+        for _ in range(sets):
+            (y0, x0), *_ = random_origins(L.shape, (T, T), 1, g)
+            ref = ReferenceCrops.build(L, (T, T), L[y0 : y0 + T, x0 : x0 + T])
+            org = [(y0, x0), *ref.origins(tiles - 1, g)]
+            first = S[y0 : y0 + T, x0 : x0 + T]
+            ratios.append(context_frame(context_windows(S, T, org), S, T, limit, first).ratio)
+        values.append(pooled_frame(ratios))
+    return float(np.median(values))
+
+
 def layouts_of(ws, seed: int):
     """The benchmark's random valid 8x8 layouts of one Wang set (the lattice's and corners')."""
     return [
@@ -306,8 +363,9 @@ def wang_figures(S, T: int, seed: int, options: dict, docs_file: Path | None = N
     """One Wang set's figures: joint ratios (list), lattice dB above its floor, frame over
     2 w_P of the default ring, frame over half the tile, detail (the tiles' median detail
     ratio over random crops', :func:`crop_detail`), corners, joints, and the tiles' median
-    detail ratio itself, the lattice above the continued floor, and the frame's ratio profile
-    (:attr:`engine.metrics.Frame.ratio`)."""
+    detail ratio itself, the lattice above the continued floor, the frame's ratio profile
+    (:attr:`engine.metrics.Frame.ratio`) and the layout frame's (:func:`layout_wang_frame`,
+    the tiles inside the lattice's layouts)."""
     ws = wang_set(S, tile_size=T, rng=seed, **options)
 
     def touches(a, b, direction):
@@ -321,6 +379,7 @@ def wang_figures(S, T: int, seed: int, options: dict, docs_file: Path | None = N
     lat = lattice(ws.tiles, S, margin=1, layouts=layouts)
     cont = continued_lattice(ws.tiles, S, layouts=layouts, template=ws.tiles[0])[2]
     fr = wang_frame(ws.tiles, S, 2 * _default_ring(T))
+    lay = layout_wang_frame(ws.tiles, layouts, S, 2 * _default_ring(T))
     half = wang_frame(ws.tiles, S, T // 2)
     raw = float(np.median([detail_ratio(t.tile, S) for t in ws.tiles]))
     det = raw / crop_detail(S, T)
@@ -331,24 +390,38 @@ def wang_figures(S, T: int, seed: int, options: dict, docs_file: Path | None = N
         from engine.io import save_image
 
         save_image(docs_file, img)
-    return pairs, lat.above, fr.value, half.value, det, corner, joints, raw, cont, fr.ratio
+    return (
+        pairs,
+        lat.above,
+        fr.value,
+        half.value,
+        det,
+        corner,
+        joints,
+        raw,
+        cont,
+        fr.ratio,
+        lay.ratio,
+    )
 
 
 def wang_row(S, T: int, docs: Path | None, name: str, seeds: int = 1, options=None):
     """Wang figures of ``seeds`` sets (seeds 0 ..): medians over them; the joints' max is the
     largest of any set; last, the frame pooled over the sets (:func:`pooled_frame`; the
-    median of the sets' own frames is among the medians). Layouts as the CLI's and the
-    editor's previews (no equal neighbours)."""
-    figures, ratios = [], []
+    median of the sets' own frames is among the medians) and the layout frame pooled alike.
+    Layouts as the CLI's and the editor's previews (no equal neighbours)."""
+    figures, ratios, in_layouts = [], [], []
     for seed in range(seeds):
         out = None if docs is None or seed else docs / f"{name}_wang.png"
-        pairs, lat, fr, _, det, corner, joints, raw, cont, ratio = wang_figures(
+        pairs, lat, fr, _, det, corner, joints, raw, cont, ratio, lay = wang_figures(
             S, T, seed, dict(options or {}), out
         )
         figures.append((np.median(pairs), max(pairs), lat, fr, det, corner, joints, raw, cont))
         ratios.append(ratio)
+        in_layouts.append(lay)
     med = np.median(np.array(figures), axis=0)
-    return (med[0], max(f[1] for f in figures), *med[2:], pooled_frame(ratios))
+    pooled = (pooled_frame(ratios), pooled_frame(in_layouts))
+    return (med[0], max(f[1] for f in figures), *med[2:], *pooled)
 
 
 def somol_row(S, T: int, docs: Path | None, name: str):
@@ -387,10 +460,11 @@ def quality(which: str, tile, docs: Path | None, seeds: int = 3, options=None) -
         T = tile_for(S, tile)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            wmed, wmax, wl, wf, wd, wc, wj, wraw, wcont, wpool = wang_row(
+            wmed, wmax, wl, wf, wd, wc, wj, wraw, wcont, wpool, lpool = wang_row(
                 S, T, docs, name, seeds, options
             )
             floor = crop_frame(S, T, 2 * _default_ring(T), sets=seeds)
+            lfloor = crop_layout_frame(S, T, 2 * _default_ring(T), sets=seeds)
             try:
                 sp, sl, sf, sd = somol_row(S, T, docs, name)
                 somol = [f"{np.median(sp):.2f} / {max(sp):.2f}", f"{sl:+.2f}", f"{sf:.2f}"]
@@ -402,7 +476,8 @@ def quality(which: str, tile, docs: Path | None, seeds: int = 3, options=None) -
                 T,
                 f"{wmed:.2f} / {wmax:.2f}",
                 f"{wcont:+.2f} ({wl:+.2f})",
-                f"{wpool / floor:.3f} ({wpool:.3f} / {floor:.3f}; {wf:.3f})",
+                f"{lpool / lfloor:.3f} ({lpool:.3f} / {lfloor:.3f})",
+                f"[{wpool / floor:.3f} ({wpool:.3f} / {floor:.3f}; {wf:.3f})]",
                 f"{wd:.2f} ({wraw:.2f})",
                 f"{wc:.2f} ({wj:.2f})",
                 *somol,
@@ -410,7 +485,7 @@ def quality(which: str, tile, docs: Path | None, seeds: int = 3, options=None) -
         )
         print(" | ".join(str(c) for c in rows[-1]), file=sys.stderr, flush=True)
     heads = ["texture", "tile", "Wang joints med / max", "Wang lattice dB (pasted)"]
-    heads += ["Wang frame (pooled / crops; median)"]
+    heads += ["Wang frame in layouts (pooled / crops)", "[reflected (pooled / crops; median)]"]
     heads += ["Wang detail (raw)", "corners (joints)", "Somol joints med / max", "Somol lattice dB"]
     heads += ["Somol frame"]
     return (
@@ -423,11 +498,14 @@ def quality(which: str, tile, docs: Path | None, seeds: int = 3, options=None) -
         "floor of crops carrying each tile's outer pixel ring continued by kriging "
         "(benchmarks/wang_lattice.py; the ideal set of a Gaussian field scores ~0 there), in "
         "brackets above the floor of crops with the ring pasted (engine.metrics.lattice). "
-        "Wang frame: tiles reflected, reference crops in the set's phase on periodic textures "
-        "(wang_frame); the sets' ratio profiles pooled (max of their mean, pooled_frame) over "
-        f"what {seeds} sets of 16 genuine source crops score pooled alike (crop_frame, median "
-        f"of {FRAME_DRAWS} draws: the yardstick's floor on this texture); in brackets both, "
-        "then the median of the sets' own frames (the figure before session 7)\n\n"
+        "Wang frame (since session 13): the tiles inside the lattice's 16 valid layouts, every "
+        "tile with its real neighbours (layout_wang_frame), reference crops in the set's "
+        "phase on periodic textures; the sets' ratio profiles pooled (max of their mean, "
+        f"pooled_frame) over what {seeds} sets of 16 genuine source crops measured in place "
+        f"score pooled alike (crop_layout_frame, median of {FRAME_DRAWS} draws: the "
+        "yardstick's floor); in parentheses both. In square brackets the frame until session "
+        "12: tiles reflected at their own border (wang_frame), pooled over crop_frame's "
+        "floor; both, then the median of the sets' own frames (before session 7)\n\n"
         + format_table(heads, rows)
         + "\n"
     )

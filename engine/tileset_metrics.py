@@ -43,6 +43,7 @@ __all__ = [
     "edge_distance",
     "frame",
     "lattice",
+    "layout_frame",
     "lattice_db",
     "luminance",
     "quality_warnings",
@@ -51,6 +52,7 @@ __all__ = [
     "ring_steps",
     "ring_tone",
     "template_share",
+    "tile_line_distance",
     "tileset_quality",
 ]
 
@@ -217,13 +219,101 @@ def frame(
     else:
         g = np.stack([_gradient_magnitude(t, sig, "reflect") for t in stack])
     prof = _profile(g, dist, lim)
+    ref = _source_profile(S, (h, w), sig, lim, template, in_phase, k, rng)
+    return _frame_of(prof, ref)
+
+
+def _source_profile(S, size, sig, lim, template, in_phase, k, rng) -> np.ndarray:
+    """The reference profile: the gradient of the blurred *source* (reflected at its border,
+    so a crop's edge pixels see their real neighbours) over ``k`` crops (in ``template``'s
+    phase), by distance to the crop's edge."""
+    h, w = size
     gs = _gradient_magnitude(S, sig, "reflect")
     org = _reference(S, (h, w), template, in_phase).origins(k, rng)
-    ref = _profile(np.stack([gs[y : y + h, x : x + w] for y, x in org]), dist, lim)
+    return _profile(np.stack([gs[y : y + h, x : x + w] for y, x in org]), edge_distance(size), lim)
+
+
+def _frame_of(prof: np.ndarray, ref: np.ndarray) -> Frame:
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(ref > 0, prof / np.where(ref > 0, ref, 1), np.where(prof > 0, np.inf, 1))
     i = int(np.argmax(ratio))
     return Frame(float(ratio[i]), i, float(ratio.min()), ratio, prof, ref)
+
+
+def tile_line_distance(shape, tile, offset=(0, 0)) -> np.ndarray:
+    """(H, W) int: distance of every pixel of an image of ``shape`` to the nearest *interior*
+    line of a grid of cells ``tile`` (h, w) whose lines lie at ``offset`` (y, x) modulo the
+    cell size (a line at p lies between pixels p - 1 and p; the pixels either side are at
+    distance 0, as :func:`edge_distance` counts inside one cell). The image's own border is
+    no line: a pixel with no line along either axis gets ``H + W``."""
+    H, W = _period(shape, "shape")
+    out = []
+    for n, t, o in zip((H, W), _period(tile, "tile"), offset, strict=True):
+        lines = np.arange(int(o) % t, n, t)
+        lines = lines[lines > 0]
+        r = np.arange(n)[:, None]
+        if len(lines) == 0:
+            out.append(np.full(n, H + W))
+            continue
+        d = np.where(r >= lines[None, :], r - lines[None, :], lines[None, :] - 1 - r)
+        out.append(d.min(axis=1))
+    return np.minimum(out[0][:, None], out[1][None, :])
+
+
+def layout_frame(
+    layouts,
+    source,
+    *,
+    tile,
+    limit: int,
+    offset=(0, 0),
+    sigma: float = FRAME_SIGMA,
+    crops: int = REFERENCE_CROPS,
+    template=None,
+    in_phase: bool = True,
+    rng=0,
+) -> Frame:
+    """Frame score of tiles *inside their layouts*: every tile with its real neighbours.
+
+    ``layouts``: images (H, W[, C]) whose tile lines lie at ``offset`` modulo ``tile`` (h, w)
+    (assembled layouts: offset 0). Their luminance is blurred by ``sigma`` and differentiated
+    as :func:`frame` does, and the gradient magnitude profiled by distance to the nearest
+    *interior* tile line (:func:`tile_line_distance`) over every cell, up to ``limit``; the
+    pixels within reach of the image's border (the blur's radius + 1) are left out, so no
+    reflected pixel is read. The reference is :func:`frame`'s: the source's own gradient over
+    ``crops`` crops (cells of the same grid at random offsets; in ``template``'s phase along
+    the axes where the texture is periodic and the tile holds whole periods), by distance to
+    the crop's edge. ``value`` etc. as :class:`Frame`.
+
+    Unlike :func:`frame` with ``wrap=False``, a structure cut by the tile line (a grout line
+    across the edge) is read with the pixels that really lie beyond it, as a person sees it
+    in the layout; the genuine source cut into a grid reads 1 up to the crops' noise.
+
+    >>> rng = np.random.default_rng(0)
+    >>> src = rng.random((256, 256))
+    >>> 0.9 < layout_frame([src], src, tile=32, limit=8, offset=(5, 11)).value < 1.1
+    True
+    """
+    h, w = _period(tile, "tile")
+    S = luminance(source)
+    lim = min(positive_int(limit, "limit"), (min(h, w) + 1) // 2)
+    sig = non_negative_number(sigma, "sigma")
+    k = positive_int(crops, "crops")
+    pad = int(4 * sig + 0.5) + 1  # scipy's Gaussian reaches 4 sigma; the gradient one more
+    s = np.zeros(lim)
+    c = np.zeros(lim)
+    for image in layouts:
+        L = luminance(image)
+        g = _gradient_magnitude(L, sig, "reflect")
+        d = tile_line_distance(L.shape, (h, w), offset)
+        d[:pad], d[-pad:], d[:, :pad], d[:, -pad:] = lim, lim, lim, lim
+        keep = d < lim
+        s += np.bincount(d[keep], weights=g[keep], minlength=lim)[:lim]
+        c += np.bincount(d[keep], minlength=lim)[:lim]
+    if not c.all():
+        raise ValueError("the layouts hold no interior tile line within the limit")
+    ref = _source_profile(S, (h, w), sig, lim, template, in_phase, k, rng)
+    return _frame_of(s / c, ref)
 
 
 def _ring_centre_steps(stack: np.ndarray, width: int) -> np.ndarray:
