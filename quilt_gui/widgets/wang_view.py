@@ -483,6 +483,8 @@ class WangView(QWidget):
 
     def _update_info(self) -> None:
         w = self.doc.wang
+        for button in (self.reroll_layout_button, self.export_button):
+            button.setEnabled(w.complete)  # a layout and an export need the whole set
         if self.doc.source is None:
             self.info.setText("Open a source image to make a Wang tile set.")
             return

@@ -121,3 +121,20 @@ def test_a_tile_streamed_in_is_drawn_alone_into_the_arrangement(qtbot, monkeypat
     shown = shown[:, : 3 * img.width()].reshape(img.height(), img.width(), 3)
     np.testing.assert_array_equal(shown[y : y + 48, x : x + 48], to_uint8(new.tile))
     np.testing.assert_array_equal(shown[:48, :48], to_uint8(w.tiles[0].tile))  # the others kept
+
+
+def test_re_roll_layout_and_export_wait_for_a_whole_set(qtbot):
+    """Both were offered before any set (each click answered by a warning)."""
+    win = make_window(qtbot)
+    open_sample(qtbot, win, "cobblestones")
+    view = win.wang_view
+    buttons = (view.reroll_layout_button, view.export_button)
+    assert not any(b.isEnabled() for b in buttons)  # no set yet
+    generate(qtbot, win, colours=1)
+    assert all(b.isEnabled() for b in buttons)
+    view.colours.setValue(2)
+    view.generate().stop()  # a part of a set
+    wait_wang(qtbot, win)
+    assert not win.doc.wang.complete and not any(b.isEnabled() for b in buttons)
+    win.doc.undo_stack.undo()  # the whole set before
+    assert all(b.isEnabled() for b in buttons)
