@@ -43,21 +43,42 @@ def somol_figures(manifest: dict) -> dict:
 
 
 def wang_figures(source, tiles, *, band: int, margin: int, layout) -> dict:
-    """The figures of a Wang set (no template: every tile carries its own border): frame and
-    ring tone within the edge band (tiles reflected, not wrapped: a Wang tile is not seamless
-    with itself), duplicates among the tiles, lattice in the preview's valid ``layout``
-    against crops carrying each tile's own margin, and the median detail ratio."""
-    from engine.metrics import detail_ratio, duplicates, frame, lattice, ring_tone
+    """The figures of a Wang set (no template: every tile carries its own border): frame within
+    the edge band read in the preview's valid ``layout`` (:func:`_wang_frame`), ring tone within
+    it, duplicates among the tiles, lattice in that layout against crops carrying each tile's
+    own margin, and the median detail ratio."""
+    from engine.metrics import detail_ratio, duplicates, lattice, ring_tone
 
     out = {
         "tiles": len(tiles),
         "detail": float(np.median([detail_ratio(t, source) for t in tiles])),
-        "frame": frame(tiles, source, limit=2 * band, wrap=False).value,
+        "frame": _wang_frame(source, tiles, 2 * band, np.asarray(layout)),
         "ring_tone": ring_tone(tiles, source, width=band),
         "duplicates": duplicates(tiles).count,
         "lattice": lattice(tiles, source, margin=margin, layouts=[np.asarray(layout)]).above,
     }
     return _rounded(out)
+
+
+def _wang_frame(source, tiles, limit: int, layout: np.ndarray) -> float:
+    """The frame of Wang tiles inside their ``layout``, every tile with its real neighbours
+    (:func:`engine.metrics.layout_frame`; README "Session 13 (wang13)": reflected at its own
+    border, a grout line cut by the tile edge read as a frame of 1.5 where the layout is a
+    perfect grid), against crops in the first tile's phase on a periodic texture that the tile
+    holds whole (as the Wang benchmark's; random-phase crops read the period itself as a
+    frame); a layout without an interior tile line within reach (a single row or
+    column, tiles under 12 px) falls back to the tiles reflected at their border."""
+    from engine.metrics import frame, layout_frame
+    from engine.tiles.layout import assemble
+
+    if min(layout.shape) >= 2:
+        try:
+            size = np.shape(tiles[0])[:2]
+            image = assemble(tiles, layout)
+            return layout_frame([image], source, tile=size, limit=limit, template=tiles[0]).value
+        except ValueError:
+            pass
+    return frame(tiles, source, limit=limit, wrap=False).value
 
 
 def detail_spread(source) -> float:

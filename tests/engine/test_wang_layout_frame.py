@@ -102,3 +102,19 @@ def test_the_ideal_wang_set_reads_one_in_its_layouts_and_a_planted_ring_is_caugh
         y, x = g.integers(0, 224, 2)
         planted.append(np.where(ring, F[y : y + 32, x : x + 32], t))
     assert layout_wang_frame(planted, lays, F, 8).value > 1.3
+
+
+def test_the_batch_reads_a_wang_sets_frame_in_its_preview_layout():
+    # the batch index's frame of a Wang set (engine.batch.quality.wang_figures): tiles whose
+    # edges cut the mortar rows, laid out as they join (the layout is the bricks themselves),
+    # read no frame; reflected tile by tile they read 1.3 and more (a false warning)
+    from engine.batch.quality import wang_figures
+
+    rng = np.random.default_rng(0)
+    S = _running_bond(rng, (384, 384), 32, 64)
+    T, offset = 64, (2, 21)
+    cells = _cells(S, T, offset)  # 5 x 5 cells, row by row
+    layout = np.array([[5 * r + c for c in range(4)] for r in range(4)])  # as they lie
+    fig = wang_figures(S, cells, band=8, margin=1, layout=layout)
+    assert fig["frame"] < 1.1
+    assert wang_frame(cells, S, 16).value > 1.3
