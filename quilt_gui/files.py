@@ -380,7 +380,10 @@ class ProjectFiles(QObject):
         except ValueError as exc:
             self._say("error", str(exc))
             return
-        text = f"Attached {Path(path).name} as the “{name}” map ({kind}); it follows every cut."
+        text = (
+            f"Attached {Path(path).name} as the “{name}” map ({kind}); it follows every cut of "
+            "the tile set, the Wang set and Heal (quilting makes the colour map only)."
+        )
         made = [  # made before it, without it: the project keeps only what has every map
             f"{n} {what}"
             for n, what in (
@@ -481,7 +484,10 @@ class ProjectFiles(QObject):
     def _on_output_saved(self, path: str, _result) -> None:
         self.doc.quilting.unsaved = False
         h, w = self.doc.quilting.output.shape[:2]
-        self._say("info", f"Saved the {w}×{h} output to {Path(path).name}.")
+        self._say(
+            "info",
+            f"Saved the {w}×{h} output to {Path(path).name}.{self.doc.quilting.colour_only()}",
+        )
 
     def export_seamless(self, *_args, path: str | None = None) -> jobs.Job | None:
         """File ▸ Export seamless tile: the tile alone, one file per material map."""

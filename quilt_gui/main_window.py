@@ -148,7 +148,7 @@ class MainWindow(QMainWindow):
             "Attach &material map…",
             self.files.attach_dialog,
             None,
-            "Add a normal / roughness / height ... map of the same size; it follows every cut",
+            "Add a normal / roughness / height ... map of the same size; tile cuts carry it",
         )
         self.act_save = A("&Save project", self.files.save, K.Save, "Save the project")
         self.act_save_as = A(

@@ -636,7 +636,8 @@ class Pipeline(QObject):
             what = f"from {len(result.blocks)} blocks"
         self.message.emit(
             "info",
-            f"Synthesized {w}×{h} {what}. Click a block to see its overlap, error map and seam.",
+            f"Synthesized {w}×{h} {what}{self.doc.quilting.colour_only()}. Click a block to see "
+            "its overlap, error map and seam.",
         )
 
     def _on_quilt_error(self, exc: BaseException) -> None:

@@ -78,6 +78,16 @@ class QuiltingDocument(QObject):
         """The finished output (made now or read from the project), None while none is."""
         return self.output if self.result is not None or self.kept is not None else None
 
+    def colour_only(self) -> str:
+        """ " (the colour map only: the normal map is not quilted)" when the source has
+        material maps, which quilting and texture transfer do not carry; else ""."""
+        source = self.root.source
+        extra = list(source.extra_maps) if source is not None else []
+        if not extra:
+            return ""
+        are = "maps are" if len(extra) > 1 else "map is"
+        return f" (the colour map only: the {', '.join(extra)} {are} not quilted)"
+
     def restore(self, output: np.ndarray | None, target: np.ndarray | None) -> None:
         """A project's saved output and transfer target (not an undo step)."""
         self.output, self.blocks, self.result = output, [], None

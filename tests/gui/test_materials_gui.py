@@ -122,3 +122,23 @@ def test_seam_weights_of_the_maps_steer_the_cut_undo_and_survive_a_reopen(qtbot,
     with qtbot.waitSignal(w.doc.path_changed, timeout=WAIT_MS):
         w.files.open_path(project, confirm=False)
     assert w.doc.tileset.map_weights == {"height": 2.0} and box.spins["height"].value() == 2.0
+
+
+def test_quilting_with_material_maps_says_it_makes_the_colour_map_only(qtbot, tmp_path):
+    """ux13: with a normal map attached ("it follows every cut"), Synthesize and Save output
+    made and wrote the colour map alone without a word."""
+    w = make_window(qtbot)
+    open_sample(qtbot, w)
+    path = tmp_path / "cobbles_normal.png"
+    Image.fromarray(normal_map_of(w.doc.source.main.mean(axis=2))).save(path)
+    with qtbot.waitSignal(w.doc.maps_changed, timeout=WAIT_MS):
+        w.files.attach_map(str(path))
+    assert "quilting makes the colour map only" in w.last_message()
+    w.doc.set_params({"out_width": 96, "out_height": 96, "block": 32})
+    w.act_quilt.trigger()
+    wait_idle(qtbot, w)
+    assert "(the colour map only: the normal map is not quilted)" in w.last_message()
+    w.files.save_output(path=str(tmp_path / "out.png"))
+    qtbot.waitUntil(lambda: not w.doc.quilting.unsaved, timeout=WAIT_MS)
+    text = w.last_message()
+    assert text.startswith("Saved the 96×96 output") and "normal map is not quilted" in text
