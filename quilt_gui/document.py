@@ -203,6 +203,7 @@ class Document(QObject):
         self.maps_changed.emit()
         self.tileset.clear()
         self.wang.clear()
+        self.quilting.start(None)  # the last source's output: no re-run on this one (ux13)
         self.path_changed.emit()
         self.apply_painted(None)
         self.apply_heal_mask(None)

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from tests.gui.helpers import make_window, open_sample, wait_idle
+from tests.gui.helpers import WAIT_MS, make_window, open_sample, wait_idle
 
 
 def test_options_that_cannot_run_keep_the_output_and_say_so_in_the_panels_words(qtbot):
@@ -55,3 +55,27 @@ def test_a_run_failing_in_its_job_leaves_no_empty_output_saying_quilting(qtbot):
     assert w.doc.quilting.output is None and w.quilt_view.counter.text() == ""
     assert not w.quilt_view.block_rect.isVisible()
     assert "Block #" not in w.quilt_view.info.text()  # no caption of a block now gone
+
+
+def test_opening_another_image_drops_the_output_and_starts_no_quilting(qtbot):
+    """ux13: with an output shown, opening another photo quilted the new one at once (its
+    cleared exclusion restarted the run: a 2048² job for a large photo nobody asked for) and
+    the fresh photo counted as modified; Save output wrote that unasked result."""
+    from resources import sample_path
+
+    w = make_window(qtbot)
+    open_sample(qtbot, w)
+    w.doc.set_params({"out_width": 96, "out_height": 96, "block": 32})
+    w.act_quilt.trigger()
+    wait_idle(qtbot, w)
+    assert w.doc.quilting.result is not None
+    started = []
+    w.doc.quilting.reset.connect(lambda: started.append(w.doc.quilting.output is not None))
+    with qtbot.waitSignal(w.doc.source_changed, timeout=WAIT_MS):
+        w.files.open_path(str(sample_path("gravel")), confirm=False)
+    wait_idle(qtbot, w)
+    assert True not in started and w.jobs.get("quilt") is None
+    q = w.doc.quilting
+    assert q.output is None and q.result is None and not q.unsaved
+    assert not w.doc.modified and not w.act_save_output.isEnabled()
+    assert w.quilt_view.output.array is None and w.quilt_view.counter.text() == ""
