@@ -133,6 +133,8 @@ def heat_rgba(error: np.ndarray, *, alpha: int = 255, vmax: float | None = None)
 
 def pixel_text(pixels: np.ndarray, row: int, col: int, bit_depth: int = 8) -> str:
     """The value of one pixel as the status bar shows it (in the file's integer range)."""
+    if np.issubdtype(np.asarray(pixels).dtype, np.integer):  # a display copy: its own values
+        return ", ".join(str(int(x)) for x in np.asarray(pixels[row, col]).ravel())
     v = np.asarray(pixels[row, col], dtype=np.float64).ravel()
     scale = 65535 if bit_depth == 16 else 255
     return ", ".join(str(int(round(x * scale))) for x in v)

@@ -28,7 +28,6 @@ from quilt_gui import jobs, params, settings, window_geometry
 from quilt_gui.document import Document
 from quilt_gui.files import ProjectFiles
 from quilt_gui.heal_tool import HealTool
-from quilt_gui.imaging import pixel_text
 from quilt_gui.pipeline import Pipeline
 from quilt_gui.theme import apply_theme
 from quilt_gui.wang_runner import WangRunner
@@ -706,13 +705,8 @@ class MainWindow(QMainWindow):
 
     # ------------------------------------------------------------------ status
     def _on_hover(self, canvas: ImageCanvas, px) -> None:
-        a = canvas.array
-        if px is None or a is None:
-            self.pixel_label.setText("")
-            return
-        r, c = px
-        depth = self.doc.source.bit_depth if canvas is self.source_view and self.doc.source else 8
-        self.pixel_label.setText(f"x {c}, y {r} = ({pixel_text(a, r, c, depth)})")
+        depth = self.doc.source.bit_depth if self.doc.source else 8  # every view shows its pixels
+        self.pixel_label.setText(canvas.hover_text(px, depth))
 
     @Slot(object)
     def _on_seam_updated(self, update) -> None:

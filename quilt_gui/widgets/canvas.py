@@ -19,7 +19,7 @@ from PySide6.QtWidgets import (
     QGraphicsView,
 )
 
-from quilt_gui.imaging import forget_display, heat_rgba, to_pixmap, to_qimage
+from quilt_gui.imaging import forget_display, heat_rgba, pixel_text, to_pixmap, to_qimage
 
 #: Zoom steps: integer factors above 100 % so that magnified pixels stay square.
 ZOOM_STEPS = (
@@ -387,6 +387,15 @@ class ImageCanvas(QGraphicsView):
     def leaveEvent(self, event) -> None:  # noqa: N802 - Qt API
         super().leaveEvent(event)
         self.hovered.emit(None)
+
+    def hover_text(self, px, bit_depth: int = 8) -> str:
+        """The status bar's words for the pixel ``px`` (row, col) under the mouse ("" off the
+        image): its position and value in the file's integer range."""
+        a = self.array
+        if px is None or a is None:
+            return ""
+        r, c = px
+        return f"x {c}, y {r} = ({pixel_text(a, r, c, bit_depth)})"
 
     def pixel_at(self, view_pos: QPointF) -> tuple[int, int] | None:
         """(row, col) of the image pixel under a view position, or None outside."""

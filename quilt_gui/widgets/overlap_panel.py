@@ -19,7 +19,7 @@ from PySide6.QtWidgets import (
 )
 
 from quilt_gui.document import Document
-from quilt_gui.imaging import heat_rgba, to_uint8
+from quilt_gui.imaging import heat_rgba, pixel_text, to_uint8
 from quilt_gui.pipeline import Pipeline
 from quilt_gui.widgets.canvas import ImageCanvas, PixelSetItem
 from quilt_gui.widgets.source_view import (
@@ -49,8 +49,10 @@ class OverlapView(ImageCanvas):
     waypoint_added = Signal(object)  # (row, col) in the overlap frame
     waypoint_removed = Signal(object)
 
-    def __init__(self, color="#7dff5f", parent=None) -> None:
+    def __init__(self, color="#7dff5f", parent=None, *, names=("R_R", "R_L", "error")) -> None:
         super().__init__(parent)
+        self.names = names  # of the three panels, for the status bar
+        self.panels: list[np.ndarray] = []  # r1, r2 and the error map as given
         self.setDragMode(ImageCanvas.DragMode.NoDrag)
         self.hide_scrollbars()
         self.frame_shape: tuple[int, int] | None = None
@@ -69,6 +71,7 @@ class OverlapView(ImageCanvas):
         """Show the regions and the error map; ``stacked`` puts them one above the other."""
         error = np.asarray(error)
         h, w = error.shape
+        self.panels = [np.asarray(r1), np.asarray(r2), error]
         panels = [_rgba(r1), _rgba(r2), heat_rgba(error)]
         if stacked:
             canvas = np.zeros((3 * h + 2 * GAP, w, 4), np.uint8)
@@ -82,8 +85,24 @@ class OverlapView(ImageCanvas):
         self.frame_shape = (h, w)
         self.set_image(canvas, fit=refit)
 
+    def hover_text(self, px, bit_depth: int = 8) -> str:
+        """The overlap pixel under the mouse: which panel, its row and column in the overlap
+        and its value (the regions' colour, the error map's error), not the composite's
+        display colours."""
+        if px is None or self.frame_shape is None or len(self.panels) != 3:
+            return ""
+        h, w = self.frame_shape
+        for name, a, (ox, oy) in zip(self.names, self.panels, self.offsets, strict=True):
+            r, c = px[0] - oy, px[1] - ox
+            if 0 <= r < h and 0 <= c < w:
+                if a.ndim == 2:
+                    return f"{name} x {c}, y {r}: {float(a[r, c]):.4g}"
+                return f"{name} x {c}, y {r} = ({pixel_text(a, r, c, bit_depth)})"
+        return ""  # the gap between two panels
+
     def clear(self) -> None:
         self.frame_shape = None
+        self.panels = []
         self.set_image(None)
         for p in self.paths:
             p.hide()
@@ -145,7 +164,7 @@ class OverlapPanel(QWidget):
         self.doc = doc
         self.views = {
             "horizontal": OverlapView(SEAM_COLORS["horizontal"]),
-            "vertical": OverlapView(SEAM_COLORS["vertical"]),
+            "vertical": OverlapView(SEAM_COLORS["vertical"], names=("R_B", "R_T", "error")),
         }
         self.labels = {k: QLabel() for k in self.views}
         for label in self.labels.values():

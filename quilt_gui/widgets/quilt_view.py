@@ -92,7 +92,7 @@ class QuiltView(QWidget):
         self.output.add_item(self.block_rect)
         self.painter = ExclusionPainter(doc, self.sample)
         self.excluded = self.painter.overlay
-        self.inspector = OverlapView("#7dff5f")
+        self.inspector = OverlapView("#7dff5f", names=("sample window", "placed", "error"))
         self.inspector.setToolTip(
             "The selected block: its sample window, the pixels placed, and "
             "the overlap error map, with the cut on each"

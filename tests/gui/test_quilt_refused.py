@@ -79,3 +79,27 @@ def test_opening_another_image_drops_the_output_and_starts_no_quilting(qtbot):
     assert q.output is None and q.result is None and not q.unsaved
     assert not w.doc.modified and not w.act_save_output.isEnabled()
     assert w.quilt_view.output.array is None and w.quilt_view.counter.text() == ""
+
+
+def test_the_overlap_views_read_out_the_overlap_not_the_composites_display_colours(qtbot):
+    """ux13: hovering an error map read "x 77, y 99 = (0, 0, 1020, 65025)": the display
+    composite's 8-bit RGBA scaled as if it were [0, 1] pixels."""
+    from tests.gui.helpers import template
+
+    w = make_window(qtbot)
+    open_sample(qtbot, w)
+    template(qtbot, w, rect=(150, 120, 128, 112))
+    view = w.overlap_panel.views["horizontal"]
+    r1, r2, error = view.panels
+    h, wd = view.frame_shape
+    (ox1, _), (ox2, _) = view.offsets[1:]
+    w._on_hover(view, (5, ox2 + 3))  # the error map's row 5, column 3
+    assert w.pixel_label.text() == f"error x 3, y 5: {float(error[5, 3]):.4g}"
+    w._on_hover(view, (7, ox1 + 2))  # R_L's pixel, in the file's range
+    v = (r2[7, 2] * 255).round().astype(int)
+    assert w.pixel_label.text() == f"R_L x 2, y 7 = ({v[0]}, {v[1]}, {v[2]})"
+    vertical = w.overlap_panel.views["vertical"]
+    w._on_hover(vertical, (1, 1))
+    assert w.pixel_label.text().startswith("R_B x 1, y 1 = (")
+    w._on_hover(view, None)
+    assert w.pixel_label.text() == ""
