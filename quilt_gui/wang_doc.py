@@ -47,6 +47,7 @@ class WangDocument(QObject):
     sample_moved = Signal(str, int)  # axis, colour: a user edit, its tiles are stale
     tile_changed = Signal(int)  # tile index
     tiles_replaced = Signal()  # every tile at once (a set put back or opened): one redraw
+    stale_changed = Signal()  # the tiles waiting for a rebuild (:attr:`stale`) replaced
     layout_changed = Signal()
     selection_changed = Signal()
     superseded = Signal()  # undo / redo put another set back: drop the jobs of this one
@@ -64,9 +65,7 @@ class WangDocument(QObject):
         self.selected: tuple[str, int] | None = None  # (axis, colour) of the chosen sample
         self.notes: tuple[str, ...] = ()
         self.parameters: dict = {}  # the engine's parameters of the last run
-        #: the tiles waiting for a rebuild (their sample moved, or the pixels changed): the
-        #: runner's work list; a snapshot and a project keep them
-        self.stale: set[int] = set()
+        self._stale: set[int] = set()
         undo_stack.indexChanged.connect(self._lighten_history)
 
     # ------------------------------------------------------------------ state
@@ -136,6 +135,18 @@ class WangDocument(QObject):
         self.tiles[int(tile.index)] = tile
         self.tile_changed.emit(int(tile.index))
         self.root.mark_dirty()
+
+    @property
+    def stale(self) -> set[int]:
+        """The tiles waiting for a rebuild (their sample moved, or the pixels changed): the
+        runner's work list (it discards each tile as it comes); a snapshot and a project keep
+        them."""
+        return self._stale
+
+    @stale.setter
+    def stale(self, tiles) -> None:
+        self._stale = set(tiles)
+        self.stale_changed.emit()
 
     def _replace_tiles(self, tiles: dict) -> None:
         """Every tile at once (one :attr:`tiles_replaced`, not one redraw per tile)."""

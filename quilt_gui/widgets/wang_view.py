@@ -157,6 +157,7 @@ class WangView(QWidget):
         self.doc, self.runner = doc, runner
         self.samples: dict[tuple[str, int], SampleItem] = {}
         self._tile_items: dict[int, list] = {}  # tile index -> its edge bars and cuts
+        self._veils: dict[int, QGraphicsRectItem] = {}  # over the tiles waiting for a rebuild
         self._grid_items: list = []
         self._shape = None
         self._make_controls()
@@ -191,6 +192,7 @@ class WangView(QWidget):
         w.samples_changed.connect(self._draw_samples)
         w.tile_changed.connect(self._on_tile_changed)
         w.tiles_replaced.connect(self._draw_tiles)
+        w.stale_changed.connect(self._draw_veils)
         w.layout_changed.connect(self._draw_preview)
         w.selection_changed.connect(self._on_selection_changed)
         self.sample_dropped.connect(runner.move_sample)
@@ -411,6 +413,7 @@ class WangView(QWidget):
         w = self.doc.wang
         t = w.tiles.get(k)
         if t is None:
+            self._veil(k)
             return
         T = t.tile.shape[0]
         r, c = divmod(k, w.colours**2)
@@ -435,6 +438,33 @@ class WangView(QWidget):
                 scene.addItem(item)
                 items.append(item)
         self._tile_items[k] = items
+        self._veil(k)
+
+    @Slot()
+    def _draw_veils(self) -> None:
+        """A dark veil over every tile waiting for a rebuild (it still shows old pixels)."""
+        for k in set(self._veils) | set(self.doc.wang.stale):
+            self._veil(k)
+        self._update_info()
+
+    def _veil(self, k: int) -> None:
+        w = self.doc.wang
+        t = w.tiles.get(k)
+        if t is None or k not in w.stale:
+            item = self._veils.pop(k, None)
+            if item is not None:
+                self.tiles.scene().removeItem(item)
+            return
+        if k not in self._veils:
+            T = t.tile.shape[0]
+            r, c = divmod(k, w.colours**2)
+            item = QGraphicsRectItem(c * T, r * T, T, T)
+            item.setBrush(QBrush(QColor(0, 0, 0, 140)))
+            item.setPen(Qt.PenStyle.NoPen)
+            item.setZValue(25)  # under the marks
+            item.setToolTip("Waiting for its rebuild: it still shows its old pixels")
+            self.tiles.scene().addItem(item)
+            self._veils[k] = item
 
     def _edge_markers(self, signature, x0: int, y0: int, T: int) -> list:
         """A thick bar in the edge's colour along the middle third of each edge (the items)."""

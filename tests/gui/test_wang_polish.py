@@ -138,3 +138,21 @@ def test_re_roll_layout_and_export_wait_for_a_whole_set(qtbot):
     assert not win.doc.wang.complete and not any(b.isEnabled() for b in buttons)
     win.doc.undo_stack.undo()  # the whole set before
     assert all(b.isEnabled() for b in buttons)
+
+
+def test_the_tiles_waiting_for_a_rebuild_are_veiled_until_they_come(qtbot):
+    """A moved sample's tiles showed their old pixels, like the finished ones, until rebuilt."""
+    from engine.tiles.wang import WangSample
+
+    win = make_window(qtbot)
+    open_sample(qtbot, win, "cobblestones")
+    view = generate(qtbot, win, colours=2)
+    w = win.doc.wang
+    assert view._veils == {}
+    y, x = w.sample("h", 0).origin
+    w.set_sample(WangSample("h", 0, (y + 2, x + 2)))  # as a drag does: its tiles wait
+    users = set(w.users("h", 0))
+    assert set(view._veils) == users == w.stale
+    assert all(item.scene() is view.tiles.scene() for item in view._veils.values())
+    wait_wang(qtbot, win)
+    assert w.complete and not w.stale and view._veils == {}  # each one lifted as it came
