@@ -436,9 +436,12 @@ class Pipeline(QObject):
             level, what = "warning", f"{params.sentence(notice)}. {what}"
         elif made < self._gen_wanted:
             what = f"Generation stopped: {made} of {self._gen_wanted} new candidates made, {what}"
-        self.message.emit(
-            level, f"{what}. Click to pick the tiles to keep; double-click to open one."
+        nxt = (
+            "Click to pick the tiles to keep; double-click to open one"
+            if doc.tileset.candidates
+            else "Generate candidates (Ctrl+G) makes them"  # nothing to click (ux13)
         )
+        self.message.emit(level, f"{what}. {nxt}.")
 
     def _on_candidates_error(self, exc) -> None:
         self._on_candidates_done(None)

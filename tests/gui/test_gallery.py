@@ -152,3 +152,24 @@ def test_fewer_candidates_than_asked_says_why_on_the_banner(qtbot, tmp_path):
     text = w.message_bar.label.text()
     assert text.startswith(f"Made {n} of 100 candidates: the source has no more patch positions")
     assert "Generation stopped" not in text
+
+
+def test_a_stop_before_the_first_candidate_does_not_say_click_to_pick(qtbot, monkeypatch):
+    """ux13: Esc right after Ctrl+G said "0 candidates. Click to pick the tiles to keep"."""
+    import engine.tiles
+
+    w = make_window(qtbot)
+    open_sample(qtbot, w)
+    generate(qtbot, w, 3)
+    w.doc.set_param("n_candidates", 30)
+
+    def none_made(*_args, **_options):  # as a run stopped before its first candidate
+        return
+        yield
+
+    monkeypatch.setattr(engine.tiles, "iter_candidates", none_made)
+    w.act_generate.trigger()
+    wait_idle(qtbot, w)
+    text = w.last_message()
+    assert text.startswith("Generation stopped: 0 of 30 new candidates made, 0 candidates.")
+    assert "Click to pick" not in text and text.endswith("Generate candidates (Ctrl+G) makes them.")
