@@ -197,6 +197,12 @@ class QuiltView(QWidget):
             h, w = out.shape[:2]
             self.counter.setText(f"{w}×{h} output kept in the project (its blocks are not)")
 
+    @property
+    def canvas(self) -> ImageCanvas:
+        """The canvas the View menu's zoom acts on when none has the keyboard focus: the
+        output."""
+        return self.output
+
     def set_output_actions(self, actions) -> None:
         """The output's context menu (right-click): Save output… and the like."""
         self.output.setContextMenuPolicy(Qt.ContextMenuPolicy.ActionsContextMenu)

@@ -198,6 +198,12 @@ class WangView(QWidget):
         self.sample_dropped.connect(runner.move_sample)
         self._on_source_changed()
 
+    @property
+    def canvas(self) -> ImageCanvas:
+        """The canvas the View menu's zoom acts on when none has the keyboard focus: the
+        layout."""
+        return self.preview
+
     @Slot(int)
     def keep_clear_of(self, height: int) -> None:
         """End the canvases ``height`` px above the bottom (the window's banner floats there:

@@ -156,3 +156,21 @@ def test_the_tiles_waiting_for_a_rebuild_are_veiled_until_they_come(qtbot):
     assert all(item.scene() is view.tiles.scene() for item in view._veils.values())
     wait_wang(qtbot, win)
     assert w.complete and not w.stale and view._veils == {}  # each one lifted as it came
+
+
+def test_the_zoom_keys_work_on_the_wang_and_quilting_tabs_away_from_a_canvas(qtbot):
+    """With the keyboard focus on a button, View ▸ Fit / Actual size / Zoom raised
+    AttributeError in the event loop (the tab had no main canvas) and did nothing."""
+    win = make_window(qtbot)
+    open_sample(qtbot, win, "cobblestones")
+    view = generate(qtbot, win, colours=1)
+    view.generate_button.setFocus()
+    assert win.current_canvas() is view.preview  # the layout
+    win.act_zoom_in.trigger()
+    assert not view.preview.fitted
+    win.act_fit.trigger()
+    assert view.preview.fitted
+    win.tabs.setCurrentWidget(win.quilt_view)
+    assert win.current_canvas() is win.quilt_view.output  # (empty: nothing to zoom yet)
+    for act in (win.act_fit, win.act_100, win.act_zoom_in, win.act_zoom_out):
+        act.trigger()
