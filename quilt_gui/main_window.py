@@ -628,15 +628,15 @@ class MainWindow(QMainWindow):
 
     @Slot(int)
     def _on_tab_changed(self, _index: int) -> None:
-        quilting = self.tabs.currentWidget() is self.quilt_view
-        wang = self.tabs.currentWidget() is self.wang_view
+        quilting, wang = (self.tabs.currentWidget() is v for v in (self.quilt_view, self.wang_view))
         self.doc.set_workflow("quilting" if quilting else "wang" if wang else "tileset")
         save_as = QKeySequence(QKeySequence.StandardKey.SaveAs)  # on the Quilting tab: Save output
         self.act_save_as.setShortcut(QKeySequence() if quilting else save_as)
         self.act_save_output.setShortcut(save_as if quilting else QKeySequence())
-        self.params_panel.show_groups(
-            QUILT_GROUPS if quilting else WANG_GROUPS if wang else TILESET_GROUPS
-        )
+        for act, key in ((self.act_generate, "Ctrl+G"), (self.act_reroll_layout, "Ctrl+R")):
+            act.setShortcut("" if wang else key)  # the Wang tab's buttons of those names take them
+        groups = QUILT_GROUPS if quilting else WANG_GROUPS if wang else TILESET_GROUPS
+        self.params_panel.show_groups(groups)
         self._show_tileset_docks(not quilting and not wang)
         self._show_criteria()
 

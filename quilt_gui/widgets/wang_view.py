@@ -243,7 +243,8 @@ class WangView(QWidget):
         )
         self.seed = self._spin(0, 2**31 - 1, o["seed"], "Seed of the set")
         self.generate_button = QPushButton("Generate")
-        self.generate_button.setToolTip("Make the Wang set from the source")
+        self.generate_button.setToolTip("Make the Wang set from the source (Ctrl+G)")
+        self.generate_button.setShortcut("Ctrl+G")  # on this tab (the tile set's elsewhere)
         self.generate_button.clicked.connect(self.generate)
         self.reroll_sample_button = QPushButton("Re-roll sample")
         self.reroll_sample_button.setToolTip(
@@ -251,6 +252,8 @@ class WangView(QWidget):
         )
         self.reroll_sample_button.clicked.connect(self.reroll_selected)
         self.reroll_layout_button = QPushButton("Re-roll layout")
+        self.reroll_layout_button.setToolTip("Another random valid layout (Ctrl+R)")
+        self.reroll_layout_button.setShortcut("Ctrl+R")
         self.reroll_layout_button.clicked.connect(self.runner.reroll_layout)
         self.seams_box = QCheckBox("Seams")
         self.seams_box.setChecked(settings.get("wang_seams"))

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from PySide6.QtGui import QImage
 
-from tests.gui.helpers import make_window, open_sample
+from tests.gui.helpers import WAIT_MS, make_window, open_sample
 from tests.gui.test_wang_view import generate, wait_wang
 
 
@@ -174,3 +174,33 @@ def test_the_zoom_keys_work_on_the_wang_and_quilting_tabs_away_from_a_canvas(qtb
     assert win.current_canvas() is win.quilt_view.output  # (empty: nothing to zoom yet)
     for act in (win.act_fit, win.act_100, win.act_zoom_in, win.act_zoom_out):
         act.trigger()
+
+
+def test_ctrl_r_and_ctrl_g_on_the_wang_tab_act_on_the_wang_set(qtbot):
+    """They re-rolled the tile set's hidden preview (an undo step on the tile set's history,
+    out of Ctrl+Z's reach on the Wang tab) and made tile set candidates."""
+    from PySide6.QtCore import Qt
+
+    from tests.gui.helpers import generate as tileset_generate
+
+    win = make_window(qtbot)
+    open_sample(qtbot, win, "cobblestones")
+    tileset_generate(qtbot, win, n=6)
+    win.doc.tileset.set_picks([0, 1, 2])
+    view = generate(qtbot, win, colours=1)
+    win.activateWindow()
+    qtbot.waitUntil(win.isActiveWindow, timeout=5000)
+    view.seed.setFocus()
+    tileset_steps, seed = win.doc.tileset.undo_stack.count(), win.doc.wang.layout_seed
+    qtbot.keyClick(view.seed, Qt.Key.Key_R, Qt.KeyboardModifier.ControlModifier)
+    # (a button's shortcut clicks it as animated: a moment later)
+    qtbot.waitUntil(lambda: win.doc.wang.layout_seed == seed + 1, timeout=WAIT_MS)
+    assert win.doc.tileset.undo_stack.count() == tileset_steps  # not the tile set's
+    view.colours.setValue(2)
+    qtbot.keyClick(view.seed, Qt.Key.Key_G, Qt.KeyboardModifier.ControlModifier)
+    qtbot.waitUntil(lambda: win.doc.wang.colours == 2, timeout=WAIT_MS)  # a new Wang set
+    assert win.jobs.get("candidates") is None  # no tile set candidates
+    wait_wang(qtbot, win)
+    win.tabs.setCurrentWidget(win.source_view)  # the tile set's own keys again there
+    assert win.act_reroll_layout.shortcut().toString() == "Ctrl+R"
+    assert win.act_generate.shortcut().toString() == "Ctrl+G"
