@@ -16,7 +16,7 @@ from PySide6.QtCore import QEvent, QObject, Qt, Slot
 
 from engine.io import to_rgb
 from quilt_gui.document import Document
-from quilt_gui.pipeline import excluded_mask
+from quilt_gui.job_bodies import excluded_mask
 from quilt_gui.widgets.canvas import ImageCanvas, ImageItem
 
 #: Tolerance set when a colour is picked while none is set (per channel, in [0, 1]).

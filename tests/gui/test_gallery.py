@@ -173,3 +173,44 @@ def test_a_stop_before_the_first_candidate_does_not_say_click_to_pick(qtbot, mon
     text = w.last_message()
     assert text.startswith("Generation stopped: 0 of 30 new candidates made, 0 candidates.")
     assert "Click to pick" not in text and text.endswith("Generate candidates (Ctrl+G) makes them.")
+
+
+def test_undoing_the_template_while_generate_runs_stops_it_and_keeps_the_history(
+    qtbot, monkeypatch
+):
+    """ux13: Ctrl+Z during Generate took back the tile rectangle, but the run went on, showed
+    30 candidates of a template no longer there and pushed its step over the undone one's
+    redo."""
+    import threading
+
+    import engine.tiles
+
+    w = make_window(qtbot)
+    open_sample(qtbot, w)
+    generate(qtbot, w, 3)
+    before = list(w.doc.tileset.candidates)
+    w.doc.set_param("n_candidates", 5)
+    w.doc.tileset.set_template_rect((140, 110, 128, 112))
+    wait_idle(qtbot, w)
+    steps = w.doc.undo_stack.count()
+
+    def slow(*_args, cancel=None, **_options):  # one candidate, then as a long run would
+        yield before[0]
+        stop = threading.Event()
+        for _ in range(12_000):  # at most 120 s
+            if cancel is None or cancel.cancelled:
+                return
+            stop.wait(0.01)
+
+    monkeypatch.setattr(engine.tiles, "iter_candidates", slow)
+    w.act_generate.trigger()
+    qtbot.waitUntil(lambda: len(w.doc.tileset.candidates) == 1, timeout=WAIT_MS)
+    job = w.jobs.get("candidates")
+    w.act_undo.trigger()  # the rectangle moves back
+    assert w.doc.tileset.template_rect == (150, 120, 128, 112)
+    assert not job.alive
+    assert w.doc.tileset.candidates == before  # what the gallery held before Generate
+    assert "Generation stopped: the tile rectangle changed" in w.last_message()
+    wait_idle(qtbot, w)
+    assert w.doc.undo_stack.count() == steps and w.doc.undo_stack.canRedo()
+    assert w.doc.undo_stack.redoText() == "Move tile rectangle"

@@ -76,7 +76,7 @@ def test_excluded_colour_is_never_copied(qtbot):
     assert w.doc.params["exclude_color"].startswith("#") and w.doc.params["exclude_tolerance"] > 0
     assert w.quilt_view.excluded.isVisible()
     wait_idle(qtbot, w)  # the change restarted the synthesis
-    from quilt_gui.pipeline import excluded_mask
+    from quilt_gui.job_bodies import excluded_mask
 
     mask = excluded_mask(src, w.doc.params["exclude_color"], w.doc.params["exclude_tolerance"])
     assert mask.any()

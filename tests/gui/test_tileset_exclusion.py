@@ -10,7 +10,7 @@ import pytest
 from PySide6.QtCore import QPointF, Qt
 
 from quilt_gui import main_window
-from quilt_gui.pipeline import excluded_mask
+from quilt_gui.job_bodies import excluded_mask
 from tests.gui.helpers import WAIT_MS, drag, make_window, open_sample, template, wait_idle
 
 
