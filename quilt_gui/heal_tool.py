@@ -57,7 +57,9 @@ class HealTool(QObject):
         self.live = RasterItem()
         self.live.setZValue(17)
         view.add_item(self.live)
+        self._healing = None  # the region the running heal fills
         doc.source_changed.connect(self._on_source_changed)
+        doc.heal_mask_changed.connect(self._on_region_changed)
 
     def set_brush(self, on: bool) -> None:
         """The Heal brush on (a drag paints the region) or off (a drag draws the tile)."""
@@ -85,6 +87,7 @@ class HealTool(QObject):
             return None
         h, w = doc.source.shape
         self.live.reset(h, w)
+        self._healing = mask
         return self.jobs.start(
             "heal",
             excluding(iter_heal),
@@ -107,7 +110,24 @@ class HealTool(QObject):
             x, y, _, _ = event.rect
             self.live.paste(event.pixels, x, y)
 
+    @Slot()
+    def _on_region_changed(self) -> None:
+        """The region changed while a heal of it ran (Undo took the stroke back, or another
+        stroke): that heal stops; its result would replace pixels no longer painted (it was
+        applied, "Healed 0 pixels", over the undone stroke's redo: ux13)."""
+        if self._healing is None or self.doc.heal_mask is self._healing:
+            return
+        self._healing = None
+        self.jobs.abort("heal")
+        self.live.reset(0, 0)
+        self.message.emit(
+            "warning",
+            "Heal stopped: the region to heal changed while it ran; the source is unchanged. "
+            "Heal painted region heals the region as it is now.",
+        )
+
     def _on_done(self, result) -> None:
+        self._healing = None
         self.live.reset(0, 0)
         names = list(self.doc.source.maps)
         maps = {names[0]: result.image, **{k: result.maps[k] for k in names[1:]}}
@@ -121,15 +141,18 @@ class HealTool(QObject):
         )
 
     def _on_error(self, exc) -> None:
+        self._healing = None
         self.live.reset(0, 0)
         self.message.emit("error", f"Heal failed: {jobs.error_text(exc)}")
 
     def _on_cancel(self) -> None:
+        self._healing = None
         self.live.reset(0, 0)
         self.message.emit("info", "Heal cancelled; the source is unchanged.")
 
     @Slot()
     def _on_source_changed(self) -> None:
+        self._healing = None
         self.jobs.abort("heal")
         self.live.reset(0, 0)
 

@@ -96,3 +96,38 @@ def test_a_heal_says_which_candidates_still_show_the_healed_pixels(qtbot):
     assert f"{len(hit)} candidates (" in text and "still show the unhealed pixels" in text
     assert "#1" in text and "R in the gallery" in text
     assert w.messages[-1][0] == "warning"
+
+
+def test_undoing_the_stroke_while_heal_runs_stops_it(qtbot, monkeypatch):
+    """ux13: Ctrl+Z right after Heal took the painted stroke back, but the heal went on and
+    replaced the pixels anyway ("Healed 0 pixels"), over the stroke's redo."""
+    import threading
+
+    import engine.heal
+    from tests.gui.helpers import open_sample
+
+    def slow(*_args, cancel=None, **_options):  # as a long heal: nothing until cancelled
+        stop = threading.Event()
+        for _ in range(12_000):  # at most 120 s
+            if cancel is None or cancel.cancelled:
+                return None
+            stop.wait(0.01)
+        return None
+        yield
+
+    w = make_window(qtbot)
+    open_sample(qtbot, w)
+    doc = w.doc
+    original = doc.source.main.copy()
+    mask = np.zeros(doc.source.shape, bool)
+    mask[100:130, 200:240] = True
+    doc.set_heal_mask(mask, text="Paint region to heal")
+    monkeypatch.setattr(engine.heal, "iter_heal", slow)
+    job = w.heal_tool.run()
+    assert job is not None and job.alive
+    w.act_undo.trigger()  # the stroke goes
+    assert doc.heal_mask is None and not job.alive
+    assert "Heal stopped: the region to heal changed" in w.last_message()
+    wait_idle(qtbot, w)
+    np.testing.assert_array_equal(doc.source.main, original)
+    assert doc.undo_stack.canRedo() and doc.undo_stack.redoText() == "Paint region to heal"
