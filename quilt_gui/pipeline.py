@@ -75,6 +75,7 @@ class Pipeline(QObject):
         self._preview_timer = _soon(self, self._start_preview)
         doc.tileset.picks_changed.connect(self.schedule_preview)
         doc.tileset.candidates_reset.connect(self.schedule_preview)
+        doc.tileset.candidates_reset.connect(self._drop_remakes)
         doc.tileset.candidate_changed.connect(self._on_candidate_changed)
         doc.exclusion_changed.connect(self.restart_quilt_if_shown)
         self._quilt_timer = _soon(self, self._restart_quilt)
@@ -410,6 +411,12 @@ class Pipeline(QObject):
             **self._tile_options(),
         )
         return self._gen_job
+
+    @Slot()
+    def _drop_remakes(self) -> None:
+        """Another set of candidates (Generate, its Undo or Redo): a re-roll or patch move
+        still running for the last set's candidate #k would land in this set's #k (ux13)."""
+        self.jobs.abort_matching("candidate:")
 
     @Slot()
     def _drop_generation(self) -> None:

@@ -214,3 +214,36 @@ def test_undoing_the_template_while_generate_runs_stops_it_and_keeps_the_history
     wait_idle(qtbot, w)
     assert w.doc.undo_stack.count() == steps and w.doc.undo_stack.canRedo()
     assert w.doc.undo_stack.redoText() == "Move tile rectangle"
+
+
+def test_undoing_generate_while_a_candidate_is_re_rolled_drops_the_re_roll(qtbot, monkeypatch):
+    """ux13: R (re-roll) then Ctrl+Z (undo Generate): the re-rolled tile landed as #k of the
+    set Undo brought back (made for the other set), with an undo step over Generate's redo."""
+    import threading
+
+    import engine.tiles
+
+    w = make_window(qtbot)
+    open_sample(qtbot, w)
+    generate(qtbot, w, 3)
+    first = [id(e) for e in w.doc.tileset.candidates]  # the very entries
+    w.doc.set_param("seed", 7)
+    w.act_generate.trigger()
+    wait_idle(qtbot, w)
+    second = list(w.doc.tileset.candidates)
+    assert [id(e) for e in second] != first
+    release = threading.Event()
+
+    def slow(*_args, cancel=None, index=0, **_options):  # a re-roll of a large tile
+        release.wait(120)
+        return second[index].replace(seed=12345)
+
+    monkeypatch.setattr(engine.tiles, "make_candidate", slow)
+    job = w.pipeline.remake_candidate(1)
+    assert job is not None and job.alive
+    w.act_undo.trigger()  # the second Generate taken back: the first set in the gallery
+    assert [id(e) for e in w.doc.tileset.candidates] == first and not job.alive
+    release.set()  # the re-roll finishes
+    wait_idle(qtbot, w)
+    assert [id(e) for e in w.doc.tileset.candidates] == first
+    assert w.doc.undo_stack.canRedo() and w.doc.undo_stack.redoText() == "Generate candidates"
