@@ -132,6 +132,10 @@ def check_wang_args(args) -> None:
     for flag, given in (("--rect", args.rect), ("--pick", args.pick)):
         if given is not None:
             raise ValueError(f"{flag} belongs to the template workflow, not to --wang sets")
+    if getattr(args, "flatten", None):  # the batch's refusal; the set was made from the photo
+        raise ValueError(
+            "--flatten is not available for Wang sets (the Wang workflow does not flatten)"
+        )
 
 
 def _events(say, count: int):

@@ -76,6 +76,9 @@ def test_wang_flags_are_checked(tmp_path, src, capsys):
     assert "Wang tiles are square and of one size" in capsys.readouterr().err
     assert main([*base, "--tile-size", "32", "--pick", "1,2"]) == 1
     assert "--pick belongs to the template workflow" in capsys.readouterr().err
+    # it was taken, the set made from the photo as it is and the manifest said flatten: true
+    assert main([*base, "--tile-size", "32", "--flatten"]) == 1
+    assert "--flatten is not available for Wang sets" in capsys.readouterr().err
     assert main([*base, "--tile-size", "96"]) == 1
     assert "too small for 96 px Wang tiles" in capsys.readouterr().err
     assert not (tmp_path / "x").exists()
