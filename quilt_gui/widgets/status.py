@@ -4,13 +4,15 @@ from __future__ import annotations
 
 import time
 
-from PySide6.QtCore import QEvent, Qt, QTimer, Signal, Slot
+from PySide6.QtCore import QEvent, QSize, Qt, QTimer, Signal, Slot
+from PySide6.QtGui import QPalette
 from PySide6.QtWidgets import (
     QHBoxLayout,
     QLabel,
     QProgressBar,
     QPushButton,
     QSizePolicy,
+    QStylePainter,
     QToolButton,
     QWidget,
 )
@@ -158,6 +160,37 @@ def duration_text(seconds: float) -> str:
     return f"~{round(seconds / 60)} min"
 
 
+class ElidingLabel(QLabel):
+    """A one-line label that ends a text too long for it with "…" (the status bar cut the job's
+    line off: "Making 256 Wang tiles — ~3 min le"); the layout may narrow it down to ``least``
+    and "…" (the job's name: its time left goes first)."""
+
+    least = ""
+
+    def minimumSizeHint(self) -> QSize:  # noqa: N802 - Qt API
+        hint = super().minimumSizeHint()
+        least = self.fontMetrics().horizontalAdvance(self.least + "…") + hint.width()
+        least -= self.fontMetrics().horizontalAdvance(self.text())  # the margins
+        return QSize(min(hint.width(), least), hint.height())
+
+    def shown_text(self) -> str:
+        return self.fontMetrics().elidedText(
+            self.text(), Qt.TextElideMode.ElideRight, self.contentsRect().width()
+        )
+
+    def paintEvent(self, _event) -> None:  # noqa: N802 - Qt API
+        painter = QStylePainter(self)
+        align = self.alignment() | Qt.AlignmentFlag.AlignVCenter
+        painter.drawItemText(
+            self.contentsRect(),
+            int(align),
+            self.palette(),
+            self.isEnabled(),
+            self.shown_text(),
+            QPalette.ColorRole.WindowText,
+        )
+
+
 class JobStatus(QWidget):
     """The main running job (its n/N and the time left), the others named, and a Cancel
     button that stops them.
@@ -170,7 +203,7 @@ class JobStatus(QWidget):
         self.manager = manager
         lay = QHBoxLayout(self)
         lay.setContentsMargins(0, 0, 0, 0)
-        self.label = QLabel()
+        self.label = ElidingLabel()  # its whole text in its tooltip
         self.others = QLabel()
         self.others.setToolTip("Other jobs running at the same time")
         self.bar = QProgressBar()
@@ -230,8 +263,10 @@ class JobStatus(QWidget):
         note = f" — {duration_text(left)} left" if left else ""
         if not left and job.estimate:
             note = f" — {job.estimate}"
+        self.label.least = job.label
         self.label.setText(job.label + note)
-        self.label.setToolTip(job.estimate)
+        extra = job.estimate if job.estimate and job.estimate not in note else ""
+        self.label.setToolTip("\n".join(t for t in (job.label + note, extra) if t))
         if p is None or p.total <= 0:
             self.bar.setRange(0, 0)  # busy indicator
         else:

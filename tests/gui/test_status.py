@@ -91,3 +91,51 @@ def test_a_banner_with_a_button_is_as_tall_as_its_text_beside_the_button(qtbot):
     need = bar.label.heightForWidth(bar.label.width())
     qtbot.waitUntil(lambda: bar.label.width() < full, timeout=WAIT_MS)
     assert bar.label.height() >= bar.label.heightForWidth(bar.label.width()) >= need
+
+
+def test_a_job_line_too_long_for_the_status_bar_ends_with_an_ellipsis(qtbot, monkeypatch):
+    """polish13b: a window narrower than the status bar's labels cut the job's line off
+    ("Making 256 Wang tiles — ~3 min le"); it ends with "…" like the Parameters panel's long
+    choice names (its time left goes first), whole in its tooltip."""
+    from PySide6.QtWidgets import QStylePainter
+
+    painted: list[str] = []
+    draw = QStylePainter.drawItemText
+
+    def recording(painter, rect, flags, palette, enabled, text, *role):
+        painted.append(text)
+        draw(painter, rect, flags, palette, enabled, text, *role)
+
+    w = make_window(qtbot)
+    gate = threading.Event()
+    try:
+        job = w.jobs.start("wang", held, 256, 3, gate, label="Making 256 Wang tiles")
+        qtbot.waitUntil(lambda: job.progress is not None, timeout=WAIT_MS)
+        job.started_at -= 6.0  # ~8 min left
+        status = w.job_status
+        status._refresh()
+        label = status.label
+        full = label.text()
+        assert full.startswith("Making 256 Wang tiles — ~") and full.endswith(" left")
+        monkeypatch.setattr(QStylePainter, "drawItemText", recording)
+        # the seams' line of the published oscillating search, in a 1100 px window
+        w.criterion_label.setText(
+            "seam H 0.123 · V 0.456 — oscillating as published (restart, per-row argmin start, "
+            "o_max 5)"
+        )
+        w.resize(1100, w.height())
+        width = label.fontMetrics().horizontalAdvance
+        qtbot.waitUntil(lambda: label.width() < width(full), timeout=WAIT_MS)
+        label.grab()
+        assert painted, "the label's text is not drawn elided"
+        shown = painted[-1]
+        assert shown.endswith("…") and full.startswith(shown[:-1]) and len(shown) > 4
+        assert width(shown) <= label.contentsRect().width()
+        assert label.toolTip() == full
+        w.criterion_label.setText("")  # room again: the whole line
+        qtbot.waitUntil(lambda: label.width() >= width(full), timeout=WAIT_MS)
+        label.grab()
+        assert painted[-1] == full
+    finally:
+        gate.set()
+    qtbot.waitUntil(lambda: not w.jobs.running(), timeout=WAIT_MS)
