@@ -1,7 +1,8 @@
 """Help ▸ Getting started and Help ▸ Keyboard and mouse: two non-modal dialogs.
 
-The shortcut sheet reads its keyboard rows from the window's actions (so it cannot drift from
-the menus) and adds the mouse gestures, which no action describes.
+The shortcut sheet reads its keyboard rows from the window's actions and the buttons with a key
+on the tab shown (so it cannot drift from the menus, and says what a key does on that tab: Ctrl+G
+on the Wang tab is its Generate button), and adds the mouse gestures, which no action describes.
 """
 
 from __future__ import annotations
@@ -9,6 +10,7 @@ from __future__ import annotations
 from PySide6.QtCore import Qt
 from PySide6.QtGui import QKeySequence
 from PySide6.QtWidgets import (
+    QAbstractButton,
     QDialog,
     QDialogButtonBox,
     QHeaderView,
@@ -70,33 +72,41 @@ def _plain(text: str) -> str:
     return text.replace("&", "").replace("…", "").strip()
 
 
-def shortcut_rows(actions) -> list[tuple[str, str]]:
-    """(what, keys) of every action with a shortcut, in menu words."""
+def shortcut_rows(actions, buttons=()) -> list[tuple[str, str]]:
+    """(what, keys) of every action with a shortcut, in menu words, and of every button shown
+    with one (its name and tooltip, without the key the tooltip names)."""
     rows = []
     for a in actions:
         keys = a.shortcut().toString(QKeySequence.SequenceFormat.NativeText)
         if keys and a.text():
             rows.append((_plain(a.text()), keys))
+    for b in buttons:
+        keys = b.shortcut().toString(QKeySequence.SequenceFormat.NativeText)
+        if keys and b.text():
+            tip = b.toolTip().replace(f" ({keys})", "")
+            tip = f": {tip[:1].lower()}{tip[1:]}" if tip else ""
+            rows.append((_plain(b.text()) + tip, keys))
     return sorted(set(rows), key=lambda r: r[0].lower())
 
 
 class ShortcutSheet(QDialog):
-    """Every keyboard shortcut of the window and every mouse gesture, in one table."""
+    """Every keyboard shortcut of the window (as on the tab shown: the sheet follows the
+    window's tabs) and every mouse gesture, in one table."""
 
     def __init__(self, actions, parent=None) -> None:
         super().__init__(parent)
         self.setWindowTitle("Keyboard and mouse")
         self.setModal(False)
-        keys = shortcut_rows(actions)
-        rows = [("Keyboard", k, what) for what, k in keys] + list(MOUSE)
-        self.table = QTableWidget(len(rows), 3)
+        self._actions = list(actions)
+        self.table = QTableWidget(0, 3)
         self.table.setHorizontalHeaderLabels(["Where", "Keys / mouse", "Does"])
         self.table.verticalHeader().hide()
         self.table.setEditTriggers(QTableWidget.EditTrigger.NoEditTriggers)
         self.table.setSelectionBehavior(QTableWidget.SelectionBehavior.SelectRows)
-        for r, row in enumerate(rows):
-            for c, text in enumerate(row):
-                self.table.setItem(r, c, QTableWidgetItem(text))
+        self.refresh()
+        tabs = getattr(parent, "tabs", None)
+        if tabs is not None:  # after the window's own handler, which moves the keys
+            tabs.currentChanged.connect(self.refresh)
         header = self.table.horizontalHeader()
         header.setSectionResizeMode(0, QHeaderView.ResizeMode.ResizeToContents)
         header.setSectionResizeMode(1, QHeaderView.ResizeMode.ResizeToContents)
@@ -107,6 +117,27 @@ class ShortcutSheet(QDialog):
         lay.addWidget(self.table)
         lay.addWidget(buttons)
         self.resize(640, 560)
+
+    def refresh(self, _index=None) -> None:
+        """The rows of the keys as they act now (a button's key only on its tab, when shown)."""
+        window = self.parentWidget()
+        buttons = []
+        if window is not None:
+            buttons = [
+                b
+                for b in window.findChildren(QAbstractButton)
+                if b.window() is window and b.isVisibleTo(window)
+            ]
+        keys = shortcut_rows(self._actions, buttons)
+        rows = [("Keyboard", k, what) for what, k in keys] + list(MOUSE)
+        self.table.setRowCount(len(rows))
+        for r, row in enumerate(rows):
+            for c, text in enumerate(row):
+                self.table.setItem(r, c, QTableWidgetItem(text))
+
+    def showEvent(self, event) -> None:  # noqa: N802 - Qt API
+        self.refresh()
+        super().showEvent(event)
 
     def rows(self) -> list[tuple[str, ...]]:
         t = self.table

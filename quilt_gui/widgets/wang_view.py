@@ -252,7 +252,7 @@ class WangView(QWidget):
         )
         self.reroll_sample_button.clicked.connect(self.reroll_selected)
         self.reroll_layout_button = QPushButton("Re-roll layout")
-        self.reroll_layout_button.setToolTip("Another random valid layout (Ctrl+R)")
+        self.reroll_layout_button.setToolTip("Another valid layout of the Wang tiles (Ctrl+R)")
         self.reroll_layout_button.setShortcut("Ctrl+R")
         self.reroll_layout_button.clicked.connect(self.runner.reroll_layout)
         self.seams_box = QCheckBox("Seams")

@@ -99,3 +99,23 @@ def test_a_long_message_is_as_tall_as_its_wrapped_text(qtbot):
     lines = bar.label.heightForWidth(bar.label.width())
     assert lines > 2 * bar.label.fontMetrics().height()  # it wraps
     assert bar.height() <= lines + 16  # the margins (5 + 5 px), not a sizeHint's narrow wrap
+
+
+def test_the_shortcut_sheet_says_what_ctrl_g_and_ctrl_r_do_on_the_tab_shown(qtbot):
+    """polish13b: opened on the Wang tab, the sheet listed neither key for Generate candidates
+    nor for Re-roll layout (the Wang tab's buttons take them there, 329559f) and said nothing
+    of what they do there; it follows the tabs while it stays open."""
+    w = make_window(qtbot)
+    w.tabs.setCurrentWidget(w.wang_view)
+    sheet = w.show_help()
+
+    def keys(rows):
+        return sorted((k, what) for where, k, what in rows if k in ("Ctrl+G", "Ctrl+R"))
+
+    assert keys(sheet.rows()) == [
+        ("Ctrl+G", "Generate: make the Wang set from the source"),
+        ("Ctrl+R", "Re-roll layout: another valid layout of the Wang tiles"),
+    ]
+    w.tabs.setCurrentWidget(w.source_view)  # the tile set's actions have them again
+    assert keys(sheet.rows()) == [("Ctrl+G", "Generate candidates"), ("Ctrl+R", "Re-roll layout")]
+    sheet.close()
