@@ -24,6 +24,7 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from benchmarks._util import Tee, format_table, provenance  # noqa: E402
+from benchmarks.quilting_jobs import JOBS, load_sample  # noqa: E402
 from engine import fft  # noqa: E402
 from engine.matching import SampleSpectrum  # noqa: E402
 from engine.quilting import quilt  # noqa: E402
@@ -112,8 +113,6 @@ def compare(sample: np.ndarray, jobs: dict, *, repeats: int = 7, query_repeats: 
 
 
 def main(argv=None) -> int:
-    from benchmarks.quilting import JOBS, load_sample
-
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--repeats", type=int, default=7, help="interleaved runs per whole job")
     args = p.parse_args(argv)

@@ -49,20 +49,16 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
 
 from benchmarks import fft_backends, quilting_large  # noqa: E402
 from benchmarks._util import Tee, format_table, median_time, provenance  # noqa: E402
+from benchmarks.quilting_jobs import JOBS, load_sample  # noqa: E402
 from engine.errormap import error_map  # noqa: E402
-from engine.io import load_image  # noqa: E402
 from engine.matching import ZERO_ERROR_FRACTION, error_floor, select_within_tolerance  # noqa: E402
 from engine.metrics import block_grid_border_ratio  # noqa: E402
 from engine.quilting import quilt  # noqa: E402
 from engine.quilting.synthesis import quilt_unstreamed  # noqa: E402
 from engine.seams import SeamSpec  # noqa: E402
 from engine.stitch import l_cut  # noqa: E402
-from resources import SAMPLE_NAMES, sample_path  # noqa: E402
+from resources import SAMPLE_NAMES  # noqa: E402
 
-JOBS = {
-    "A": dict(crop=128, out=(512, 512), block=32, overlap=6),
-    "B": dict(crop=256, out=(1024, 1024), block=48, overlap=8),
-}
 TARGETS = {("A", "exact"): 0.25, ("B", "exact"): 1.2, ("B", "fast"): 0.36}
 
 
@@ -111,10 +107,6 @@ class _Grid:
 
     def __init__(self, image, block, overlap):
         self.image, self.step, self.band = image, (block - overlap,) * 2, overlap
-
-
-def load_sample(name: str, crop: int) -> np.ndarray:
-    return np.ascontiguousarray(load_image(sample_path(name)).rgb[:crop, :crop])
 
 
 def _threads() -> set[str]:

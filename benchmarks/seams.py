@@ -403,7 +403,7 @@ def diagnose(sets: dict[str, list[Overlap]], *, o_max=3, limit=10) -> str:
     optimum); the gain a move could still make at tau = 0 from the final path (first
     improvement, resume); and best improvement (steepest descent, slow: ``limit`` maps spread
     over the set, beside first improvement on the same maps)."""
-    from engine.seams.oscillating import _mus, criterion, initial_controls
+    from engine.seams.oscillating import controls_seam, criterion, initial_controls
 
     rows = []
     for name, overlaps in sets.items():
@@ -421,7 +421,7 @@ def diagnose(sets: dict[str, list[Overlap]], *, o_max=3, limit=10) -> str:
             np.maximum.at(cf, fin.path[:, 0], fin.path[:, 1])
             start.append(criterion(e, c0, cyclic=cyc) / opt.criterion - 1)
             jumps.append(np.mean(np.abs(np.diff(c0)) > 1))
-            n0 = (c0 - _mus(c0, cyc) + 1).sum()
+            n0 = len(controls_seam(e, c0, cyc, "oscillating").path)  # the start's path pixels
             px.append((n0 / h, len(fin.path) / h, len(opt.path) / h))
             nb = _criteria(e, _neighbours(cf, pins, o_max, cyc, w), cyc).min()
             left.append(max(0.0, (fin.criterion - nb) / fin.criterion))

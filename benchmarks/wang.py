@@ -111,7 +111,7 @@ INTERIORS = {
 }
 
 
-def _stamp() -> str:
+def stamp() -> str:
     try:
         rev = subprocess.run(
             ["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, check=False
@@ -165,7 +165,7 @@ def speed(repeats: int) -> str:
 
 
 # ----------------------------------------------------------------------------- quality
-def _textures(which: str):
+def textures(which: str):
     if which == "samples":
         for n in SAMPLES:
             yield n, load_image(resources.sample_path(n)).pixels
@@ -178,7 +178,7 @@ def _textures(which: str):
         yield n, to_float(a[:, :, None] if a.ndim == 2 else a)
 
 
-def _fit(S, tile: int) -> int:
+def fit_tile(S, tile: int) -> int:
     from engine.tiles.wang import WangSetup
 
     while tile >= 16:
@@ -210,7 +210,7 @@ def _options(construction, T: int) -> dict:
     return dict(opts(T) if callable(opts) else opts)
 
 
-def _default_ring(T: int) -> int:
+def default_ring(T: int) -> int:
     from engine.tiles.candidates import default_patch_overlap
     from engine.tiles.template import default_overlap
 
@@ -378,8 +378,8 @@ def wang_figures(S, T: int, seed: int, options: dict, docs_file: Path | None = N
     # samples (a wider margin would hide a construction's own shared ring)
     lat = lattice(ws.tiles, S, margin=1, layouts=layouts)
     cont = continued_lattice(ws.tiles, S, layouts=layouts, template=ws.tiles[0])[2]
-    fr = wang_frame(ws.tiles, S, 2 * _default_ring(T))
-    lay = layout_wang_frame(ws.tiles, layouts, S, 2 * _default_ring(T))
+    fr = wang_frame(ws.tiles, S, 2 * default_ring(T))
+    lay = layout_wang_frame(ws.tiles, layouts, S, 2 * default_ring(T))
     half = wang_frame(ws.tiles, S, T // 2)
     raw = float(np.median([detail_ratio(t.tile, S) for t in ws.tiles]))
     det = raw / crop_detail(S, T)
@@ -444,27 +444,27 @@ def somol_row(S, T: int, docs: Path | None, name: str):
 
 def tile_for(S, tile) -> int:
     """The quality table's tile size for ``S``: ``tile`` or the largest that fits
-    (:func:`_fit`); with ``tile="auto"`` the CLI's ``--tile-size auto`` rule
+    (:func:`fit_tile`); with ``tile="auto"`` the CLI's ``--tile-size auto`` rule
     (:func:`engine.tiles.wang_size.auto_tile_size`) applied to that of 128 px, the same rule
     for every texture."""
     if tile != "auto":
-        return _fit(S, int(tile))
+        return fit_tile(S, int(tile))
     from engine.tiles.wang_size import auto_tile_size
 
-    return auto_tile_size(S, _fit(S, 128))[0]
+    return auto_tile_size(S, fit_tile(S, 128))[0]
 
 
 def quality(which: str, tile, docs: Path | None, seeds: int = 3, options=None) -> str:
     rows = []
-    for name, S in _textures(which):
+    for name, S in textures(which):
         T = tile_for(S, tile)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             wmed, wmax, wl, wf, wd, wc, wj, wraw, wcont, wpool, lpool = wang_row(
                 S, T, docs, name, seeds, options
             )
-            floor = crop_frame(S, T, 2 * _default_ring(T), sets=seeds)
-            lfloor = crop_layout_frame(S, T, 2 * _default_ring(T), sets=seeds)
+            floor = crop_frame(S, T, 2 * default_ring(T), sets=seeds)
+            lfloor = crop_layout_frame(S, T, 2 * default_ring(T), sets=seeds)
             try:
                 sp, sl, sf, sd = somol_row(S, T, docs, name)
                 somol = [f"{np.median(sp):.2f} / {max(sp):.2f}", f"{sl:+.2f}", f"{sf:.2f}"]
@@ -516,7 +516,7 @@ def interiors(which: str, tile: int, docs: Path | None, seeds: int = 2) -> str:
     names = list(INTERIORS)
     per: dict[str, list] = {n: [] for n in names}  # construction -> per texture figures
     textures = []
-    for tex, S in _textures(which):
+    for tex, S in textures(which):
         T = tile_for(S, tile)
         textures.append(tex)
         for n in names:
@@ -604,7 +604,7 @@ def main(argv=None) -> int:
     if args.docs is not None:
         args.docs.mkdir(parents=True, exist_ok=True)
     if not args.no_speed:
-        text = f"{_stamp()}\n\n{speed(args.repeats)}"
+        text = f"{stamp()}\n\n{speed(args.repeats)}"
         print(text)
         (RESULTS / "wang.txt").write_text(text)
     if args.quality:
@@ -614,7 +614,7 @@ def main(argv=None) -> int:
         what = (" (corner_match=False)" if options else "") + (
             " (--tile auto: the tile column is the rule's size)" if args.tile == "auto" else ""
         )
-        text = f"{_stamp()}{what}\n\n{table}"
+        text = f"{stamp()}{what}\n\n{table}"
         print(text)
         suffix = ("_no_corner_match" if options else "") + ("_auto" if args.tile == "auto" else "")
         (RESULTS / f"wang_quality_{args.quality}{suffix}.txt").write_text(text)
@@ -623,7 +623,7 @@ def main(argv=None) -> int:
         load = _load_avg()
         table = interiors(args.interiors, args.tile, args.docs, seeds)
         text = (
-            f"{_stamp()} (1-minute load {load:.1f} -> {_load_avg():.1f}; quality figures do "
+            f"{stamp()} (1-minute load {load:.1f} -> {_load_avg():.1f}; quality figures do "
             f"not depend on load)\n\n{table}"
         )
         print(text)

@@ -1,7 +1,7 @@
 """Where four Wang tiles meet: the step energy around the crossings (issue 11, session 8).
 
 Run ``python -m benchmarks.wang_corners`` (``--help`` for options). Per texture of an
-evaluation set, K = 2 Wang sets of the benchmark's tile size (:func:`benchmarks.wang._fit`),
+evaluation set, K = 2 Wang sets of the benchmark's tile size (:func:`benchmarks.wang.fit_tile`),
 seeds 0 .. ``--seeds`` − 1, each in the benchmark's 16 random valid 8x8 layouts without equal
 neighbours; :func:`engine.metrics.corner_energy` of every layout (the mean step — across, along
 and off the tile lines — within r px of the 49 crossings, over the layout's own mean step),
@@ -32,7 +32,7 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from benchmarks._util import format_table  # noqa: E402
-from benchmarks.wang import RESULTS, _fit, _stamp, _textures, layouts_of  # noqa: E402
+from benchmarks.wang import RESULTS, fit_tile, layouts_of, stamp, textures  # noqa: E402
 from engine.metrics import LATTICE_LAYOUTS, corner_energy, mean_step, step_windows  # noqa: E402
 from engine.tiles.layout import assemble  # noqa: E402
 from engine.tiles.wang import wang_set  # noqa: E402
@@ -100,8 +100,8 @@ def planted(S, T: int) -> float:
 
 def corners(which: str, tile: int, seeds: int, options: dict, docs: Path | None) -> str:
     rows = []
-    for name, S in _textures(which):
-        T = _fit(S, tile)
+    for name, S in textures(which):
+        T = fit_tile(S, tile)
         figs = []
         for seed in range(seeds):
             out = None if docs is None or seed else docs / f"{name}_wang_8x8.png"
@@ -152,7 +152,7 @@ def main(argv=None) -> int:
     if args.docs is not None:
         args.docs.mkdir(parents=True, exist_ok=True)
     options = {"corner_match": False} if args.no_corner_match else {}
-    text = f"{_stamp()}\n\n{corners(args.set, args.tile, args.seeds, options, args.docs)}"
+    text = f"{stamp()}\n\n{corners(args.set, args.tile, args.seeds, options, args.docs)}"
     print(text)
     suffix = "_no_corner_match" if args.no_corner_match else ""
     (RESULTS / f"wang_corners_{args.set}{suffix}.txt").write_text(text)

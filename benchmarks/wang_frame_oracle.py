@@ -42,12 +42,12 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
 from benchmarks._util import format_table  # noqa: E402
 from benchmarks.wang import (  # noqa: E402
     RESULTS,
-    _default_ring,
-    _fit,
-    _stamp,
-    _textures,
     context_frame,
     context_windows,
+    default_ring,
+    fit_tile,
+    stamp,
+    textures,
     wang_frame,
 )
 from engine.metrics import edge_distance, layout_frame, luminance, tile_line_distance  # noqa: E402
@@ -100,11 +100,11 @@ def _spread(v) -> str:
 
 def oracle(which: str, triples: int, tile: int = 128, names=None) -> str:
     rows = []
-    for name, S in _textures(which):
+    for name, S in textures(which):
         if names and name not in names:
             continue
-        T = _fit(S, tile)
-        limit, L = 2 * _default_ring(T), luminance(S)
+        T = fit_tile(S, tile)
+        limit, L = 2 * default_ring(T), luminance(S)
         draws = []
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -155,7 +155,7 @@ def main(argv=None) -> int:
     ap.add_argument("--triples", type=int, default=8, help="genuine and planted triples")
     ap.add_argument("--only", nargs="*", default=None, help="these textures only (not saved)")
     args = ap.parse_args(argv)
-    text = f"{_stamp()}\n\n{oracle(args.set, args.triples, names=args.only)}"
+    text = f"{stamp()}\n\n{oracle(args.set, args.triples, names=args.only)}"
     print(text)
     if not args.only:
         RESULTS.mkdir(exist_ok=True)

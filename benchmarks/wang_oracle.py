@@ -41,7 +41,7 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from benchmarks._util import format_table  # noqa: E402
-from benchmarks.wang import RESULTS, _default_ring, _stamp, crop_detail  # noqa: E402
+from benchmarks.wang import RESULTS, crop_detail, default_ring, stamp  # noqa: E402
 from benchmarks.wang_lattice import continued_lattice  # noqa: E402
 from engine.metrics import LATTICE_LAYOUTS, border_ratio, detail_ratio, frame, lattice  # noqa: E402
 from engine.tiles.wang import canonical_signatures  # noqa: E402
@@ -143,7 +143,7 @@ def figures(tiles, sigs, S, T: int, seed: int) -> list[float]:
     ]
     lat = lattice(tiles, S, margin=1, layouts=layouts)
     cont = continued_lattice(tiles, S, layouts=layouts)[2]
-    fr = frame(tiles, S, limit=2 * _default_ring(T), wrap=False)
+    fr = frame(tiles, S, limit=2 * default_ring(T), wrap=False)
     det = float(np.median([detail_ratio(t, S) for t in tiles])) / crop_detail(S, T)
     return [float(np.median(pairs)), max(pairs), lat.above, fr.value, det, cont]
 
@@ -196,7 +196,7 @@ def main(argv=None) -> int:
     ap.add_argument("--no-engine", action="store_true", help="skip the engine's own sets")
     args = ap.parse_args(argv)
     ells = [float(v) for v in args.ell.split(",")]
-    text = f"{_stamp()}\n\n{run(ells, args.tile, args.seeds, not args.no_engine)}"
+    text = f"{stamp()}\n\n{run(ells, args.tile, args.seeds, not args.no_engine)}"
     print(text)
     RESULTS.mkdir(exist_ok=True)
     (RESULTS / "wang_oracle.txt").write_text(text)
