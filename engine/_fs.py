@@ -292,9 +292,11 @@ def check_folder(
     inputs: Iterable = (),
     overwrite: bool = True,
     action: str = "export to",
+    overwrite_word: str = "overwrite=True",
 ) -> list[str]:
     """Refuse, before any work, an ``out`` that :func:`replace_folder` would refuse; returns the
-    names in it (empty if it does not exist). Also removes stale temporaries of ``out``."""
+    names in it (empty if it does not exist). Also removes stale temporaries of ``out``.
+    ``overwrite_word`` is the caller's name of ``overwrite`` (the CLI's ``--overwrite``)."""
     shown = os.fspath(out)
     out = Path(os.path.abspath(shown))
 
@@ -329,7 +331,7 @@ def check_folder(
     if existing and not overwrite:
         fail(
             errno.EEXIST,
-            "the folder is not empty (pass overwrite=True or --overwrite to replace it)",
+            f"the folder is not empty (pass {overwrite_word} to replace it)",
         )
     if existing:
         mine = set(owned(out))

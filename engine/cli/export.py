@@ -94,6 +94,7 @@ def run(args) -> int:
             inputs=[args.project],
             overwrite=args.overwrite,
             action="export to",
+            overwrite_word="--overwrite",
         )
     project = load_project(args.project)
     if args.name is not None:

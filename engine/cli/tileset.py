@@ -401,10 +401,23 @@ def run(args) -> int:
     check_out(args)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        code = work(args, settings, rect)
+        try:
+            code = work(args, settings, rect)
+        except ValueError as exc:  # the engine's names of the sizes -> the flags given (ux13)
+            raise ValueError(flag_words(str(exc), args)) from None
     for text in dict.fromkeys(str(w.message) for w in caught):  # each once, in order
         print(f"quilt-studio tileset: warning: {text}", file=sys.stderr)
     return code
+
+
+def flag_words(text: str, args) -> str:
+    """An engine message with the settings' names of the tile sizes as the flags that set them:
+    "choose a smaller tile_min" reads "choose a smaller --tile-size" after ``--tile-size 600``."""
+    given = getattr(args, "tile_size", None) is not None
+    flags = {"tile_min": "--tile-size" if given else "--tile-min", "tile_max": "--tile-max"}
+    if given:
+        flags["tile_max"] = "--tile-size"
+    return re.sub(r"(?<![\w./-])(tile_min|tile_max)(?![\w/])", lambda m: flags[m[1]], text)
 
 
 def _events(say, n: int):

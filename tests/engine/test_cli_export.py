@@ -69,7 +69,8 @@ def test_cli_export_writes_the_bundle(tmp_path, project_file, capsys):
     assert man["layout"]["cells"] == [[0, 1, 2], [2, 1, 0]]
     # 8-bit on request (dithered by default), refusing to overwrite without --overwrite
     assert main(["export", str(path), "--out", str(out), "--bit-depth", "8"]) == 1
-    assert "not empty" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "not empty (pass --overwrite to replace it)" in err and "=True" not in err  # ux13
     assert main(["export", str(path), "--out", str(out), "--bit-depth", "8", "--overwrite"]) == 0
     man8 = json.loads((out / "demo.json").read_text())
     assert man8["bit_depth"] == 8 and man8["dithered"]

@@ -182,7 +182,11 @@ def test_picks_maps_exclusion_and_options(src, tmp_path):
 def test_bad_input_gives_clear_errors(src, tmp_path, capsys):
     out = str(tmp_path / "bad")
     assert main(["tileset", str(src["rgb8"]), "--out", out, "--tile-min", "200"]) == 1
-    assert "smaller than the minimum tile" in capsys.readouterr().err
+    err = capsys.readouterr().err  # the flag given, not the setting's name (ux13)
+    assert "smaller than the minimum tile" in err and "a smaller --tile-min or" in err
+    assert main(["tileset", str(src["rgb8"]), "--out", out, "--tile-size", "200"]) == 1
+    err = capsys.readouterr().err
+    assert "a smaller --tile-size or" in err and "tile_min" not in err
     assert main(["tileset", str(tmp_path / "missing.png"), "--out", out]) == 1
     assert "no such file" in capsys.readouterr().err
     assert main(["tileset", str(src["rgb8"]), "--out", out, *ARGS, "--pick", "9"]) == 1
