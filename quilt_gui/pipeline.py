@@ -431,11 +431,17 @@ class Pipeline(QObject):
         self.jobs.abort("candidates")
         self._gen_job, self._gen_waiting = None, {}
         self.doc.tileset.apply_candidates(*self._gen_old)
-        self.message.emit(
-            "warning",
+        text = (
             "Generation stopped: the tile rectangle changed, and candidates made for the old "
-            "one would not connect to it. Generate candidates (Ctrl+G) makes them again.",
+            "one would not connect to it. Generate candidates (Ctrl+G) makes them again."
         )
+        if self.doc.tileset.template_rect is None:  # Undo took the template away: Ctrl+G is
+            # disabled until there is a tile rectangle again (the banner offered it: ux13)
+            text = (
+                "Generation stopped: the tile rectangle was taken away. Find best tile (Ctrl+T)"
+                " or draw the tile rectangle, then Generate candidates (Ctrl+G)."
+            )
+        self.message.emit("warning", text)
 
     def _on_candidate_event(self, event) -> None:
         """Candidates finish in any order; they are shown in the order of their index, so

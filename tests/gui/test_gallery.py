@@ -7,7 +7,7 @@ from PySide6.QtCore import QEvent, QPointF, Qt
 from PySide6.QtGui import QMouseEvent
 
 from engine.tiles.candidates import candidate_seed
-from tests.gui.helpers import WAIT_MS, generate, make_window, open_sample, wait_idle
+from tests.gui.helpers import WAIT_MS, generate, make_window, open_sample, template, wait_idle
 
 
 def _mouse(view, kind, row) -> None:
@@ -247,3 +247,41 @@ def test_undoing_generate_while_a_candidate_is_re_rolled_drops_the_re_roll(qtbot
     wait_idle(qtbot, w)
     assert [id(e) for e in w.doc.tileset.candidates] == first
     assert w.doc.undo_stack.canRedo() and w.doc.undo_stack.redoText() == "Generate candidates"
+
+
+def test_undoing_the_only_template_while_generate_runs_names_what_comes_first(qtbot, monkeypatch):
+    """ux13: Ctrl+Z took the template away during Generate, and the banner offered "Generate
+    candidates (Ctrl+G)", disabled until there is a tile rectangle again."""
+    import threading
+
+    import engine.tiles
+
+    w = make_window(qtbot)
+    open_sample(qtbot, w)
+    assert w.doc.tileset.template_rect is None
+    template(qtbot, w)
+    w.doc.set_param("n_candidates", 3)
+    wait_idle(qtbot, w)
+
+    def slow(*_args, cancel=None, **_options):  # as a long run would, until cancelled
+        stop = threading.Event()
+        for _ in range(12_000):  # at most 120 s
+            if cancel is None or cancel.cancelled:
+                return
+            yield from ()
+            stop.wait(0.01)
+
+    monkeypatch.setattr(engine.tiles, "iter_candidates", slow)
+    w.act_generate.trigger()
+    job = w.jobs.get("candidates")
+    assert job is not None and job.alive
+    for _ in range(3):  # the parameter's step (if it is one), then the template
+        if w.doc.tileset.template_rect is not None:
+            w.act_undo.trigger()
+    assert w.doc.tileset.template_rect is None
+    assert not job.alive
+    wait_idle(qtbot, w)
+    text = w.last_message()
+    assert text.startswith("Generation stopped: the tile rectangle was taken away")
+    assert "Find best tile (Ctrl+T)" in text and not w.act_generate.isEnabled()
+    assert "makes them again" not in text
