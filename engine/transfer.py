@@ -319,6 +319,60 @@ def iter_transfer(
     """
     s = sample_array(sample)
     t = as_image(target, "target")
+    sched, plans = transfer_plans(
+        s,
+        t.shape[:2],
+        block=block,
+        overlap=overlap,
+        alpha=alpha,
+        iterations=iterations,
+        correspondence=correspondence,
+        sigma=sigma,
+        tolerance=tolerance,
+        seam=seam,
+        excluded=excluded,
+        mode=mode,
+    )
+    threads = resolve_threads(threads)
+    passes = [
+        plan(o, threads, channels_extra=1, terms="block", extra_bytes=_transfer_bytes(s, t))
+        for o in plans
+    ]
+    total = replace(
+        passes[0],
+        blocks=sum(p.blocks for p in passes),
+        seconds=sum(p.seconds for p in passes),
+        peak_bytes=max(p.peak_bytes for p in passes),
+    )
+    check_plan(total, f"texture transfer ({len(sched)} passes)")
+    use_numba_for(total.blocks)
+    gen = as_rng(rng)
+    seed = int(gen.integers(2**63))
+    return _iter_transfer(
+        s, t, plans, passes, total, sched, correspondence, float(sigma), seed, cancel, threads
+    )
+
+
+def transfer_plans(
+    sample,
+    out_shape,
+    *,
+    block,
+    overlap,
+    alpha,
+    iterations,
+    correspondence,
+    sigma,
+    tolerance,
+    seam,
+    excluded,
+    mode,
+):
+    """The options of :func:`iter_transfer` checked: ``(schedule, plans)``, each pass's
+    :func:`~engine.quilting.options.check_options` dict; ValueError / TypeError when they
+    cannot run (the editor checks them on a stand-in of the sample before clearing its
+    output)."""
+    s = sample_array(sample)
     choice(correspondence, "correspondence", CORRESPONDENCES)
     _check_alpha(alpha)
     if isinstance(sigma, bool) or not isinstance(sigma, numbers.Real) or not sigma > 0:
@@ -328,7 +382,6 @@ def iter_transfer(
     if overlap is not None:
         overlap = positive_int(overlap, "overlap")
     sched = transfer_schedule(b1, n_iter, alpha=alpha, overlap=overlap)
-    out_shape = t.shape[:2]
     plans = []
     for i, (b, ov, _) in enumerate(sched, start=1):
         if b < 4 or ov >= b:
@@ -354,24 +407,7 @@ def iter_transfer(
                 mode=mode,
             )
         )
-    threads = resolve_threads(threads)
-    passes = [
-        plan(o, threads, channels_extra=1, terms="block", extra_bytes=_transfer_bytes(s, t))
-        for o in plans
-    ]
-    total = replace(
-        passes[0],
-        blocks=sum(p.blocks for p in passes),
-        seconds=sum(p.seconds for p in passes),
-        peak_bytes=max(p.peak_bytes for p in passes),
-    )
-    check_plan(total, f"texture transfer ({n_iter} passes)")
-    use_numba_for(total.blocks)
-    gen = as_rng(rng)
-    seed = int(gen.integers(2**63))
-    return _iter_transfer(
-        s, t, plans, passes, total, sched, correspondence, float(sigma), seed, cancel, threads
-    )
+    return sched, plans
 
 
 def _transfer_bytes(sample, target) -> int:

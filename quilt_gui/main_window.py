@@ -623,8 +623,7 @@ class MainWindow(QMainWindow):
 
     def run_transfer(self, *_args) -> None:
         self.tabs.setCurrentWidget(self.quilt_view)
-        if self.files.may_replace_output():
-            self.pipeline.run_transfer()
+        self.pipeline.run_transfer(may_replace=self.files.may_replace_output)
 
     @Slot(int)
     def _on_tab_changed(self, _index: int) -> None:

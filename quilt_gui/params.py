@@ -395,6 +395,22 @@ _QUILT_WORDS = (
         f"a “{BY_KEY['q_method'].label}” other than “{_choice_label('q_method', 'straight')}”",
     ),
     (re.compile(r"with select='bhatia'"), f"with “{_choice_label('select', 'bhatia')}”"),
+    # texture transfer's passes: "iterations=1 shrinks block 16 to 16 px and overlap 16 to ..."
+    (  # its first pass (nothing shrunk): the overlap is as wide as the block
+        re.compile(
+            r"iterations=\d+ shrinks block (\d+) to \1 px and overlap (\d+) to \2 px at "
+            r"iteration 1: .*"
+        ),
+        f"a “{BY_KEY['q_overlap'].label}” of \\2 px does not fit a “{BY_KEY['block'].label}” "
+        f"of \\1 px: choose a smaller “{BY_KEY['q_overlap'].label}” or a larger "
+        f"“{BY_KEY['block'].label}”",
+    ),
+    (re.compile(r"iterations=(\d+)"), f"“{BY_KEY['iterations'].label}” \\1"),
+    (re.compile(r"shrinks block\b"), f"shrinks the “{BY_KEY['block'].label}”"),
+    (re.compile(r"at iteration (\d+)"), r"in pass \1"),
+    (re.compile(r"fewer iterations"), f"fewer “{BY_KEY['iterations'].label}”"),
+    (re.compile(r"a larger block\b"), f"a larger “{BY_KEY['block'].label}”"),
+    (re.compile(r"a smaller overlap\b"), f"a smaller “{BY_KEY['q_overlap'].label}”"),
     (re.compile(r"\bmin_block\b"), f"“{BY_KEY['min_block'].label}”"),
     (re.compile(r"\ban overlap\b"), f"a “{BY_KEY['q_overlap'].label}”"),
     (re.compile(r"^overlap\b|\boverlap(?= \d)"), f"“{BY_KEY['q_overlap'].label}”"),

@@ -616,14 +616,38 @@ class Pipeline(QObject):
             return params.quilt_words(str(exc))
         return None
 
+    def transfer_options(self) -> dict:
+        """Keyword options of :func:`engine.transfer.iter_transfer` from the parameters."""
+        p = self.doc.params
+        opts = quilt_options(p)
+        for key in ("select", "candidates", "tileable", "adaptive_threshold", "min_block"):
+            opts.pop(key)
+        alpha = None if p["alpha_ramp"] else p["alpha"]
+        keys = ("iterations", "correspondence", "sigma")
+        return opts | {"alpha": alpha} | {k: p[k] for k in keys}
+
+    def transfer_problem(self, opts: dict) -> str | None:
+        """Why the transfer cannot run with ``opts`` on this source and target (the editor's
+        words), or None: the engine's check on the source's shape (as :meth:`quilt_problem`)."""
+        from engine.transfer import transfer_plans
+
+        opts = {k: v for k, v in opts.items() if k != "rng"}
+        stand_in = np.broadcast_to(np.float32(0), self.doc.source.main.shape)
+        try:
+            transfer_plans(stand_in, self.doc.quilting.target.shape[:2], excluded=None, **opts)
+        except (ValueError, TypeError) as exc:
+            return params.quilt_words(str(exc))
+        return None
+
     def exclusion(self) -> tuple:
         """(colour, tolerance, painted mask): the arguments of :func:`excluded_mask` (the
         source pixels the template search, the candidates and quilting never use)."""
         p = self.doc.params
         return p["exclude_color"], p["exclude_tolerance"], self.doc.exclude_painted
 
-    def run_transfer(self) -> jobs.Job | None:
-        """Texture transfer of the source onto the target's layout; passes stream in."""
+    def run_transfer(self, may_replace=None) -> jobs.Job | None:
+        """Texture transfer of the source onto the target's layout; passes stream in. The
+        options are checked before the shown output is cleared (as :meth:`run_quilt`)."""
         doc = self.doc
         if doc.source is None:
             self.message.emit("warning", "Open a sample image first.")
@@ -631,12 +655,15 @@ class Pipeline(QObject):
         if doc.quilting.target is None:
             self.message.emit("warning", "Load a target image first (Quilting ▸ Load target).")
             return None
+        opts = self.transfer_options()
+        problem = self.transfer_problem(opts)
+        if problem is not None:
+            self.message.emit("error", problem)
+            return None
+        if may_replace is not None and not may_replace():
+            return None
         self._quilt_mode = "transfer"
-        p = doc.params
         doc.quilting.start(doc.quilting.target.shape[:2])
-        opts = quilt_options(p)
-        for key in ("select", "candidates", "tileable", "adaptive_threshold", "min_block"):
-            opts.pop(key)
         return self.jobs.start(
             "quilt",
             transfer_job,
@@ -644,10 +671,6 @@ class Pipeline(QObject):
             doc.quilting.target,
             label="Texture transfer",
             exclusion=self.exclusion(),
-            alpha=None if p["alpha_ramp"] else p["alpha"],
-            iterations=p["iterations"],
-            correspondence=p["correspondence"],
-            sigma=p["sigma"],
             on_event=self._on_quilt_event,
             on_done=self._on_quilt_done,
             on_error=self._on_quilt_error,

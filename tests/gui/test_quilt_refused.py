@@ -103,3 +103,49 @@ def test_the_overlap_views_read_out_the_overlap_not_the_composites_display_colou
     assert w.pixel_label.text().startswith("R_B x 1, y 1 = (")
     w._on_hover(view, None)
     assert w.pixel_label.text() == ""
+
+
+def test_a_transfer_that_cannot_run_keeps_its_output_and_says_so_in_the_panels_words(
+    qtbot, tmp_path
+):
+    """mend15a: a block overlap as wide as the block restarted the shown transfer, which
+    failed in its job: the output went (None), the message in the engine's words
+    ("iterations=1 shrinks block 16 to 16 px ..."); pressing Transfer again left it None."""
+    from PIL import Image
+
+    from quilt_gui.params import quilt_words
+
+    w = make_window(qtbot)
+    open_sample(qtbot, w)
+    path = tmp_path / "gray.png"
+    Image.fromarray(np.full((48, 64), 128, np.uint8)).save(path)
+    with qtbot.waitSignal(w.doc.quilting.target_changed, timeout=WAIT_MS):
+        w.files.load_target(str(path))
+    w.doc.set_params({"block": 16, "iterations": 1})
+    w.act_transfer.trigger()
+    wait_idle(qtbot, w)
+    kept = w.doc.quilting.output.copy()
+    asked = []
+    w.files.ask_discard_output = lambda: asked.append(1) or True
+    w.doc.set_param("q_overlap", 16)  # restarts the shown transfer: it cannot run
+    wait_idle(qtbot, w)
+    w.act_transfer.trigger()
+    wait_idle(qtbot, w)
+    assert asked == []  # nothing to discard for a run that cannot start
+    assert w.doc.quilting.result is not None
+    assert np.array_equal(w.doc.quilting.output, kept)
+    text = w.last_message("error")
+    assert "a “Block overlap” of 16 px does not fit a “Block size” of 16 px" in text, text
+    assert "iterations=" not in text and "block 16" not in text
+    later = (
+        "iterations=3 shrinks block 16 to 7 px at iteration 3: use fewer iterations, a larger block"
+    )
+    assert quilt_words(later) == (
+        "“Passes” 3 shrinks the “Block size” 16 to 7 px in pass 3: use fewer “Passes”, a larger "
+        "“Block size”"
+    )
+    w.doc.set_param("q_overlap", 4)  # a transfer the options allow replaces it after asking
+    wait_idle(qtbot, w)
+    w.act_transfer.trigger()
+    wait_idle(qtbot, w)
+    assert asked == [1] and len(w.doc.quilting.result.iterations) == 1
