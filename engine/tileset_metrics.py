@@ -208,19 +208,22 @@ def frame(
     """
     stack = _tile_stack(tiles)
     S = luminance(source)
-    n, h, w = stack.shape
-    lim = positive_int(limit, "limit")
-    lim = min(lim, (min(h, w) + 1) // 2)
-    sig = non_negative_number(sigma, "sigma")
+    g, dist, lim, sig = _tile_gradients(stack, limit, sigma, "wrap" if wrap else "reflect")
     k = positive_int(crops, "crops")
-    dist = edge_distance((h, w))
-    if wrap:
-        g = np.stack([_gradient_magnitude(t, sig, "wrap") for t in stack])
-    else:
-        g = np.stack([_gradient_magnitude(t, sig, "reflect") for t in stack])
     prof = _profile(g, dist, lim)
-    ref = _source_profile(S, (h, w), sig, lim, template, in_phase, k, rng)
+    ref = _source_profile(S, stack.shape[1:], sig, lim, template, in_phase, k, rng)
     return _frame_of(prof, ref)
+
+
+def _tile_gradients(stack: np.ndarray, limit, sigma, mode: str):
+    """The tiles' side of :func:`frame` and :func:`frame_profiles`: the gradient magnitude
+    (n, h, w) of every tile blurred by ``sigma`` (``mode`` "wrap" or "reflect"), the tile's
+    edge distance, ``limit`` at most half the tile, and ``sigma`` checked."""
+    h, w = stack.shape[1:]
+    lim = min(positive_int(limit, "limit"), (min(h, w) + 1) // 2)
+    sig = non_negative_number(sigma, "sigma")
+    g = np.stack([_gradient_magnitude(t, sig, mode) for t in stack])
+    return g, edge_distance((h, w)), lim, sig
 
 
 def _source_profile(S, size, sig, lim, template, in_phase, k, rng) -> np.ndarray:
@@ -378,13 +381,9 @@ def ring_reference(
 def frame_profiles(tiles, *, limit: int, sigma: float = FRAME_SIGMA) -> np.ndarray:
     """(n, limit) float: per tile (blurred and differentiated as repeated) its mean gradient
     magnitude at each distance 0 .. ``limit`` - 1 from its edge (``limit`` at most half the
-    tile, as in :func:`frame`, whose ``profile`` with ``wrap`` is their mean)."""
-    stack = _tile_stack(tiles)
-    h, w = stack.shape[1:]
-    lim = min(positive_int(limit, "limit"), (min(h, w) + 1) // 2)
-    sig = non_negative_number(sigma, "sigma")
-    dist = edge_distance((h, w))
-    return np.stack([_profile(_gradient_magnitude(t, sig, "wrap")[None], dist, lim) for t in stack])
+    tile, as in :func:`frame`, whose ``profile`` with ``wrap`` is their mean up to rounding)."""
+    g, dist, lim, _ = _tile_gradients(_tile_stack(tiles), limit, sigma, "wrap")
+    return np.stack([_profile(t[None], dist, lim) for t in g])
 
 
 @dataclass(frozen=True, slots=True)
