@@ -37,8 +37,11 @@ from pathlib import Path
 
 import numpy as np
 
+from engine.tileset_metrics import QUALITY_LIMITS
+
 RESULTS = Path(__file__).parent / "results" / "set_bound.txt"
-FRAME_LINE, TONE_LINE = 1.15, 1.3
+#: the tile-set warnings' lines
+FRAME_LINE, TONE_LINE = QUALITY_LIMITS["frame"], QUALITY_LIMITS["ring_tone"]
 SHOWN = 8  # distances shown in the first table
 
 

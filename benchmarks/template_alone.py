@@ -58,6 +58,7 @@ def among_centres(S, T, wp) -> tuple[float, float]:
 def rows(names) -> list[list[str]]:
     from benchmarks import evalset
     from benchmarks.tileset import evaluate_texture, load_image_array
+    from engine.metrics import QUALITY_LIMITS
 
     out = []
     for name in names:
@@ -75,7 +76,7 @@ def rows(names) -> list[list[str]]:
                 f"{darker:.2f}",
                 f"{spread:.2f}",
                 f"{f['tone']:.2f}",
-                "ok" if f["tone"] <= 1.3 else "fails",
+                "ok" if f["tone"] <= QUALITY_LIMITS["ring_tone"] else "fails",
             ]
         )
     return out
