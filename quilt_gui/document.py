@@ -207,7 +207,6 @@ class Document(QObject):
         self.path_changed.emit()
         self.apply_painted(None)
         self.apply_heal_mask(None)
-        self.quilting.start(None)
         self._emit_modified()
 
     def attach_map(self, name: str, pixels: np.ndarray, path: str, kind: str) -> None:
