@@ -178,10 +178,14 @@ def unhealed_candidates(doc, healed) -> str:
     hit = [e.index for e in ts.candidates if e.patch_rect is not None and holds(e.patch_rect)]
     if not hit:
         return ""
-    picked = sum(i in ts.picks for i in hit)
-    names = ", ".join(f"#{i + 1}" for i in hit[:8]) + (", …" if len(hit) > 8 else "")
+
+    def names(indices) -> str:
+        return ", ".join(f"#{i + 1}" for i in indices[:8]) + (", …" if len(indices) > 8 else "")
+
+    picked = [i for i in hit if i in ts.picks]
+    which = f"{names(hit)}; {len(picked)} of them picked" + (f": {names(picked)}" if picked else "")
     return (
-        f" {len(hit)} candidates ({picked} of them picked: {names}) still show the unhealed "
-        "pixels, their patches were cut from them: re-roll them (R in the gallery) or "
-        "Generate again."
+        f" {len(hit)} candidate{'s' if len(hit) > 1 else ''} ({which}) still show"
+        f"{'' if len(hit) > 1 else 's'} the unhealed pixels, their patches were cut from them: "
+        "re-roll them (R in the gallery) or Generate again."
     )

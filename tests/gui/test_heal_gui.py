@@ -93,7 +93,12 @@ def test_a_heal_says_which_candidates_still_show_the_healed_pixels(qtbot):
     wait_idle(qtbot, w)
     text = w.last_message()
     assert text.startswith("Healed") and 1 in hit
-    assert f"{len(hit)} candidates (" in text and "still show the unhealed pixels" in text
+    assert "still show" in text and "the unhealed pixels" in text
+    # every candidate hit named, then which of them are picked (mend15a: "2 candidates (1 of
+    # them picked: #1, #6)" listed the unpicked #6 as picked)
+    picked = [f"#{i}" for i in hit if i - 1 in doc.tileset.picks]
+    names = ", ".join(f"#{i}" for i in hit)
+    assert f"({names}; {len(picked)} of them picked: {', '.join(picked)})" in text, text
     assert "#1" in text and "R in the gallery" in text
     assert w.messages[-1][0] == "warning"
 
