@@ -43,6 +43,8 @@ class WangRunner(QObject):
         doc.wang.sample_moved.connect(self._on_sample_moved)
         doc.wang.superseded.connect(self._drop_jobs)
         doc.wang.restored.connect(self._on_restored)
+        self._stopped_due = False  # a restored stopped set, said once the undo step is taken
+        doc.wang.undo_stack.indexChanged.connect(self._after_step)
         doc.source_changed.connect(self._on_source_changed)
         doc.pixels_changed.connect(self._on_pixels_changed)
 
@@ -288,6 +290,7 @@ class WangRunner(QObject):
         set before is no longer true."""
         self.jobs.abort_matching("wang")
         self.retracted.emit(STOPPED)
+        self._stopped_due = False
         self.stale = set()
         self._outdated = {}
 
@@ -297,7 +300,14 @@ class WangRunner(QObject):
         whose pixels changed: rebuild them; a set stopped before its end says so again."""
         self.stale = set(pending)
         self.rebuild()
-        if not self.stale and not self.doc.wang.complete:
+        # said after the undo stack's index moves: inside QUndoCommand.redo() / undo() its
+        # undo text is still the step before (or the one being undone), not this set's
+        self._stopped_due = not self.stale and not self.doc.wang.complete
+
+    @Slot()
+    def _after_step(self) -> None:
+        if self._stopped_due:
+            self._stopped_due = False
             self._say_stopped()
 
     @Slot()

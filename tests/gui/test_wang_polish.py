@@ -26,6 +26,8 @@ def test_the_stopped_banner_follows_the_set_undo_and_redo_show(qtbot):
     wait_wang(qtbot, win)
     assert w.colours == 2 and not w.complete
     assert bar.text.startswith(f"Wang set stopped: {len(w.tiles)} of {w.count} tiles made")
+    # mend15a: the hint was read inside the redo, before the stack's index moved
+    assert bar.text.endswith("(Edit ▸ Undo, Ctrl+Z, brings back the set before)."), bar.text
     win.wang_view.generate()  # Generate makes it: the old stop is not news any more
     assert "stopped" not in bar.text
     wait_wang(qtbot, win)
