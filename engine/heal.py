@@ -12,11 +12,9 @@ Algorithm
     2. Onion order: the next block is the one whose window is known best (the largest share of
        original or already healed pixels), ties broken by the mean depth of its missing pixels
        in the mask (distance to the mask's edge). So the fill grows from the boundary inwards.
-    3. Search: every window near the mask (its bounding box grown by ``SEARCH_MARGIN`` blocks
-       or its own size, farther only where nothing there fits: :func:`_search_box`) lying
-       wholly outside the mask (and the ``excluded`` pixels) is scored by the SSD over the
-       block's known pixels, for all positions at once by FFT; the block is drawn among the
-       windows within ``1 + tolerance`` of the best
+    3. Search: every window of the source lying wholly outside the mask (and the ``excluded``
+       pixels) is scored by the SSD over the block's known pixels, for all positions at once by
+       FFT; the block is drawn among the windows within ``1 + tolerance`` of the best
        (:func:`engine.matching.select_within_tolerance`, seeded by ``rng``).
     4. Cut: the block's edge strips that are wholly known (the *arms*) are cut by the seam
        method through the error of old against new (the top and left arms as one L joined in
@@ -61,8 +59,6 @@ from engine.seams.spec import SeamSpec, as_seam_spec, check_blend
 __all__ = ["HEAL_SEAM", "HealBlock", "HealResult", "default_block", "heal", "iter_heal"]
 
 MIN_BLOCK = 6
-#: a heal searches the mask's bounding box grown by this many blocks (:func:`_search_box`)
-SEARCH_MARGIN = 8
 #: the default cut: minimum error boundary cut on the squared error, feathered over 4 px
 HEAL_SEAM = SeamSpec("dp", metric="ssd", blend="feather", width=4.0)
 
@@ -212,52 +208,23 @@ def iter_heal(
     ov = max(1, b // 4) if overlap is None else positive_int(overlap, "overlap", minimum=1)
     if ov >= b:
         raise ValueError(f"overlap must be smaller than the block ({b}), got {ov}")
-    box = _search_box(bad, m, b)
-    zero = ZERO_ERROR_FRACTION * error_floor(img) * img.shape[2]  # the whole image's texture
-    cm = m[box]
-    passes = [(cm, b, ov)]
+    passes = [(m, b, ov)]
     fine = max(MIN_BLOCK, b // 3)
     if refine and fine < b:  # re-heal the rim with small blocks: the mask's edge is a fixed cut
-        rim = cm & (ndimage.distance_transform_edt(cm) <= ov)
+        rim = m & (ndimage.distance_transform_edt(m) <= ov)
         passes.append((rim, fine, max(1, fine // 4)))
     return _iter_heal(
         img,
-        box,
-        cm,
+        m,
         extra,
-        bad[box],
+        bad,
         passes,
         tolerance,
-        zero,
         spec,
         as_rng(rng),
         cancel,
         1 if threads is None else max(1, int(threads)),
     )
-
-
-def _search_box(bad: np.ndarray, mask: np.ndarray, b: int) -> tuple[slice, slice]:
-    """The part of the image a heal reads: the mask's bounding box grown by ``SEARCH_MARGIN``
-    blocks or the box's own extent, whichever is more (doubled while no ``b`` × ``b`` window
-    in it is free of ``bad`` pixels), clamped to the image.
-
-    GIMP's Resynthesizer heals from a band around the selection too (its *context sampling
-    width*). A search over the whole photo took about 5 minutes for a 400×400 region of a
-    6000×4000 photo (each block one FFT query of the 24 Mpx, ux13b); the box of that region is
-    1200×1200. Where the box covers the image the heal is the one over the whole image."""
-    H, W = mask.shape
-    rows, cols = np.nonzero(mask.any(axis=1))[0], np.nonzero(mask.any(axis=0))[0]
-    y0, y1, x0, x1 = int(rows[0]), int(rows[-1]) + 1, int(cols[0]), int(cols[-1]) + 1
-    margin = max(SEARCH_MARGIN * b, y1 - y0, x1 - x0)
-    while True:
-        box = (
-            slice(max(0, y0 - margin), min(H, y1 + margin)),
-            slice(max(0, x0 - margin), min(W, x1 + margin)),
-        )
-        whole = box == (slice(0, H), slice(0, W))
-        if whole or (min(bad[box].shape) >= b and not _window_hits(bad[box], b, b).all()):
-            return box
-        margin *= 2
 
 
 def _cells(fill: np.ndarray, b: int, ov: int) -> list[tuple[int, int]]:
@@ -269,15 +236,13 @@ def _cells(fill: np.ndarray, b: int, ov: int) -> list[tuple[int, int]]:
     return [(y, x) for y in ys for x in xs if fill[y : y + b, x : x + b].any()]
 
 
-def _iter_heal(full, box, mask, maps, bad, passes, tolerance, zero, spec, rng, cancel, threads):
-    """The heal inside ``box`` of the image ``full`` and its ``maps`` (``mask``, ``bad`` and
-    the passes' regions cut to the box already); events in the whole image's coordinates."""
-    img = full[box]
-    oy, ox = box[0].start, box[1].start
+def _iter_heal(img, mask, maps, bad, passes, tolerance, spec, rng, cancel, threads):
+    C = img.shape[2]
     canvas = img.copy()
-    canvases = {k: v[box].copy() for k, v in maps.items()}
+    canvases = {k: v.copy() for k, v in maps.items()}
     depth = ndimage.distance_transform_edt(mask)
     spectrum = SampleSpectrum(np.where(mask[:, :, None], 0.0, img), workers=threads)
+    zero = ZERO_ERROR_FRACTION * error_floor(img) * C
     plan = [(level, fill, b, ov, _cells(fill, b, ov)) for level, (fill, b, ov) in enumerate(passes)]
     blocks: list[HealBlock] = []
     total, done = sum(len(p[-1]) for p in plan), 0
@@ -312,29 +277,23 @@ def _iter_heal(full, box, mask, maps, bad, passes, tolerance, zero, spec, rng, c
             a3 = alpha[:, :, None]
             canvas[win] = np.where(write, a3 * old + (1 - a3) * new, old)
             for name, cm in canvases.items():
-                mo, mn = cm[win], maps[name][box][src]
+                mo, mn = cm[win], maps[name][src]
                 cm[win] = np.where(write, a3 * mo + (1 - a3) * mn, mo)
             unknown[win] = False
             event = HealBlock(
                 index=len(blocks),
                 level=level,
-                rect=(x + ox, y + oy, b, b),
-                source=(sx + ox, sy + oy),
+                rect=(x, y, b, b),
+                source=(sx, sy),
                 arms=arms,
-                path=frozen_array(path + (y + oy, x + ox)),
+                path=frozen_array(path + (y, x)),
                 criterion=criterion,
                 pixels=frozen_array(canvas[win]),
             )
             blocks.append(event)
             yield event
             yield Progress(done, total, "blocks")
-    image = full.copy()
-    image[box] = canvas
-    healed = {}
-    for name, cm in canvases.items():
-        healed[name] = maps[name].copy()
-        healed[name][box] = cm
-    return HealResult(image, healed, tuple(blocks), passes[0][1], passes[0][2])
+    return HealResult(canvas, canvases, tuple(blocks), passes[0][1], passes[0][2])
 
 
 def _next_cell(cells, unknown, depth, b) -> int:
