@@ -282,6 +282,17 @@ def crop_frame(S, T: int, limit: int, tiles: int = 16, sets: int = 1) -> float:
     windows of the source differ much from each other: measured 1.01-1.05 on the stochastic
     samples and text but 1.12-1.18 on brick (perspective), page (lighting, margins), planks,
     for one set of 16; 1.01-1.02 and 1.12-1.13 for three sets pooled."""
+    return _crop_sets_median(S, T, tiles, sets, lambda org: wang_frame(_crops(S, T, org), S, limit))
+
+
+def _crops(S, T: int, origins):
+    return [S[y : y + T, x : x + T] for y, x in origins]
+
+
+def _crop_sets_median(S, T: int, tiles: int, sets: int, frame_of) -> float:
+    """Median over :data:`FRAME_DRAWS` seeded draws of ``sets`` pooled sets of ``tiles`` crop
+    origins (the first random, the others in its phase: :mod:`engine.reference_crops`), each
+    set read by ``frame_of(origins)`` (a :class:`Frame`)."""
     from engine.metrics import luminance
     from engine.reference_crops import ReferenceCrops, random_origins
 
@@ -293,9 +304,7 @@ def crop_frame(S, T: int, limit: int, tiles: int = 16, sets: int = 1) -> float:
         for _ in range(sets):
             (y0, x0), *_ = random_origins(L.shape, (T, T), 1, g)
             ref = ReferenceCrops.build(L, (T, T), L[y0 : y0 + T, x0 : x0 + T])
-            org = [(y0, x0), *ref.origins(tiles - 1, g)]
-            crops = [S[y : y + T, x : x + T] for y, x in org]
-            ratios.append(wang_frame(crops, S, limit).ratio)
+            ratios.append(frame_of([(y0, x0), *ref.origins(tiles - 1, g)]).ratio)
         values.append(pooled_frame(ratios))
     return float(np.median(values))
 
@@ -333,22 +342,12 @@ def crop_layout_frame(S, T: int, limit: int, tiles: int = 16, sets: int = 1) -> 
     (drawn as :func:`crop_frame` draws them, in the first crop's phase on periodic textures)
     measured with their real neighbours (:func:`context_frame`), pooled (:func:`pooled_frame`).
     A frame read this way is the crops' sampling noise alone: no tile edge is reflected."""
-    from engine.metrics import luminance
-    from engine.reference_crops import ReferenceCrops, random_origins
 
-    L = luminance(S)
-    values = []
-    for k in range(FRAME_DRAWS):
-        g = np.random.default_rng(k)
-        ratios = []
-        for _ in range(sets):
-            (y0, x0), *_ = random_origins(L.shape, (T, T), 1, g)
-            ref = ReferenceCrops.build(L, (T, T), L[y0 : y0 + T, x0 : x0 + T])
-            org = [(y0, x0), *ref.origins(tiles - 1, g)]
-            first = S[y0 : y0 + T, x0 : x0 + T]
-            ratios.append(context_frame(context_windows(S, T, org), S, T, limit, first).ratio)
-        values.append(pooled_frame(ratios))
-    return float(np.median(values))
+    def frame_of(org):
+        (first,) = _crops(S, T, org[:1])
+        return context_frame(context_windows(S, T, org), S, T, limit, first)
+
+    return _crop_sets_median(S, T, tiles, sets, frame_of)
 
 
 def layouts_of(ws, seed: int):
