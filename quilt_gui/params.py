@@ -136,24 +136,32 @@ TILESET_KEYS = frozenset(k for k in BY_KEY if k in _FIELDS or k in _RENAMED or k
 }
 
 
+#: the smallest square tile Auto gives a source under 128 px (the searched range's minimum)
+MIN_AUTO_TILE = 8
+
+
 def auto_tile_size(shape, scale=None) -> int | None:
     """The "Auto" tile size for a source of ``shape`` (H, W): the largest power of two of
-    64 … 2048 px that is at most half the shorter side; None (search a range) for a source
-    under 128 px. With the source's structure ``scale`` (:class:`engine.tiles.scale.Scale`),
-    that side moved to the nearest one within a quarter of it that holds whole periods of a
-    periodic texture and still fits the source (the Wang sets' rule,
-    :func:`engine.tiles.wang_size.whole_period_size`): 256 px cuts 48 px planks at every tile
-    line, 240 px holds five (README, issue 10 Session 11)."""
-    half = min(int(shape[0]), int(shape[1])) // 2
-    fits = [int(s) for s in TILE_SIZES if int(s) <= half]
-    if not fits:
-        return None
-    if scale is None:
-        return fits[-1]
+    64 … 2048 px that is at most half the shorter side; for a source under 128 px, the largest
+    square the searched range holds (half the shorter side, at least :data:`MIN_AUTO_TILE` px)
+    whose side plus overlap fits the shorter side (15 px on a 40×30 photo, where the range
+    found 15×8); None when not even that fits. With the source's structure ``scale``
+    (:class:`engine.tiles.scale.Scale`), that side moved to the nearest one within a quarter of
+    it that holds whole periods of a periodic texture and still fits the source (the Wang
+    sets' rule, :func:`engine.tiles.wang_size.whole_period_size`): 256 px cuts 48 px planks at
+    every tile line, 240 px holds five (README, issue 10 Session 11)."""
     from engine.tiles.template import default_overlap
-    from engine.tiles.wang_size import whole_period_size
 
     short = min(int(shape[0]), int(shape[1]))
+    fits = [int(s) for s in TILE_SIZES if int(s) <= short // 2]
+    if not fits:  # under 128 px: no power of two; the largest square that fits
+        top = max(MIN_AUTO_TILE, short // 2)  # the searched range's largest side
+        sides = [n for n in range(MIN_AUTO_TILE, top + 1) if n + default_overlap(n) <= short]
+        return sides[-1] if sides else None
+    if scale is None:
+        return fits[-1]
+    from engine.tiles.wang_size import whole_period_size
+
     side = whole_period_size(scale, fits[-1], lambda n: n + default_overlap(n) <= short)
     return side or fits[-1]
 

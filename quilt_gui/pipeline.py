@@ -147,6 +147,7 @@ class Pipeline(QObject):
         ``size``: a square tile side instead of the parameters' (the Auto size retries with
         half the side when no tile of its size fits outside the excluded pixels)."""
         from engine.tiles import iter_find_template
+        from engine.tiles.template import default_overlap
 
         doc = self.doc
         if doc.source is None:
@@ -155,6 +156,16 @@ class Pipeline(QObject):
         s = self.settings()
         if size is not None:
             s = s.replace(tile_size=size)
+        if doc.params["tile_size"] == params.AUTO and s.tile_size is None:  # under 10 px
+            H, W = doc.source.shape[:2]
+            n = params.MIN_AUTO_TILE
+            self.message.emit(
+                "warning",
+                f"No square tile fits this {W}×{H} image: “Tile size” Auto (square) needs "
+                f"{n + default_overlap(n)} px each way (the smallest tile, {n} px, and its "
+                "overlap). Open a larger image.",
+            )
+            return None
         auto = doc.params["tile_size"] == params.AUTO and s.tile_size is not None
         self._auto_size = s.tile_size[0] if auto else None
         if size is None:  # a retry at half the side keeps the first search's rect and word

@@ -1,5 +1,6 @@
 """The template search's structure-scale warning reaches the editor's banner (issue 10, item 6)."""
 
+import numpy as np
 from PIL import Image
 
 from benchmarks.evalset import shelves
@@ -95,3 +96,27 @@ def test_the_auto_size_note_names_every_axis_it_keeps_whole():
     assert "(5 × 48 px each way, measured)" in note
     assert params.auto_size_note((512, 512), planks, 256) is None  # the power of two kept
     assert params.auto_size_note((512, 512), None, 240) is None
+
+
+def test_auto_square_gives_a_square_tile_on_an_image_under_128_px(qtbot, tmp_path):
+    """ux13: Auto (square) searched a range on a 40×30 photo and found a 15×8 tile; it is the
+    largest square of that range now, and a photo too small for any square says so."""
+    assert params.auto_tile_size((30, 40)) == 15 and params.auto_tile_size((10, 10)) == 8
+    assert params.auto_tile_size((9, 12)) is None  # an 8 px tile and its 2 px overlap: 10 px
+    rng = np.random.default_rng(0)
+    w = make_window(qtbot)
+    for shape in ((30, 40), (9, 12)):
+        path = tmp_path / f"tiny{shape[0]}.png"
+        Image.fromarray((rng.random((*shape, 3)) * 255).astype(np.uint8)).save(path)
+        with qtbot.waitSignal(w.doc.source_changed, timeout=WAIT_MS):
+            w.files.open_path(str(path), confirm=False)
+        wait_idle(qtbot, w)
+        assert w.doc.params["tile_size"] == params.AUTO
+        w.act_find.trigger()
+        wait_idle(qtbot, w)
+    best = [text for _, text in w.messages if text.startswith("Best tile")]
+    assert len(best) == 1 and best[0].startswith("Best tile: 15x15 at")
+    assert w.last_message() == (
+        "No square tile fits this 12×9 image: “Tile size” Auto (square) needs 10 px each way "
+        "(the smallest tile, 8 px, and its overlap). Open a larger image."
+    )
