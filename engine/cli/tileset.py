@@ -406,18 +406,26 @@ def run(args) -> int:
         except ValueError as exc:  # the engine's names of the sizes -> the flags given (ux13)
             raise ValueError(flag_words(str(exc), args)) from None
     for text in dict.fromkeys(str(w.message) for w in caught):  # each once, in order
-        print(f"quilt-studio tileset: warning: {text}", file=sys.stderr)
+        print(f"quilt-studio tileset: warning: {flag_words(text, args)}", file=sys.stderr)
     return code
 
 
 def flag_words(text: str, args) -> str:
     """An engine message with the settings' names of the tile sizes as the flags that set them:
-    "choose a smaller tile_min" reads "choose a smaller --tile-size" after ``--tile-size 600``."""
+    "choose a smaller tile_min" reads "choose a smaller --tile-size" after ``--tile-size 600``;
+    a size written after one (the engine's WxH) as the flag takes it: "tile_max 400x400" reads
+    "--tile-max 400", "using tile_max 140x130" reads "using --tile-max 130x140 (HxW)"."""
     given = getattr(args, "tile_size", None) is not None
     flags = {"tile_min": "--tile-size" if given else "--tile-min", "tile_max": "--tile-max"}
     if given:
         flags["tile_max"] = "--tile-size"
-    return re.sub(r"(?<![\w./-])(tile_min|tile_max)(?![\w/])", lambda m: flags[m[1]], text)
+
+    def flag(m) -> str:
+        w, h = m[2], m[3]
+        size = "" if w is None else f" {h}" if w == h else f" {h}x{w} (HxW)"
+        return flags[m[1]] + size
+
+    return re.sub(r"(?<![\w./-])(tile_min|tile_max)(?![\w/])(?: (\d+)x(\d+)\b)?", flag, text)
 
 
 def _events(say, n: int):

@@ -230,8 +230,9 @@ def test_bad_sources_outputs_and_options_fail_before_any_work(src, tmp_path, cap
     # a tile range that does not fit the source is clamped with a warning, printed once
     wide = ["--candidates", "2", "--tile-min", "40", "--tile-max", "400"]
     assert main(["tileset", str(src["rgb8"]), "--out", str(out), *wide]) == 0
-    err = capsys.readouterr().err
-    assert err.count("warning: tile_max 400x400 plus overlap") == 1
+    err = capsys.readouterr().err  # in the flags' words and syntax (HxW), not the settings'
+    assert err.count("warning: --tile-max 400 plus overlap") == 1 and "tile_max" not in err
+    assert "does not fit the 160x150 source; using --tile-max 130x140 (HxW)" in err
 
 
 def test_small_source_gets_a_margin_that_fits_its_ring(tmp_path, capsys):
