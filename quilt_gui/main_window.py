@@ -42,7 +42,7 @@ from quilt_gui.widgets.params_panel import QUILT_GROUPS, TILESET_GROUPS, WANG_GR
 from quilt_gui.widgets.preview import PreviewView
 from quilt_gui.widgets.quilt_view import QuiltView
 from quilt_gui.widgets.source_view import SourceView
-from quilt_gui.widgets.status import JobStatus, MessageBar
+from quilt_gui.widgets.status import ElidingLabel, JobStatus, MessageBar
 from quilt_gui.widgets.tile_view import REPEATS, TileView
 from quilt_gui.widgets.wang_view import WangView
 from quilt_gui.widgets.watch_search import describe_seam
@@ -422,11 +422,11 @@ class MainWindow(QMainWindow):
         self.pixel_label = QLabel()
         self.pixel_label.setMinimumWidth(260)
         self.pixel_label.setToolTip("Pixel under the cursor: x, y and value")
-        self.criterion_label = QLabel()
-        self.criterion_label.setToolTip(
+        self.criterion_label = ElidingLabel(  # the whole line, then this, in its tooltip
             "Seam criterion (sum of the error along the seam) of "
             "the left/right (H) and top/bottom (V) overlaps, and the method and variant "
-            "that made the seams"
+            "that made the seams",
+            least="seam H 0.000 · V 0.000",  # the figures go last
         )
         self.job_status = JobStatus(self.jobs)
         sb.addPermanentWidget(self.pixel_label)

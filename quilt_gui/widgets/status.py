@@ -163,9 +163,19 @@ def duration_text(seconds: float) -> str:
 class ElidingLabel(QLabel):
     """A one-line label that ends a text too long for it with "…" (the status bar cut the job's
     line off: "Making 256 Wang tiles — ~3 min le"); the layout may narrow it down to ``least``
-    and "…" (the job's name: its time left goes first)."""
+    and "…" (the job's name: its time left goes first). Its tooltip is the whole text, then
+    ``about`` (what the label shows)."""
 
     least = ""
+
+    def __init__(self, about: str = "", parent=None, *, least: str = "") -> None:
+        super().__init__(parent)
+        self.about, self.least = about, least
+        self.setToolTip(about)
+
+    def setText(self, text: str) -> None:  # noqa: N802 - Qt API
+        super().setText(text)
+        self.setToolTip("\n".join(t for t in (text, self.about) if t))
 
     def minimumSizeHint(self) -> QSize:  # noqa: N802 - Qt API
         hint = super().minimumSizeHint()
@@ -204,8 +214,7 @@ class JobStatus(QWidget):
         lay = QHBoxLayout(self)
         lay.setContentsMargins(0, 0, 0, 0)
         self.label = ElidingLabel()  # its whole text in its tooltip
-        self.others = QLabel()
-        self.others.setToolTip("Other jobs running at the same time")
+        self.others = ElidingLabel("Other jobs running at the same time", least="· also")
         self.bar = QProgressBar()
         self.bar.setFixedWidth(160)
         self.bar.setTextVisible(True)

@@ -139,3 +139,54 @@ def test_a_job_line_too_long_for_the_status_bar_ends_with_an_ellipsis(qtbot, mon
     finally:
         gate.set()
     qtbot.waitUntil(lambda: not w.jobs.running(), timeout=WAIT_MS)
+
+
+def test_the_seams_line_and_the_other_jobs_end_with_an_ellipsis_in_a_narrow_window(
+    qtbot, monkeypatch
+):
+    """polish13c: in a narrow window the seams' line ("oscillating as published (restart,
+    per…") and the "· also …" list of other jobs were cut off; they end with "…" like the job's
+    line, each whole in its tooltip (the seams' line above what it means)."""
+    from PySide6.QtWidgets import QStylePainter
+
+    painted: dict[int, str] = {}
+    draw = QStylePainter.drawItemText
+
+    def recording(painter, rect, flags, palette, enabled, text, *role):
+        painted[id(painter.device())] = text
+        draw(painter, rect, flags, palette, enabled, text, *role)
+
+    w = make_window(qtbot)
+    gate = threading.Event()
+    try:
+        job = w.jobs.start("wang", held, 256, 3, gate, label="Making 256 Wang tiles")
+        other = w.jobs.start("candidates", held, 30, 1, gate, label="Generating 30 candidates")
+        qtbot.waitUntil(lambda: job.progress and other.progress, timeout=WAIT_MS)
+        job.started_at -= 6.0
+        other.started_at -= 1.0
+        status = w.job_status
+        status._refresh()
+        seams = (
+            "seam H 0.123 · V 0.456 — oscillating as published (restart, per-row argmin start, "
+            "o_max 5)"
+        )
+        w.criterion_label.setText(seams)
+        also = status.others.text()
+        assert also == "· also Generating 30 candidates"
+        assert w.criterion_label.toolTip().startswith(seams + "\nSeam criterion (sum")
+        assert status.others.toolTip() == also + "\nOther jobs running at the same time"
+        monkeypatch.setattr(QStylePainter, "drawItemText", recording)
+        w.resize(700, w.height())
+        labels = (w.criterion_label, status.others)
+        for label in labels:
+            width = label.fontMetrics().horizontalAdvance
+            narrowed = lambda label=label, width=width: label.width() < width(label.text())  # noqa: E731
+            qtbot.waitUntil(narrowed, timeout=WAIT_MS)
+            painted.clear()
+            label.grab()
+            shown = painted.get(id(label), "")  # drawn elided, not cut off (a QLabel: not here)
+            assert shown.endswith("…") and label.text().startswith(shown[:-1]) and len(shown) > 4
+            assert width(shown) <= label.contentsRect().width()
+    finally:
+        gate.set()
+    qtbot.waitUntil(lambda: not w.jobs.running(), timeout=WAIT_MS)
