@@ -33,3 +33,14 @@ def blob_texture(size=256, cell=64, seed=0):
     _, (iy, ix) = ndimage.distance_transform_edt(~seeds, return_indices=True)
     tone = rng.random((size, size, 3))[iy, ix]
     return np.clip(0.2 + 0.6 * tone + 0.03 * rng.standard_normal((size, size, 3)), 0, 1)
+
+
+def running_bond(rng, shape, course, brick):
+    """Running-bond bricks (mortar rows 0-3 of every course) with a stationary grain: periodic
+    in structure, no two crops alike."""
+    yy, xx = np.mgrid[0 : shape[0], 0 : shape[1]]
+    shift = (yy // course % 2) * (brick // 2)
+    joint = (yy % course < 4) | ((xx + shift) % brick < 4)
+    grain = ndimage.gaussian_filter(rng.standard_normal(shape), 1.2, mode="wrap")
+    grain /= grain.std()
+    return np.where(joint, 0.75, 0.45 + 0.05 * grain)[..., None]

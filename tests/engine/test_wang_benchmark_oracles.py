@@ -9,6 +9,7 @@ from benchmarks.wang_lattice import continued_lattice
 from benchmarks.wang_oracle import Field, ideal_set
 from engine.metrics import detail_ratio, frame, lattice
 from engine.tiles.wang_layout import wang_layout
+from tests.engine.helpers import running_bond
 
 
 def _crops(S, T, n, seed):
@@ -57,23 +58,13 @@ def test_the_ideal_wang_set_of_a_gaussian_field_sits_on_the_continued_floor():
     assert floor < ideal - 1.5
 
 
-def _running_bond(rng, shape, course, brick):
-    """Running-bond bricks with a stationary grain: periodic in structure, no two crops alike."""
-    yy, xx = np.mgrid[0 : shape[0], 0 : shape[1]]
-    shift = (yy // course % 2) * (brick // 2)
-    joint = (yy % course < 4) | ((xx + shift) % brick < 4)
-    grain = ndimage.gaussian_filter(rng.standard_normal(shape), 1.2, mode="wrap")
-    grain /= grain.std()
-    return np.where(joint, 0.75, 0.45 + 0.05 * grain)[..., None]
-
-
 def test_wang_frame_reads_an_aligned_set_of_a_periodic_texture_as_no_frame():
     # crops of a periodic texture all in one phase (what a Wang set continuing the courses
     # across every joint is) have their mortar lines at the same distances from the tile edge:
     # against random-phase crops that reads as a frame, against crops in the set's phase not
     # (the tile, 64 px, holds two courses and one brick: whole periods on both axes)
     rng = np.random.default_rng(0)
-    S = _running_bond(rng, (384, 384), 32, 64)
+    S = running_bond(rng, (384, 384), 32, 64)
     T, y0, x0 = 64, 9, 21  # a phase that puts a mortar line near the tile edge
     g = np.random.default_rng(1)
     ys = y0 + 64 * g.integers(0, 4, 16)
@@ -92,7 +83,7 @@ def test_crop_frame_is_about_one_on_a_stationary_texture_and_counts_genuine_crop
     noise = ndimage.gaussian_filter(rng.standard_normal((256, 256)), 2)[..., None]
     assert 0.95 < crop_frame(noise, 48, 12) < 1.1
     # on running bonds the crops lie in one phase: an aligned set, no frame either
-    bricks = _running_bond(rng, (384, 384), 32, 64)
+    bricks = running_bond(rng, (384, 384), 32, 64)
     assert crop_frame(bricks, 64, 16) < 1.1
 
 
@@ -129,7 +120,7 @@ def test_continued_floor_in_the_sets_phase_reads_an_aligned_set_lower():
     # The continued floor is not exact here (non-Gaussian: aligned crops still read about
     # +2 dB above it); on a stochastic texture the same draws as without a template.
     rng = np.random.default_rng(0)
-    S = _running_bond(rng, (512, 512), 32, 64)
+    S = running_bond(rng, (512, 512), 32, 64)
     g = np.random.default_rng(1)
     ys, xs = 9 + 64 * g.integers(0, 6, 16), 21 + 64 * g.integers(0, 6, 16)
     tiles = [S[y : y + 64, x : x + 64] for y, x in zip(ys, xs, strict=True)]

@@ -15,21 +15,12 @@ from benchmarks.wang import (
 from benchmarks.wang_oracle import Field, ideal_set
 from engine.metrics import edge_distance, layout_frame, tile_line_distance
 from engine.tiles.wang_layout import wang_layout
+from tests.engine.helpers import running_bond
 
 
 def _noise(seed, size=384, sigma=2.0):
     n = ndimage.gaussian_filter(np.random.default_rng(seed).standard_normal((size, size)), sigma)
     return ((n - n.min()) / np.ptp(n))[..., None]
-
-
-def _running_bond(rng, shape, course, brick):
-    """Running-bond bricks (mortar rows 0-3 of every course) with a stationary grain."""
-    yy, xx = np.mgrid[0 : shape[0], 0 : shape[1]]
-    shift = (yy // course % 2) * (brick // 2)
-    joint = (yy % course < 4) | ((xx + shift) % brick < 4)
-    grain = ndimage.gaussian_filter(rng.standard_normal(shape), 1.2, mode="wrap")
-    grain /= grain.std()
-    return np.where(joint, 0.75, 0.45 + 0.05 * grain)[..., None]
 
 
 def _cells(image, T, offset):
@@ -64,7 +55,7 @@ def test_a_line_across_the_tile_edge_is_no_frame_in_the_layout_though_reflected_
     # session 11's case: a mortar line cut by the tile edge reads as a frame when each tile
     # is reflected at its border, yet the source cut into that grid is the texture itself
     rng = np.random.default_rng(0)
-    S = _running_bond(rng, (384, 384), 32, 64)
+    S = running_bond(rng, (384, 384), 32, 64)
     T, offset = 64, (2, 21)  # the mortar rows 0-3 of a course straddle the horizontal lines
     cells = _cells(S, T, offset)
     assert wang_frame(cells, S, 16).value > 1.3
@@ -111,7 +102,7 @@ def test_the_batch_reads_a_wang_sets_frame_in_its_preview_layout():
     from engine.batch.quality import wang_figures
 
     rng = np.random.default_rng(0)
-    S = _running_bond(rng, (384, 384), 32, 64)
+    S = running_bond(rng, (384, 384), 32, 64)
     T, offset = 64, (2, 21)
     cells = _cells(S, T, offset)  # 5 x 5 cells, row by row
     layout = np.array([[5 * r + c for c in range(4)] for r in range(4)])  # as they lie

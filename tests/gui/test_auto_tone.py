@@ -35,17 +35,24 @@ def test_uneven_lighting_is_flattened_said_on_the_banner_and_can_be_switched_off
     assert not hint.isVisibleTo(panel)
 
 
-def test_flattened_lighting_before_and_after_on_the_source_canvas(qtbot, tmp_path):
-    import numpy as np
-
-    from engine.tone import flatten_lighting
-
+def _lit_bricks_window(qtbot, tmp_path):
+    """A window with a 256 px bricks photo open and 64 px tiles (the Flattened lighting view's
+    tests)."""
     path = tmp_path / "bricks.png"
     Image.fromarray(bricks(256, seed=3)).save(path)
     w = make_window(qtbot)
     with qtbot.waitSignal(w.doc.source_changed, timeout=WAIT_MS):
         w.files.open_path(str(path), confirm=False)
     w.doc.set_params({"tile_size": "64"})
+    return w
+
+
+def test_flattened_lighting_before_and_after_on_the_source_canvas(qtbot, tmp_path):
+    import numpy as np
+
+    from engine.tone import flatten_lighting
+
+    w = _lit_bricks_window(qtbot, tmp_path)
     photo, canvas, act = w.doc.source.main, w.source_view, w.flatten_compare.action
     assert act in w.actions() and act.shortcut().toString() == "F"
     act.trigger()  # after: the source as the tiles are made from it
@@ -104,12 +111,7 @@ def test_a_tile_size_changed_and_back_while_flattening_shows_the_scale_asked(qtb
 
     from engine.tone import flatten_lighting
 
-    path = tmp_path / "bricks.png"
-    Image.fromarray(bricks(256, seed=3)).save(path)
-    w = make_window(qtbot)
-    with qtbot.waitSignal(w.doc.source_changed, timeout=WAIT_MS):
-        w.files.open_path(str(path), confirm=False)
-    w.doc.set_params({"tile_size": "64"})
+    w = _lit_bricks_window(qtbot, tmp_path)
     view, photo = w.flatten_compare, w.doc.source.main
     view.action.trigger()
     qtbot.waitUntil(lambda: view.shown is not None, timeout=WAIT_MS)
